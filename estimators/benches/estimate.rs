@@ -1,0 +1,35 @@
+//! Criterion bench: one estimate of each registered estimator on each test bed it runs on, at a
+//! small sample budget (SPEC §11). Run with `cargo bench -p estimators`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use estimators::budget::Budget;
+use estimators::params::Params;
+use estimators::registry::{ESTIMATORS, TESTBEDS};
+use estimators::rng::stream;
+use estimators::task::Task;
+
+fn one_estimate(c: &mut Criterion) {
+    let budget = Budget::samples(64).expect("64 >= 1");
+    for bed_entry in TESTBEDS {
+        let variant = bed_entry.variants[0];
+        let bed = (bed_entry.build)(variant, &Params::new().with("resolution", 8.0)).expect("default test bed builds");
+        let mut group = c.benchmark_group(format!("estimate_{}_{}spp", bed_entry.id, budget.amount));
+        group.throughput(Throughput::Elements(budget.amount));
+        for e in ESTIMATORS.iter().filter(|e| e.skip_reason(bed.provides()).is_none()) {
+            let est = (e.build)(&Params::new()).expect("default estimator builds");
+            let mut rng = stream(1, e.id);
+            let mut i = 0usize;
+            group.bench_function(BenchmarkId::from_parameter(e.id), |b| {
+                b.iter(|| {
+                    i = (i + 1) % bed.integrals();
+                    let task = Task::new(bed.as_ref(), i, budget);
+                    est.estimate(&task, &mut rng).expect("estimate")
+                })
+            });
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, one_estimate);
+criterion_main!(benches);

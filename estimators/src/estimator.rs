@@ -1,0 +1,65 @@
+//! The estimator plug-in trait (SPEC §2).
+
+use crate::error::EstimateError;
+use crate::math::Rgb;
+use crate::rng::StreamRng;
+use crate::task::Task;
+use crate::testbed::TestBed;
+use serde::{Deserialize, Serialize};
+
+/// What the papers claim of an estimator's expectation (and what the harness then tests).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Bias {
+    /// Expectation equals the integral at every budget.
+    Unbiased,
+    /// Only consistent (self-normalised ratios, exponentiated log estimates).
+    Consistent,
+    /// Biased by construction (controls such as ray marching or clamping).
+    Biased,
+}
+
+impl Bias {
+    /// The name used in tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Bias::Unbiased => "unbiased",
+            Bias::Consistent => "consistent",
+            Bias::Biased => "biased",
+        }
+    }
+}
+
+/// An estimator: given a [`Task`] (one integral, one budget, counted access to the scene) and its
+/// own random stream, return an estimate. Adaptive state lives inside one call.
+///
+/// A minimal estimator, the independent uniform-hemisphere average:
+/// ```
+/// use estimators::{estimator::Estimator, error::EstimateError, math::{Frame, Rgb}, rng::StreamRng,
+///                  samplers::uniform_hemisphere, task::Task};
+///
+/// struct Uniform;
+/// impl Estimator for Uniform {
+///     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+///         let probe = task.hemisphere().ok_or(EstimateError::Refused("needs a surface".into()))?;
+///         let frame = Frame::around(probe.point().normal);
+///         let (mut sum, mut n) = (Rgb::ZERO, 0.0);
+///         while task.more() {
+///             let wi = frame.to_world(uniform_hemisphere::sample_local(rng));
+///             sum += probe.integrand(wi) / uniform_hemisphere::pdf(1.0);
+///             n += 1.0;
+///         }
+///         Ok(sum / n)
+///     }
+/// }
+/// ```
+pub trait Estimator: Send + Sync {
+    /// One estimate of `task.integral()` spending `task.budget()` (loop while `task.more()`).
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError>;
+
+    /// Whether this configured estimator can run on `bed` beyond the static needs of its registry
+    /// entry; `Err(reason)` makes the harness skip the pair and report the reason.
+    fn supports(&self, _bed: &dyn TestBed) -> Result<(), String> {
+        Ok(())
+    }
+}

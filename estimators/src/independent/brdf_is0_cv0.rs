@@ -1,0 +1,44 @@
+//! `brdf_is0_cv0`: BRDF importance sampling (paper 001 §4.5): the diffuse cosine lobe and the
+//! Phong lobe as a mixture, weighted by the exact mixture pdf ([`crate::brdf::Phong::pdf`]).
+
+use crate::estimator::{Bias, Estimator};
+use crate::error::EstimateError;
+use crate::math::Rgb;
+use crate::registry::EstimatorEntry;
+use crate::rng::StreamRng;
+use crate::task::Task;
+use crate::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "brdf_is0_cv0",
+    paper: "001",
+    label: "BRDF_is0_cv0",
+    bias: Bias::Unbiased,
+    needs: Needs::SURFACE,
+    summary: "BRDF importance sampling (cosine + Phong lobe mixture), no control variate",
+    build: |p| {
+        p.reject_unknown("brdf_is0_cv0", &[])?;
+        Ok(Box::new(BrdfIs0Cv0))
+    },
+};
+
+/// The estimator (no parameters).
+pub struct BrdfIs0Cv0;
+
+impl Estimator for BrdfIs0Cv0 {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        super::average(task, rng, |probe, rng| {
+            let p = probe.point();
+            let s = p.brdf.sample(p.wo, p.normal, rng);
+            // The mixture pdf is positive wherever the integrand is non-zero (the cosine lobe
+            // covers the hemisphere when kd > 0, the Phong lobe covers its support when kd = 0);
+            // a zero pdf can only come with a zero integrand, which contributes nothing.
+            if s.pdf > 0.0 {
+                probe.integrand(s.w) / s.pdf
+            } else {
+                probe.integrand(s.w) * 0.0
+            }
+        })
+    }
+}

@@ -1,0 +1,38 @@
+//! `is0_cv0`: uniform hemisphere sampling without control variate, the independent-sample
+//! baseline of papers 000/001 (their "MCMC"): `(1/N) sum 2 pi f(w_k)`.
+
+use crate::estimator::{Bias, Estimator};
+use crate::error::EstimateError;
+use crate::math::{Frame, Rgb};
+use crate::registry::EstimatorEntry;
+use crate::rng::StreamRng;
+use crate::samplers::uniform_hemisphere;
+use crate::task::Task;
+use crate::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "is0_cv0",
+    paper: "001",
+    label: "MCMC (independent MC)",
+    bias: Bias::Unbiased,
+    needs: Needs::SURFACE,
+    summary: "uniform hemisphere sampling, no control variate (independent MC baseline)",
+    build: |p| {
+        p.reject_unknown("is0_cv0", &[])?;
+        Ok(Box::new(Is0Cv0))
+    },
+};
+
+/// The estimator (no parameters).
+pub struct Is0Cv0;
+
+impl Estimator for Is0Cv0 {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        super::average(task, rng, |probe, rng| {
+            let frame = Frame::around(probe.point().normal);
+            let local = uniform_hemisphere::sample_local(rng);
+            probe.integrand(frame.to_world(local)) / uniform_hemisphere::pdf(local.z)
+        })
+    }
+}

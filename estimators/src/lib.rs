@@ -1,0 +1,27 @@
+//! # estimators
+//!
+//! The library half of `mcbench`, a convergence-study harness for adaptive Monte Carlo rendering
+//! estimators: the plug-in traits ([`testbed::TestBed`], [`estimator::Estimator`],
+//! [`budget::Budget`]), the registries, the analytic test beds with their references, samplers,
+//! the estimator families, and the small statistics the harness and the sampler tests share.
+//!
+//! No I/O, plotting or CLI lives here (that is the `experiments` crate).
+#![warn(missing_docs)]
+
+pub mod accumulate;
+pub mod brdf;
+pub mod budget;
+pub mod error;
+pub mod estimator;
+pub mod independent;
+pub mod lighting;
+pub mod math;
+pub mod params;
+pub mod quadrature;
+pub mod registry;
+pub mod rng;
+pub mod samplers;
+pub mod stats;
+pub mod task;
+pub mod testbed;
+pub mod testbeds;

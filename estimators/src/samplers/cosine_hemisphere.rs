@@ -1,0 +1,29 @@
+//! Cosine-weighted hemisphere sampling (Malley's method): density `cos(theta) / pi`.
+
+use super::spherical_direction;
+use crate::math::Vec3;
+use rand::Rng;
+use std::f64::consts::PI;
+
+/// The density per unit solid angle for a direction with `cos(theta) = cos_theta`.
+pub fn pdf(cos_theta: f64) -> f64 {
+    cos_theta.max(0.0) / PI
+}
+
+/// A direction in local coordinates (+z is the normal): `cos^2(theta) = 1 - u1`.
+pub fn sample_local<R: Rng + ?Sized>(rng: &mut R) -> Vec3 {
+    let cos_theta = (1.0 - rng.gen::<f64>()).sqrt();
+    spherical_direction(cos_theta, 2.0 * PI * rng.gen::<f64>())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::samplers::testing::{assert_sampler_fits, SphereGrid};
+
+    #[test]
+    fn chi_square_cosine_hemisphere() {
+        let grid = SphereGrid::upper(16, 16);
+        assert_sampler_fits("cosine hemisphere", &grid, 200_000, 2, |r| sample_local(r), |d| pdf(d.z));
+    }
+}

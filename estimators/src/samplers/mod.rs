@@ -1,0 +1,17 @@
+//! Direction samplers with the densities they report (per unit solid angle).
+//!
+//! Every sampler here has a chi-square goodness-of-fit test beside it (SPEC §6), built on
+//! [`testing::assert_sampler_fits`].
+
+pub mod cosine_hemisphere;
+pub mod phong_lobe;
+pub mod testing;
+pub mod uniform_hemisphere;
+
+use crate::math::Vec3;
+
+/// A unit direction from `cos(theta)` and `phi` about the local +z axis.
+pub fn spherical_direction(cos_theta: f64, phi: f64) -> Vec3 {
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}

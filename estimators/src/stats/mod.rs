@@ -1,0 +1,21 @@
+//! Statistics for the convergence harness (SPEC §5–6).
+//!
+//! - [`moments`]: compensated sums and exactly mergeable running mean/variance;
+//! - [`hypothesis`]: one-sample t, z and Welch tests, Holm–Bonferroni, Šidák, detectable bias;
+//! - [`chi_square`]: chi-square goodness of fit with merged low-expectation cells, histograms, and
+//!   the shared [`StatsError`];
+//! - [`regression`]: least-squares line and power-law (log-log) fits with a 95% slope interval.
+//!
+//! The commonly used items are re-exported here.
+
+pub mod chi_square;
+pub mod hypothesis;
+pub mod moments;
+pub mod regression;
+
+pub use chi_square::{chi_square_gof, histogram, ChiSquare, StatsError, MIN_EXPECTED_COUNT};
+pub use hypothesis::{
+    detectable_shift, holm_bonferroni, one_sample_t, sidak_alpha, welch, z_test, TestOutcome,
+};
+pub use moments::{Moments, NeumaierSum};
+pub use regression::{linear_fit, log_log_fit, SlopeFit};

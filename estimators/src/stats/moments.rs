@@ -1,0 +1,267 @@
+//! Running, exactly mergeable sample statistics.
+//!
+//! [`NeumaierSum`] is a compensated (Kahan–Babuška–Neumaier) sum; [`Moments`] keeps the count,
+//! mean and sum of squared deviations of a sample (Welford's update) and merges two partial
+//! results with Chan et al.'s parallel formula. Both are plain floating-point state machines with no
+//! hidden randomness or parallelism: the same sequence of `add`/`push`/`merge` calls always gives
+//! bit-identical results, which keeps parallel reductions reproducible as long as the merge order is
+//! fixed.
+
+use serde::{Deserialize, Serialize};
+
+/// Compensated summation (Neumaier's variant of Kahan summation).
+///
+/// The running error of every addition is accumulated in a separate compensation term, so the
+/// result is accurate to about one rounding of the exact sum regardless of the number of terms
+/// (unlike naive summation, whose error grows with the count).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct NeumaierSum {
+    sum: f64,
+    comp: f64,
+}
+
+impl NeumaierSum {
+    /// An empty sum (value `0.0`).
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds one term.
+    pub fn add(&mut self, x: f64) {
+        let t = self.sum + x;
+        if self.sum.abs() >= x.abs() {
+            self.comp += (self.sum - t) + x;
+        } else {
+            self.comp += (x - t) + self.sum;
+        }
+        self.sum = t;
+    }
+
+    /// The compensated value of the sum.
+    ///
+    /// Non-finite sums (an infinite or NaN term) are returned as the plain running sum, so an
+    /// infinite term gives an infinite result rather than NaN.
+    pub fn value(&self) -> f64 {
+        if self.sum.is_finite() {
+            self.sum + self.comp
+        } else {
+            self.sum
+        }
+    }
+
+    /// Adds another partial sum into this one (deterministic for a fixed merge order).
+    pub fn merge(&mut self, other: &NeumaierSum) {
+        self.add(other.sum);
+        self.comp += other.comp;
+    }
+}
+
+impl Extend<f64> for NeumaierSum {
+    fn extend<I: IntoIterator<Item = f64>>(&mut self, iter: I) {
+        for x in iter {
+            self.add(x);
+        }
+    }
+}
+
+impl FromIterator<f64> for NeumaierSum {
+    fn from_iter<I: IntoIterator<Item = f64>>(iter: I) -> Self {
+        let mut s = Self::new();
+        s.extend(iter);
+        s
+    }
+}
+
+/// Running count, mean and sum of squared deviations of a sample.
+///
+/// Updated one value at a time with Welford's algorithm ([`Moments::push`]) and combined with
+/// Chan, Golub and LeVeque's pairwise formula ([`Moments::merge`]), both numerically stable when the
+/// mean is large compared with the spread.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Moments {
+    n: u64,
+    mean: f64,
+    m2: f64,
+}
+
+impl Moments {
+    /// An empty sample.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds one observation.
+    pub fn push(&mut self, x: f64) {
+        self.n += 1;
+        let delta = x - self.mean;
+        self.mean += delta / self.n as f64;
+        self.m2 += delta * (x - self.mean);
+    }
+
+    /// Merges the statistics of another, disjoint sample into this one.
+    ///
+    /// Deterministic: the same sequence of merges always gives bit-identical results. Merging an
+    /// empty sample is a no-op, and merging into an empty sample copies `other`.
+    pub fn merge(&mut self, other: &Moments) {
+        if other.n == 0 {
+            return;
+        }
+        if self.n == 0 {
+            *self = other.clone();
+            return;
+        }
+        let na = self.n as f64;
+        let nb = other.n as f64;
+        let n = self.n + other.n;
+        let nf = n as f64;
+        let delta = other.mean - self.mean;
+        self.mean += delta * (nb / nf);
+        self.m2 += other.m2 + delta * delta * (na * nb / nf);
+        self.n = n;
+    }
+
+    /// Number of observations.
+    pub fn count(&self) -> u64 {
+        self.n
+    }
+
+    /// Sample mean; `NaN` for an empty sample.
+    pub fn mean(&self) -> f64 {
+        if self.n == 0 {
+            f64::NAN
+        } else {
+            self.mean
+        }
+    }
+
+    /// Unbiased sample variance (divisor `n - 1`); `NaN` when fewer than 2 observations.
+    pub fn variance(&self) -> f64 {
+        if self.n < 2 {
+            f64::NAN
+        } else {
+            (self.m2 / (self.n - 1) as f64).max(0.0)
+        }
+    }
+
+    /// Standard error of the mean, `sqrt(variance / n)`; `NaN` when fewer than 2 observations.
+    pub fn std_err(&self) -> f64 {
+        (self.variance() / self.n as f64).sqrt()
+    }
+}
+
+impl Extend<f64> for Moments {
+    fn extend<I: IntoIterator<Item = f64>>(&mut self, iter: I) {
+        for x in iter {
+            self.push(x);
+        }
+    }
+}
+
+impl FromIterator<f64> for Moments {
+    fn from_iter<I: IntoIterator<Item = f64>>(iter: I) -> Self {
+        let mut m = Self::new();
+        m.extend(iter);
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / b.abs().max(f64::MIN_POSITIVE)
+    }
+
+    #[test]
+    fn neumaier_beats_naive_on_many_tenths() {
+        let mut naive = 0.0f64;
+        let mut s = NeumaierSum::new();
+        for _ in 0..10_000_000 {
+            naive += 0.1;
+            s.add(0.1);
+        }
+        // The exact sum of 1e7 copies of fl(0.1) rounds to 1e6.
+        assert_eq!(s.value(), 1.0e6);
+        assert!((naive - 1.0e6).abs() > 1e-4, "naive = {naive}");
+    }
+
+    #[test]
+    fn neumaier_handles_classic_cancellation() {
+        let xs = [1.0, 1e100, 1.0, -1e100];
+        let naive: f64 = xs.iter().sum();
+        let s: NeumaierSum = xs.iter().copied().collect();
+        assert_eq!(naive, 0.0);
+        assert_eq!(s.value(), 2.0);
+    }
+
+    #[test]
+    fn neumaier_merge_and_non_finite() {
+        let mut a: NeumaierSum = [1.0, 1e100].into_iter().collect();
+        let b: NeumaierSum = [1.0, -1e100].into_iter().collect();
+        a.merge(&b);
+        assert_eq!(a.value(), 2.0);
+        let inf: NeumaierSum = [1.0, f64::INFINITY, 2.0].into_iter().collect();
+        assert_eq!(inf.value(), f64::INFINITY);
+        assert_eq!(NeumaierSum::new().value(), 0.0);
+    }
+
+    #[test]
+    fn moments_basic_values() {
+        let m: Moments = [2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0]
+            .into_iter()
+            .collect();
+        assert_eq!(m.count(), 8);
+        assert_eq!(m.mean(), 5.0);
+        assert!(rel(m.variance(), 32.0 / 7.0) < 1e-15);
+        assert!(rel(m.std_err(), (32.0f64 / 7.0 / 8.0).sqrt()) < 1e-15);
+    }
+
+    #[test]
+    fn moments_small_samples_are_nan() {
+        let empty = Moments::new();
+        assert!(empty.mean().is_nan() && empty.variance().is_nan() && empty.std_err().is_nan());
+        let mut one = Moments::new();
+        one.push(3.0);
+        assert_eq!(one.mean(), 3.0);
+        assert!(one.variance().is_nan() && one.std_err().is_nan());
+    }
+
+    #[test]
+    fn moments_stable_with_large_offset() {
+        // Naive sum-of-squares would lose every digit here.
+        let m: Moments = [1e9 + 4.0, 1e9 + 7.0, 1e9 + 13.0, 1e9 + 16.0]
+            .into_iter()
+            .collect();
+        assert!(rel(m.variance(), 30.0) < 1e-9, "{}", m.variance());
+    }
+
+    #[test]
+    fn merge_equals_sequential_push() {
+        let mut rng = Pcg64::seed_from_u64(0x5eed_0001);
+        let xs: Vec<f64> = (0..10_007)
+            .map(|_| 3.0 + rng.gen::<f64>().powi(3))
+            .collect();
+        let seq: Moments = xs.iter().copied().collect();
+        let mut merged = Moments::new();
+        for chunk in xs.chunks(997) {
+            let part: Moments = chunk.iter().copied().collect();
+            merged.merge(&part);
+        }
+        assert_eq!(merged.count(), seq.count());
+        assert!(rel(merged.mean(), seq.mean()) < 1e-12);
+        assert!(rel(merged.variance(), seq.variance()) < 1e-12);
+        // Merging is deterministic and empty samples are neutral.
+        let mut again = Moments::new();
+        for chunk in xs.chunks(997) {
+            again.merge(&Moments::new());
+            again.merge(&chunk.iter().copied().collect());
+        }
+        assert_eq!(again, merged);
+        let mut into_empty = Moments::new();
+        into_empty.merge(&seq);
+        assert_eq!(into_empty, seq);
+    }
+}

@@ -1,0 +1,97 @@
+//! The harness's counted view of a test bed for one estimate (SPEC §2 "Budget").
+//!
+//! Estimators reach the scene only through a [`Task`] and its probes, and the probes count every
+//! sample, ray and fetch, so no plug-in can forget to count (the argmin `Problem` wrapper idea).
+
+use crate::budget::{Budget, BudgetKind};
+use crate::math::{Rgb, Vec3};
+use crate::testbed::{HemisphereScene, ShadingPoint, TestBed};
+use serde::{Deserialize, Serialize};
+use std::cell::Cell;
+use std::time::Instant;
+
+/// The costs of one estimate, counted by the harness.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Costs {
+    /// Integrand evaluations (the papers' samples).
+    pub samples: u64,
+    /// Evaluations of a medium parameter stack (extinction, albedo, noise octaves: one per point).
+    pub fetches: u64,
+    /// Cheap approximate-extinction evaluations (control variates), counted apart.
+    pub cheap_fetches: u64,
+    /// Rays traced (incident-radiance queries, shadow rays, ...).
+    pub rays: u64,
+}
+
+/// One estimate of one integral under one budget.
+pub struct Task<'a> {
+    bed: &'a dyn TestBed,
+    integral: usize,
+    budget: Budget,
+    costs: Cell<Costs>,
+    started: Instant,
+}
+
+impl<'a> Task<'a> {
+    /// A task for integral `integral` of `bed` (the harness builds these).
+    pub fn new(bed: &'a dyn TestBed, integral: usize, budget: Budget) -> Self {
+        Task { bed, integral, budget, costs: Cell::new(Costs::default()), started: Instant::now() }
+    }
+    /// The integral index.
+    pub fn integral(&self) -> usize {
+        self.integral
+    }
+    /// The budget of this estimate.
+    pub fn budget(&self) -> Budget {
+        self.budget
+    }
+    /// Costs so far.
+    pub fn costs(&self) -> Costs {
+        self.costs.get()
+    }
+    /// True while the budget is not spent (checked before each sample).
+    pub fn more(&self) -> bool {
+        let c = self.costs.get();
+        match self.budget.kind {
+            BudgetKind::Samples => c.samples < self.budget.amount,
+            BudgetKind::Fetches => c.fetches < self.budget.amount,
+            BudgetKind::Micros => (self.started.elapsed().as_micros() as u64) < self.budget.amount,
+        }
+    }
+    /// The hemispherical-integral probe of this integral, when the scene has one.
+    pub fn hemisphere(&self) -> Option<HemisphereProbe<'_>> {
+        let scene = self.bed.hemisphere()?;
+        Some(HemisphereProbe { point: scene.shading(self.integral), scene, task: self })
+    }
+    fn count(&self, f: impl FnOnce(&mut Costs)) {
+        let mut c = self.costs.get();
+        f(&mut c);
+        self.costs.set(c);
+    }
+}
+
+/// Counted access to a hemispherical integral.
+pub struct HemisphereProbe<'a> {
+    scene: &'a dyn HemisphereScene,
+    task: &'a Task<'a>,
+    point: ShadingPoint,
+}
+
+impl HemisphereProbe<'_> {
+    /// The shading point (geometry and BRDF are known locally and cost nothing).
+    pub fn point(&self) -> &ShadingPoint {
+        &self.point
+    }
+    /// The integrand `L_in(w_i) f(w_i, w_o) cos(theta_i)`: one sample and one ray. Zero below the
+    /// horizon (still one sample: the estimator drew it).
+    pub fn integrand(&self, wi: Vec3) -> Rgb {
+        self.task.count(|c| c.samples += 1);
+        let p = &self.point;
+        let cos = wi.dot(p.normal);
+        if cos <= 0.0 {
+            return Rgb::ZERO;
+        }
+        self.task.count(|c| c.rays += 1);
+        self.scene.incident(self.task.integral, wi) * p.brdf.eval(wi, p.wo, p.normal) * cos
+    }
+}

@@ -1,0 +1,154 @@
+//! The test-bed plug-in trait (SPEC §2): a deterministic scene defining integrals to estimate and
+//! their references, and what it provides to estimators.
+
+use crate::brdf::Phong;
+use crate::math::{Rgb, Vec3};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// What a test bed provides and what an estimator needs (a small bit set).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct Needs(u32);
+
+impl Needs {
+    /// Nothing.
+    pub const NONE: Needs = Needs(0);
+    /// Hemispherical surface integrals ([`HemisphereScene`]).
+    pub const SURFACE: Needs = Needs(1);
+    /// A participating medium (fetches are counted).
+    pub const MEDIUM: Needs = Needs(2);
+    /// A point light.
+    pub const POINT_LIGHT: Needs = Needs(4);
+    /// A sequence of environment maps (frames).
+    pub const ENV_SEQUENCE: Needs = Needs(8);
+    /// Area lights that can be sampled.
+    pub const AREA_LIGHTS: Needs = Needs(16);
+    const NAMES: [(Needs, &'static str); 5] = [
+        (Needs::SURFACE, "surface"),
+        (Needs::MEDIUM, "medium"),
+        (Needs::POINT_LIGHT, "point light"),
+        (Needs::ENV_SEQUENCE, "environment sequence"),
+        (Needs::AREA_LIGHTS, "area lights"),
+    ];
+    /// Union of two sets.
+    pub const fn and(self, o: Needs) -> Needs {
+        Needs(self.0 | o.0)
+    }
+    /// True when every member of `o` is in `self`.
+    pub fn contains(self, o: Needs) -> bool {
+        self.0 & o.0 == o.0
+    }
+    /// The members of `self` missing from `provided`, or `None` when all are there.
+    pub fn missing_from(self, provided: Needs) -> Option<Needs> {
+        let m = Needs(self.0 & !provided.0);
+        (m.0 != 0).then_some(m)
+    }
+}
+
+impl fmt::Display for Needs {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let names: Vec<&str> = Needs::NAMES.iter().filter(|(n, _)| self.contains(*n)).map(|(_, s)| *s).collect();
+        if names.is_empty() {
+            write!(f, "nothing")
+        } else {
+            write!(f, "{}", names.join(" + "))
+        }
+    }
+}
+
+/// How a reference was obtained.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum ReferenceKind {
+    /// Closed form or deterministic quadrature with a stated absolute error bound.
+    Exact {
+        /// How it was computed.
+        method: String,
+        /// The largest absolute error bound over integrals and channels.
+        bound: f64,
+    },
+    /// A stored long-run Monte Carlo value with per-integral standard errors.
+    Stored {
+        /// The command that made it.
+        command: String,
+        /// Independent samples behind each stored value (for Welch's degrees of freedom).
+        samples: u64,
+    },
+}
+
+/// The reference values of a test bed's integrals (one RGB per integral).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Reference {
+    /// How it was obtained.
+    pub kind: ReferenceKind,
+    /// Value per integral.
+    pub value: Vec<Rgb>,
+    /// Standard error per integral (zero for exact references).
+    pub std_err: Vec<Rgb>,
+}
+
+impl Reference {
+    /// True for closed-form or quadrature references.
+    pub fn is_exact(&self) -> bool {
+        matches!(self.kind, ReferenceKind::Exact { .. })
+    }
+}
+
+/// The local shading setup of one surface integral.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingPoint {
+    /// Hit point.
+    pub position: Vec3,
+    /// Unit shading normal.
+    pub normal: Vec3,
+    /// Unit direction towards the viewer.
+    pub wo: Vec3,
+    /// The surface BRDF.
+    pub brdf: Phong,
+}
+
+/// A scene whose integrals are hemispherical: `integral of L_in(w) f(w, w_o) cos(theta) dw` at
+/// one shading point per integral (papers 001, 003, 004).
+pub trait HemisphereScene: Send + Sync {
+    /// The shading point of integral `i`.
+    fn shading(&self, i: usize) -> ShadingPoint;
+    /// Radiance arriving at the shading point of integral `i` from direction `wi` (one ray).
+    fn incident(&self, i: usize, wi: Vec3) -> Rgb;
+}
+
+/// A test bed (SPEC §2). Integrals are pixels in row-major order, `i = py * width + px`.
+///
+/// ```
+/// use estimators::registry::testbed;
+/// use estimators::params::Params;
+/// let bed = (testbed("gradient-plane").unwrap().build)("diffuse", &Params::new().with("resolution", 4.0)).unwrap();
+/// assert_eq!(bed.integrals(), 16);
+/// assert!(bed.reference().is_exact());
+/// // A diffuse pixel integrates to kd (c0 + 2 c1 / 3) in closed form (red: 0.8 * (1 + 2/3)).
+/// assert!((bed.reference().value[0][0] - 0.8 * (1.0 + 2.0 / 3.0)).abs() < 1e-12);
+/// ```
+pub trait TestBed: Send + Sync {
+    /// Registered id, e.g. `gradient-plane`.
+    fn id(&self) -> &'static str;
+    /// Variant name, e.g. `default`.
+    fn variant(&self) -> &str;
+    /// What the scene provides.
+    fn provides(&self) -> Needs;
+    /// Image width and height; the number of integrals is their product.
+    fn resolution(&self) -> (usize, usize);
+    /// The references of every integral.
+    fn reference(&self) -> &Reference;
+    /// Extra geometry columns for integral `i` in `integrals.csv` (name, value).
+    fn geometry(&self, _i: usize) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
+    /// The hemispherical-integral view of the scene, when it has one.
+    fn hemisphere(&self) -> Option<&dyn HemisphereScene> {
+        None
+    }
+    /// Number of integrals.
+    fn integrals(&self) -> usize {
+        let (w, h) = self.resolution();
+        w * h
+    }
+}

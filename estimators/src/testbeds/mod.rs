@@ -1,0 +1,5 @@
+//! The analytic test beds (SPEC §3), each with its exact or stored reference.
+
+pub mod gradient_plane;
+pub mod phong_lobe;
+pub mod pinhole;

@@ -1,0 +1,228 @@
+//! What a run concludes: convergence-slope fits (SPEC §5), unbiasedness tests (SPEC §6) and the
+//! papers' speed-up computation (paper 000/001).
+
+use crate::cell::CellResult;
+use crate::metrics::SummaryRow;
+use estimators::estimator::Bias;
+use estimators::stats::{detectable_shift, holm_bonferroni, log_log_fit, one_sample_t, welch, z_test};
+use estimators::testbed::{Reference, ReferenceKind};
+use serde::{Deserialize, Serialize};
+
+/// Family-wise significance of the unbiasedness tests (SPEC §6).
+pub const UNBIASEDNESS_ALPHA: f64 = 1e-3;
+/// Power at which the detectable bias is reported.
+pub const POWER: f64 = 0.8;
+
+/// A convergence-slope fit of log RMSE on log budget.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Fit {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// Fitted slope (the order of convergence is -slope).
+    pub slope: f64,
+    /// 95% confidence interval, low end.
+    pub slope_ci_low: f64,
+    /// 95% confidence interval, high end.
+    pub slope_ci_high: f64,
+    /// Coefficient of determination.
+    pub r2: f64,
+    /// Intercept of the fit (log RMSE at budget 1).
+    pub intercept: f64,
+    /// Budgets used.
+    pub budgets: Vec<u64>,
+}
+
+/// Fits every (test bed, variant, estimator) series of rows (at least 3 budgets with RMSE > 0).
+pub fn fits(rows: &[SummaryRow]) -> Vec<Fit> {
+    let mut out = Vec::new();
+    for series in group(rows) {
+        let pts: Vec<&SummaryRow> = series.into_iter().filter(|r| r.rmse > 0.0).collect();
+        let x: Vec<f64> = pts.iter().map(|r| r.budget as f64).collect();
+        let y: Vec<f64> = pts.iter().map(|r| r.rmse).collect();
+        if let Ok(f) = log_log_fit(&x, &y) {
+            out.push(Fit {
+                testbed: pts[0].testbed.clone(),
+                variant: pts[0].variant.clone(),
+                estimator: pts[0].estimator.clone(),
+                slope: f.slope,
+                slope_ci_low: f.slope_ci_low,
+                slope_ci_high: f.slope_ci_high,
+                r2: f.r2,
+                intercept: f.intercept,
+                budgets: pts.iter().map(|r| r.budget).collect(),
+            });
+        }
+    }
+    out
+}
+
+/// Rows grouped by (test bed, variant, estimator), in first-appearance order.
+pub fn group(rows: &[SummaryRow]) -> Vec<Vec<&SummaryRow>> {
+    let mut groups: Vec<Vec<&SummaryRow>> = Vec::new();
+    for r in rows {
+        match groups.iter_mut().find(|g| g[0].testbed == r.testbed && g[0].variant == r.variant && g[0].estimator == r.estimator) {
+            Some(g) => g.push(r),
+            None => groups.push(vec![r]),
+        }
+    }
+    groups
+}
+
+/// One statistical test verdict.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TestRow {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// `holm_t` (exact reference), `holm_welch` (stored reference) or `pooled_z`.
+    pub test: String,
+    /// Budget the test ran at.
+    pub budget: u64,
+    /// Test statistic (largest |t| for the Holm tests).
+    pub statistic: f64,
+    /// Smallest Holm-adjusted p-value (or the pooled test's p-value).
+    pub p_value: f64,
+    /// `pass` (no bias detected) or `biased` (flagged at alpha).
+    pub verdict: String,
+    /// Family-wise alpha.
+    pub alpha: f64,
+    /// Relative bias the test detects with 80% power (median over integrals for Holm tests).
+    pub detectable_rel_bias: f64,
+    /// What the paper claims (`unbiased`, `consistent`, `biased`).
+    pub claim: String,
+    /// Whether the verdict agrees with the claim (a biased control must be flagged).
+    pub agrees: bool,
+}
+
+fn row(cell: &CellResult, claim: Bias, test: &str, statistic: f64, p: f64, detectable: f64) -> TestRow {
+    let flagged = p < UNBIASEDNESS_ALPHA;
+    TestRow {
+        testbed: cell.key.testbed.clone(),
+        variant: cell.key.variant.clone(),
+        estimator: cell.key.estimator.clone(),
+        test: test.to_string(),
+        budget: cell.key.budget.amount,
+        statistic,
+        p_value: p,
+        verdict: if flagged { "biased" } else { "pass" }.to_string(),
+        alpha: UNBIASEDNESS_ALPHA,
+        detectable_rel_bias: detectable,
+        claim: claim.name().to_string(),
+        agrees: match claim {
+            Bias::Unbiased => !flagged,
+            Bias::Biased => flagged,
+            Bias::Consistent => true,
+        },
+    }
+}
+
+/// The SPEC §6 unbiasedness tests of one cell: per integral and channel a t-test (exact
+/// reference) or Welch test (stored reference), Holm-Bonferroni over all of them; and a pooled
+/// z-test of the mean relative bias.
+pub fn unbiasedness(cell: &CellResult, reference: &Reference, claim: Bias) -> Vec<TestRow> {
+    let reps = cell.key.reps as u64;
+    let m = cell.moments.len() * 3;
+    let stored_n = match &reference.kind {
+        ReferenceKind::Stored { samples, .. } => Some(*samples),
+        ReferenceKind::Exact { .. } => None,
+    };
+    let (mut ps, mut max_t, mut detect) = (Vec::with_capacity(m), 0.0f64, Vec::with_capacity(m));
+    let (mut pooled, mut pooled_var, mut pooled_n) = (0.0, 0.0, 0usize);
+    let per_test_alpha = UNBIASEDNESS_ALPHA / m as f64;
+    for (i, mom) in cell.moments.iter().enumerate() {
+        for (c, mc) in mom.iter().enumerate() {
+            let (r, rse) = (reference.value[i][c], reference.std_err[i][c]);
+            let se = mc.std_err();
+            let t = match stored_n {
+                None => one_sample_t(mc.mean(), se, reps, r),
+                Some(n) => welch(mc.mean(), se, reps, r, rse, n),
+            };
+            max_t = max_t.max(t.statistic.abs());
+            ps.push(t.p_value);
+            let se_total = (se * se + rse * rse).sqrt();
+            if r != 0.0 {
+                detect.push(detectable_shift(se_total, per_test_alpha, POWER) / r.abs());
+                pooled += (mc.mean() - r) / r;
+                pooled_var += (se_total / r).powi(2);
+                pooled_n += 1;
+            }
+        }
+    }
+    let adjusted = holm_bonferroni(&ps);
+    let min_p = adjusted.iter().copied().filter(|p| !p.is_nan()).fold(1.0, f64::min);
+    detect.sort_by(f64::total_cmp);
+    let median_detect = detect.get(detect.len() / 2).copied().unwrap_or(f64::NAN);
+    let name = if stored_n.is_some() { "holm_welch" } else { "holm_t" };
+    let mut out = vec![row(cell, claim, name, max_t, min_p, median_detect)];
+    if pooled_n > 0 {
+        let (mean, se) = (pooled / pooled_n as f64, pooled_var.sqrt() / pooled_n as f64);
+        let z = z_test(mean, se, 0.0);
+        out.push(row(cell, claim, "pooled_z", z.statistic, z.p_value, detectable_shift(se, UNBIASEDNESS_ALPHA, POWER)));
+    }
+    out
+}
+
+/// The papers' speed-up at the rightmost budget (paper 000 §5, 001 §5): samples the baseline needs
+/// to reach the method's error (from the baseline's fitted slope) over the method's samples, divided
+/// by the method's overhead (its time per estimate over the baseline's).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpeedUp {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// Baseline name.
+    pub baseline: String,
+    /// The rightmost budget.
+    pub budget: u64,
+    /// Baseline samples needed for the method's RMSE over the method's samples.
+    pub sample_ratio: f64,
+    /// Method seconds per estimate over the baseline's at the same budget.
+    pub overhead: f64,
+    /// sample_ratio / overhead.
+    pub speedup: f64,
+}
+
+/// Speed-ups of every series against `baseline`.
+pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str) -> Vec<SpeedUp> {
+    let mut out = Vec::new();
+    for series in group(rows) {
+        let last = series[series.len() - 1];
+        if last.estimator == baseline {
+            continue;
+        }
+        let same = |r: &&SummaryRow| r.testbed == last.testbed && r.variant == last.variant && r.estimator == baseline;
+        let (Some(fit), Some(base)) = (
+            fits.iter().find(|f| f.testbed == last.testbed && f.variant == last.variant && f.estimator == baseline),
+            rows.iter().filter(same).find(|r| r.budget == last.budget),
+        ) else {
+            continue;
+        };
+        if last.rmse <= 0.0 || fit.slope >= 0.0 {
+            continue;
+        }
+        let needed = ((last.rmse.ln() - fit.intercept) / fit.slope).exp();
+        let sample_ratio = needed / last.budget as f64;
+        let overhead = last.seconds / base.seconds;
+        out.push(SpeedUp {
+            testbed: last.testbed.clone(),
+            variant: last.variant.clone(),
+            estimator: last.estimator.clone(),
+            baseline: baseline.to_string(),
+            budget: last.budget,
+            sample_ratio,
+            overhead,
+            speedup: sample_ratio / overhead,
+        });
+    }
+    out
+}

@@ -1,0 +1,130 @@
+//! One cell of a sweep, (test bed, variant, estimator, budget), and its sufficient statistics:
+//! per-integral moments over repetitions, cost totals, and a log-histogram of estimate times.
+//! Cells are what the harness stores for resuming and what shards will merge.
+
+use estimators::budget::Budget;
+use estimators::stats::Moments;
+use estimators::task::Costs;
+use serde::{Deserialize, Serialize};
+
+/// What identifies a cell's result: equal keys give equal results.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellKey {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Test-bed parameters as JSON text.
+    pub testbed_params: String,
+    /// Estimator name (id with parameters).
+    pub estimator: String,
+    /// Budget.
+    pub budget: Budget,
+    /// Repetitions.
+    pub reps: usize,
+    /// Seed.
+    pub seed: u64,
+    /// Harness version that made it.
+    pub version: String,
+}
+
+impl CellKey {
+    /// A file name for the cell: readable prefix plus a digest of the whole key.
+    pub fn file_name(&self) -> String {
+        let text = serde_json::to_string(self).unwrap_or_default();
+        let clean = |s: &str| s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect::<String>();
+        format!(
+            "{}_{}_{}_{}{}_{:016x}.json",
+            clean(&self.testbed),
+            clean(&self.variant),
+            clean(&self.estimator),
+            self.budget.kind.name(),
+            self.budget.amount,
+            estimators::rng::fnv1a(&text)
+        )
+    }
+}
+
+/// Estimate times: total and a histogram of `round(16 log2(seconds))` for medians.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TimeStats {
+    /// Sum of single-thread seconds.
+    pub total: f64,
+    /// Number of timed estimates.
+    pub count: u64,
+    /// (bin, count) pairs, bins increasing.
+    pub hist: Vec<(i32, u64)>,
+}
+
+impl TimeStats {
+    const BINS_PER_OCTAVE: f64 = 16.0;
+    /// Records one estimate's time.
+    pub fn push(&mut self, seconds: f64) {
+        self.total += seconds;
+        self.count += 1;
+        let bin = (seconds.max(1e-12).log2() * Self::BINS_PER_OCTAVE).round() as i32;
+        match self.hist.binary_search_by_key(&bin, |p| p.0) {
+            Ok(i) => self.hist[i].1 += 1,
+            Err(i) => self.hist.insert(i, (bin, 1)),
+        }
+    }
+    /// Merges another record.
+    pub fn merge(&mut self, o: &TimeStats) {
+        self.total += o.total;
+        self.count += o.count;
+        for &(bin, n) in &o.hist {
+            match self.hist.binary_search_by_key(&bin, |p| p.0) {
+                Ok(i) => self.hist[i].1 += n,
+                Err(i) => self.hist.insert(i, (bin, n)),
+            }
+        }
+    }
+    /// Mean seconds per estimate.
+    pub fn mean(&self) -> f64 {
+        self.total / self.count.max(1) as f64
+    }
+    /// Median seconds per estimate (to the histogram's 4% resolution).
+    pub fn median(&self) -> f64 {
+        let half = self.count.div_ceil(2);
+        let mut seen = 0;
+        for &(bin, n) in &self.hist {
+            seen += n;
+            if seen >= half {
+                return (bin as f64 / Self::BINS_PER_OCTAVE).exp2();
+            }
+        }
+        f64::NAN
+    }
+}
+
+/// The sufficient statistics of one cell.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellResult {
+    /// What it is.
+    pub key: CellKey,
+    /// Per integral, per channel: moments of the estimates over repetitions.
+    pub moments: Vec<[Moments; 3]>,
+    /// Cost totals over all estimates.
+    pub costs: Costs,
+    /// Number of estimates (reps x integrals).
+    pub estimates: u64,
+    /// Estimate times.
+    pub time: TimeStats,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_times_within_histogram_resolution() {
+        let mut t = TimeStats::default();
+        for s in [1e-6, 2e-6, 3e-6, 4e-6, 100e-6] {
+            t.push(s);
+        }
+        assert!((t.median() / 3e-6 - 1.0).abs() < 0.03, "{}", t.median());
+        let mut u = TimeStats::default();
+        u.merge(&t);
+        assert_eq!(u, t);
+    }
+}

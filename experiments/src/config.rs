@@ -1,0 +1,245 @@
+//! Sweeps and the config files that describe or override them (SPEC §9: "a TOML or JSON config
+//! file describes custom sweeps").
+//!
+//! ```toml
+//! name = "my-sweep"            # required when no experiment is named on the command line
+//! seed = 7
+//! reps = 8
+//! budget_kind = "samples"      # samples | fetches | micros
+//! budgets = [4, 16, 64, 256]
+//! baseline = "is0_cv0"         # speed-ups are computed against it
+//! [[testbeds]]
+//! id = "gradient-plane"
+//! variant = "glossy"
+//! params = { resolution = 16 }
+//! [[estimators]]
+//! id = "clamped_is0_cv0"
+//! params = { clamp = 4.0 }
+//! ```
+
+use crate::error::{HarnessError, Result};
+use estimators::budget::{Budget, BudgetKind};
+use estimators::error::ConfigError;
+use estimators::params::{ParamValue, Params};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// One test bed of a sweep.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TestBedSpec {
+    /// Registered id.
+    pub id: String,
+    /// Variant (the test bed's first variant when omitted).
+    #[serde(default)]
+    pub variant: Option<String>,
+    /// Test-bed parameters.
+    #[serde(default)]
+    pub params: Params,
+}
+
+/// One estimator of a sweep.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EstimatorSpec {
+    /// Registered id.
+    pub id: String,
+    /// Estimator parameters.
+    #[serde(default)]
+    pub params: Params,
+}
+
+impl EstimatorSpec {
+    /// An estimator with default parameters.
+    pub fn new(id: &str) -> Self {
+        EstimatorSpec { id: id.to_string(), params: Params::new() }
+    }
+    /// The name in result files: the id, followed by `[k=v,...]` when parameters are set.
+    pub fn name(&self) -> String {
+        if self.params.0.is_empty() {
+            return self.id.clone();
+        }
+        let kv: Vec<String> = self
+            .params
+            .0
+            .iter()
+            .map(|(k, v)| match v {
+                ParamValue::Number(x) => format!("{k}={x}"),
+                ParamValue::Text(t) => format!("{k}={t}"),
+            })
+            .collect();
+        format!("{}[{}]", self.id, kv.join(","))
+    }
+}
+
+/// Quick (CI-sized) or full (the papers' sizes).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// Small sizes: every experiment in about a minute.
+    Quick,
+    /// The papers' sizes.
+    Full,
+}
+
+impl Mode {
+    /// Name written in `meta.mode`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Quick => "quick",
+            Mode::Full => "full",
+        }
+    }
+}
+
+/// A fully specified sweep: test beds x estimators x budgets x repetitions.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sweep {
+    /// Experiment name (the results folder).
+    pub experiment: String,
+    /// Test beds.
+    pub testbeds: Vec<TestBedSpec>,
+    /// Estimators.
+    pub estimators: Vec<EstimatorSpec>,
+    /// Budgets, increasing.
+    pub budgets: Vec<Budget>,
+    /// Repetitions per integral.
+    pub reps: usize,
+    /// Experiment seed.
+    pub seed: u64,
+    /// Quick or full.
+    pub mode: Mode,
+    /// Estimator name the speed-ups are computed against.
+    pub baseline: Option<String>,
+}
+
+/// `4^k` for `k` in `ks`: the papers' spp sweep.
+pub fn powers_of_four(ks: std::ops::RangeInclusive<u32>) -> Vec<Budget> {
+    ks.map(|k| Budget { kind: BudgetKind::Samples, amount: 4u64.pow(k) }).collect()
+}
+
+/// The optional fields of a config file; present fields override the named experiment's sweep.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepFile {
+    /// Experiment name (required for a custom sweep).
+    pub name: Option<String>,
+    /// Seed.
+    pub seed: Option<u64>,
+    /// Repetitions.
+    pub reps: Option<usize>,
+    /// Budget kind of `budgets`.
+    pub budget_kind: Option<String>,
+    /// Budgets.
+    pub budgets: Option<Vec<u64>>,
+    /// Baseline estimator name for speed-ups.
+    pub baseline: Option<String>,
+    /// Test beds.
+    pub testbeds: Option<Vec<TestBedSpec>>,
+    /// Estimators.
+    pub estimators: Option<Vec<EstimatorSpec>>,
+}
+
+impl SweepFile {
+    /// Reads a `.toml` or `.json` file; any problem is a one-line error naming the file.
+    pub fn read(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| HarnessError::bad_file(path, e))?;
+        let parsed = match path.extension().and_then(|e| e.to_str()) {
+            Some("json") => serde_json::from_str(&text).map_err(|e| e.to_string()),
+            Some("toml") => toml::from_str(&text).map_err(|e| e.message().to_string()),
+            _ => Err("config files must end in .toml or .json".to_string()),
+        };
+        parsed.map_err(|reason| HarnessError::bad_file(path, reason.lines().next().unwrap_or("malformed").to_string()))
+    }
+
+    /// Applies the file to `base` (a named experiment's sweep) or builds a custom sweep.
+    pub fn apply(self, base: Option<Sweep>, mode: Mode) -> Result<Sweep> {
+        let mut sweep = match base {
+            Some(s) => s,
+            None => Sweep {
+                experiment: self.name.clone().ok_or_else(|| ConfigError::invalid("name", "(missing)", "a custom sweep needs a name"))?,
+                testbeds: Vec::new(),
+                estimators: Vec::new(),
+                budgets: Vec::new(),
+                reps: 8,
+                seed: 1,
+                mode,
+                baseline: None,
+            },
+        };
+        if let Some(name) = self.name {
+            sweep.experiment = name;
+        }
+        if let Some(seed) = self.seed {
+            sweep.seed = seed;
+        }
+        if let Some(reps) = self.reps {
+            sweep.reps = reps;
+        }
+        let kind = match self.budget_kind {
+            Some(k) => BudgetKind::parse(&k)?,
+            None => sweep.budgets.first().map(|b| b.kind).unwrap_or(BudgetKind::Samples),
+        };
+        if let Some(values) = self.budgets {
+            sweep.budgets = values.into_iter().map(|v| Budget::new(kind, v)).collect::<Result<_, _>>()?;
+        }
+        if self.baseline.is_some() {
+            sweep.baseline = self.baseline;
+        }
+        if let Some(t) = self.testbeds {
+            sweep.testbeds = t;
+        }
+        if let Some(e) = self.estimators {
+            sweep.estimators = e;
+        }
+        Ok(sweep)
+    }
+}
+
+impl Sweep {
+    /// Checks what can be checked without building anything.
+    pub fn validate(&self) -> Result<()> {
+        let name_ok = !self.experiment.is_empty()
+            && self.experiment.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+        if !name_ok {
+            return Err(ConfigError::invalid("name", &self.experiment, "use letters, digits, '-' and '_'").into());
+        }
+        if self.reps < 2 {
+            return Err(ConfigError::invalid("reps", self.reps, "at least 2 repetitions are needed for variances").into());
+        }
+        if self.budgets.is_empty() || self.testbeds.is_empty() || self.estimators.is_empty() {
+            return Err(ConfigError::invalid("sweep", &self.experiment, "needs at least one test bed, estimator and budget").into());
+        }
+        if let Some(b) = self.budgets.iter().find(|b| b.amount == 0) {
+            return Err(ConfigError::invalid("budgets", b.amount, "budgets must be >= 1").into());
+        }
+        if self.budgets.windows(2).any(|w| w[0].amount >= w[1].amount || w[0].kind != w[1].kind) {
+            return Err(ConfigError::invalid("budgets", format!("{:?}", self.budgets.iter().map(|b| b.amount).collect::<Vec<_>>()), "must be increasing and of one kind").into());
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn spec_names_include_parameters() {
+        let mut e = EstimatorSpec::new("clamped_is0_cv0");
+        assert_eq!(e.name(), "clamped_is0_cv0");
+        e.params = Params::new().with("clamp", 4.0);
+        assert_eq!(e.name(), "clamped_is0_cv0[clamp=4]");
+    }
+
+    #[test]
+    fn custom_sweep_from_toml_and_validation() {
+        let f: SweepFile = toml::from_str("name='x'\nreps=4\nbudgets=[4,16]\n[[testbeds]]\nid='gradient-plane'\n[[estimators]]\nid='is0_cv0'\n").unwrap();
+        let s = f.apply(None, Mode::Quick).unwrap();
+        assert!(s.validate().is_ok());
+        assert_eq!(s.budgets.len(), 2);
+        let bad: SweepFile = toml::from_str("name='x'\nreps=1\nbudgets=[4]\n[[testbeds]]\nid='a'\n[[estimators]]\nid='b'\n").unwrap();
+        assert!(bad.apply(None, Mode::Quick).unwrap().validate().unwrap_err().to_string().contains("reps"));
+        assert!(toml::from_str::<SweepFile>("rep = 3").is_err());
+    }
+}

@@ -1,0 +1,123 @@
+//! SPEC §5 metrics of one cell against its test bed's reference: RMSE (noise-corrected for
+//! stored references: `E[(X - R)^2] = MSE + Var R`), variance, pooled bias with its standard
+//! error, costs per estimate, efficiency and FoM.
+
+use crate::cell::CellResult;
+use estimators::stats::NeumaierSum;
+use estimators::testbed::Reference;
+use serde::{Deserialize, Serialize};
+
+/// One row of `summary.csv` (SPEC §8; the first 18 columns are the contract, the rest extend it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SummaryRow {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// `samples`, `fetches` or `micros`.
+    pub budget_kind: String,
+    /// Budget per estimate.
+    pub budget: u64,
+    /// Repetitions.
+    pub reps: usize,
+    /// Integrals (pixels).
+    pub integrals: usize,
+    /// Root mean square error over integrals and channels.
+    pub rmse: f64,
+    /// Mean square error (noise-corrected).
+    pub mse: f64,
+    /// Mean variance of one estimate.
+    pub variance: f64,
+    /// Pooled bias (mean over integrals and channels of mean - reference).
+    pub bias: f64,
+    /// Standard error of the pooled bias.
+    pub bias_se: f64,
+    /// Samples per estimate.
+    pub samples: f64,
+    /// Medium fetches per estimate.
+    pub fetches: f64,
+    /// Rays per estimate.
+    pub rays: f64,
+    /// Mean single-thread seconds per estimate (timing: varies run to run).
+    pub seconds: f64,
+    /// 1 / (variance x seconds) (timing).
+    pub efficiency: Option<f64>,
+    /// 1 / (MSE x fetches per estimate), empty without fetches.
+    pub fom: Option<f64>,
+    /// RMSE relative to the reference (over non-zero references).
+    pub rel_rmse: f64,
+    /// Mean reference variance subtracted from the MSE (0 for exact references).
+    pub reference_var: f64,
+    /// Cheap approximate-extinction fetches per estimate.
+    pub cheap_fetches: f64,
+    /// Median single-thread seconds per estimate (timing).
+    pub seconds_median: f64,
+    /// 1 / (MSE x seconds) (timing).
+    pub efficiency_mse: Option<f64>,
+}
+
+/// Column names whose values depend on the wall clock (excluded from determinism checks).
+pub const TIMING_COLUMNS: &[&str] = &["seconds", "efficiency", "seconds_median", "efficiency_mse"];
+
+fn inverse(x: f64) -> Option<f64> {
+    (x > 0.0 && x.is_finite()).then(|| 1.0 / x)
+}
+
+/// Computes the summary row of a cell.
+pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
+    let reps = cell.key.reps as f64;
+    let (mut mse, mut var, mut bias, mut bias_var, mut rel, mut ref_var) =
+        (NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new());
+    let mut rel_n = 0usize;
+    for (i, m) in cell.moments.iter().enumerate() {
+        for (c, mc) in m.iter().enumerate() {
+            let (r, rse2) = (reference.value[i][c], reference.std_err[i][c].powi(2));
+            let sample_var = mc.variance();
+            let d = mc.mean() - r;
+            // Mean over repetitions of (x - R)^2, minus the reference's own variance.
+            let e2 = d * d + sample_var * (reps - 1.0) / reps - rse2;
+            mse.add(e2);
+            var.add(sample_var);
+            bias.add(d);
+            bias_var.add(sample_var / reps + rse2);
+            ref_var.add(rse2);
+            if r != 0.0 {
+                rel.add(e2 / (r * r));
+                rel_n += 1;
+            }
+        }
+    }
+    let m = (cell.moments.len() * 3) as f64;
+    let per = |x: u64| x as f64 / cell.estimates.max(1) as f64;
+    let mse_v = mse.value() / m;
+    let variance = var.value() / m;
+    let seconds = cell.time.mean();
+    let fetches = per(cell.costs.fetches);
+    SummaryRow {
+        testbed: cell.key.testbed.clone(),
+        variant: cell.key.variant.clone(),
+        estimator: cell.key.estimator.clone(),
+        budget_kind: cell.key.budget.kind.name().to_string(),
+        budget: cell.key.budget.amount,
+        reps: cell.key.reps,
+        integrals: cell.moments.len(),
+        rmse: mse_v.max(0.0).sqrt(),
+        mse: mse_v,
+        variance,
+        bias: bias.value() / m,
+        bias_se: bias_var.value().sqrt() / m,
+        samples: per(cell.costs.samples),
+        fetches,
+        rays: per(cell.costs.rays),
+        seconds,
+        efficiency: inverse(variance * seconds),
+        fom: if fetches > 0.0 { inverse(mse_v * fetches) } else { None },
+        rel_rmse: (rel.value() / rel_n.max(1) as f64).max(0.0).sqrt(),
+        reference_var: ref_var.value() / m,
+        cheap_fetches: per(cell.costs.cheap_fetches),
+        seconds_median: cell.time.median(),
+        efficiency_mse: inverse(mse_v * seconds),
+    }
+}
