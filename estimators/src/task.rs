@@ -7,7 +7,7 @@ use crate::budget::{Budget, BudgetKind};
 use crate::math::{Rgb, Vec3};
 use crate::testbed::{HemisphereScene, ShadingPoint, TestBed};
 use serde::{Deserialize, Serialize};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::time::Instant;
 
 /// The costs of one estimate, counted by the harness.
@@ -30,12 +30,13 @@ pub struct Task<'a> {
     budget: Budget,
     costs: Cell<Costs>,
     started: Instant,
+    diagnostics: RefCell<Vec<(&'static str, f64)>>,
 }
 
 impl<'a> Task<'a> {
     /// A task for integral `integral` of `bed` (the harness builds these).
     pub fn new(bed: &'a dyn TestBed, integral: usize, budget: Budget) -> Self {
-        Task { bed, integral, budget, costs: Cell::new(Costs::default()), started: Instant::now() }
+        Task { bed, integral, budget, costs: Cell::new(Costs::default()), started: Instant::now(), diagnostics: RefCell::new(Vec::new()) }
     }
     /// The integral index.
     pub fn integral(&self) -> usize {
@@ -57,6 +58,19 @@ impl<'a> Task<'a> {
             BudgetKind::Fetches => c.fetches < self.budget.amount,
             BudgetKind::Micros => (self.started.elapsed().as_micros() as u64) < self.budget.amount,
         }
+    }
+    /// Records a diagnostic of this estimate (e.g. `cache_bytes`, `cells`, `ess`); the harness
+    /// reports its mean per cell in summary.json. A later value under the same name replaces it.
+    pub fn note(&self, name: &'static str, value: f64) {
+        let mut d = self.diagnostics.borrow_mut();
+        match d.iter_mut().find(|(n, _)| *n == name) {
+            Some(slot) => slot.1 = value,
+            None => d.push((name, value)),
+        }
+    }
+    /// The diagnostics recorded so far.
+    pub fn diagnostics(&self) -> Vec<(&'static str, f64)> {
+        self.diagnostics.borrow().clone()
     }
     /// The hemispherical-integral probe of this integral, when the scene has one.
     pub fn hemisphere(&self) -> Option<HemisphereProbe<'_>> {

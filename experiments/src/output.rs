@@ -1,0 +1,207 @@
+//! Result files (SPEC §8, a contract): `summary.csv`, `integrals.csv`, `summary.json`; every write
+//! is atomic (temp file + rename) so an interrupted run never leaves a half-written file.
+
+use crate::analysis::{Fit, SpeedUp, TestRow};
+use crate::error::{HarnessError, Result};
+use crate::metrics::SummaryRow;
+use crate::plan::Skipped;
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::Path;
+
+/// Writes `bytes` to `path` atomically (a temp file in the same folder, then a rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("out");
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| -> std::io::Result<()> {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        HarnessError::write(path, e)
+    })
+}
+
+/// Run metadata (`meta` in summary.json).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Meta {
+    /// Experiment name.
+    pub experiment: String,
+    /// Seed.
+    pub seed: u64,
+    /// Git commit of the source (or `unknown`).
+    pub git_commit: String,
+    /// Worker threads.
+    pub threads: usize,
+    /// CPU model.
+    pub cpu: String,
+    /// Harness version.
+    pub version: String,
+    /// `quick` or `full`.
+    pub mode: String,
+    /// Repetitions.
+    pub reps: usize,
+    /// Wall-clock seconds of the whole run (timing).
+    pub wall_seconds: f64,
+    /// Free-form notes (noise corrections applied, references used, ...).
+    pub notes: Vec<String>,
+}
+
+/// A paper claim beside our measurement (`paper` in summary.json).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Claim {
+    /// Test bed the claim was checked on.
+    pub testbed: String,
+    /// The claim in words, with where the paper makes it.
+    pub claim: String,
+    /// The paper's number.
+    pub paper_value: Option<f64>,
+    /// Our number.
+    pub our_value: Option<f64>,
+    /// Whether it held here (`None`: not measured in this run, see `note`).
+    pub held: Option<bool>,
+    /// How it was judged, or why it was not.
+    pub note: String,
+}
+
+/// Everything `summary.json` holds, plus the rows of `summary.csv` (for plots and reports).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunReport {
+    /// Run metadata.
+    pub meta: Meta,
+    /// Convergence fits.
+    pub fits: Vec<Fit>,
+    /// Statistical tests.
+    pub tests: Vec<TestRow>,
+    /// Paper claims beside our numbers.
+    pub paper: Vec<Claim>,
+    /// Speed-ups against the baseline.
+    pub speedups: Vec<SpeedUp>,
+    /// Pairs that did not run, with the reason.
+    pub skipped: Vec<Skipped>,
+    /// Estimator ids the experiment names that are not registered yet.
+    pub unavailable: Vec<String>,
+    /// Summary rows (also in summary.csv; not repeated in summary.json).
+    #[serde(skip)]
+    pub rows: Vec<SummaryRow>,
+    /// Paper label per estimator name (legend text).
+    pub labels: Vec<(String, String)>,
+}
+
+/// One row of `integrals.csv` (SPEC §8) with the test bed's geometry columns appended.
+#[derive(Clone, Debug, PartialEq)]
+pub struct IntegralRow {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// Integral index.
+    pub integral: usize,
+    /// Pixel column.
+    pub px: usize,
+    /// Pixel row.
+    pub py: usize,
+    /// Channel 0..3 (R, G, B).
+    pub channel: usize,
+    /// Reference value.
+    pub reference: f64,
+    /// Reference standard error.
+    pub reference_se: f64,
+    /// Mean estimate over repetitions.
+    pub mean: f64,
+    /// Standard error of the mean.
+    pub std_err: f64,
+    /// Geometry (name, value).
+    pub geometry: Vec<(&'static str, f64)>,
+}
+
+fn csv_bytes<F: FnOnce(&mut csv::Writer<Vec<u8>>) -> csv::Result<()>>(f: F) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    f(&mut w).map_err(|e| HarnessError::write("csv", e))?;
+    w.into_inner().map_err(|e| HarnessError::write("csv", e))
+}
+
+/// Writes `summary.csv`.
+pub fn write_summary_csv(path: &Path, rows: &[SummaryRow]) -> Result<()> {
+    let bytes = csv_bytes(|w| {
+        if rows.is_empty() {
+            w.write_record(SUMMARY_HEADER)?;
+        }
+        rows.iter().try_for_each(|r| w.serialize(r))
+    })?;
+    write_atomic(path, &bytes)
+}
+
+/// The header of summary.csv (used when there are no rows).
+pub const SUMMARY_HEADER: &[&str] = &[
+    "testbed", "variant", "estimator", "budget_kind", "budget", "reps", "integrals", "rmse", "mse", "variance", "bias",
+    "bias_se", "samples", "fetches", "rays", "seconds", "efficiency", "fom", "rel_rmse", "reference_var",
+    "cheap_fetches", "seconds_median", "efficiency_mse",
+];
+
+/// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).
+pub fn write_integrals_csv(path: &Path, rows: &[IntegralRow]) -> Result<()> {
+    let mut geo: Vec<&'static str> = Vec::new();
+    for r in rows {
+        for (name, _) in &r.geometry {
+            if !geo.contains(name) {
+                geo.push(name);
+            }
+        }
+    }
+    let bytes = csv_bytes(|w| {
+        let mut header: Vec<&str> = vec![
+            "testbed", "variant", "estimator", "integral", "px", "py", "channel", "reference", "reference_se", "mean", "std_err",
+        ];
+        header.extend(&geo);
+        w.write_record(&header)?;
+        for r in rows {
+            let mut rec = vec![
+                r.testbed.clone(),
+                r.variant.clone(),
+                r.estimator.clone(),
+                r.integral.to_string(),
+                r.px.to_string(),
+                r.py.to_string(),
+                r.channel.to_string(),
+                r.reference.to_string(),
+                r.reference_se.to_string(),
+                r.mean.to_string(),
+                r.std_err.to_string(),
+            ];
+            for g in &geo {
+                rec.push(r.geometry.iter().find(|(n, _)| n == g).map(|(_, v)| v.to_string()).unwrap_or_default());
+            }
+            w.write_record(&rec)?;
+        }
+        Ok(())
+    })?;
+    write_atomic(path, &bytes)
+}
+
+/// Writes `summary.json`.
+pub fn write_summary_json(path: &Path, report: &RunReport) -> Result<()> {
+    let text = serde_json::to_string_pretty(report).map_err(|e| HarnessError::write(path, e))?;
+    write_atomic(path, text.as_bytes())
+}
+
+/// Reads a results folder back (`summary.json` and `summary.csv`), for `mcbench plot`.
+pub fn read_results(dir: &Path) -> Result<RunReport> {
+    let json = dir.join("summary.json");
+    let text = std::fs::read_to_string(&json).map_err(|e| HarnessError::bad_file(&json, e))?;
+    let mut report: RunReport = serde_json::from_str(&text).map_err(|e| HarnessError::bad_file(&json, e))?;
+    let csv_path = dir.join("summary.csv");
+    let mut rd = csv::Reader::from_path(&csv_path).map_err(|e| HarnessError::bad_file(&csv_path, e))?;
+    report.rows = rd
+        .deserialize()
+        .collect::<std::result::Result<Vec<SummaryRow>, _>>()
+        .map_err(|e| HarnessError::bad_file(&csv_path, e))?;
+    Ok(report)
+}
