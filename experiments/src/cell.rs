@@ -110,6 +110,19 @@ pub struct CellResult {
     pub estimates: u64,
     /// Estimate times.
     pub time: TimeStats,
+    /// Sums over estimates of each diagnostic the estimator noted (name, sum).
+    #[serde(default)]
+    pub diagnostics: Vec<(String, f64)>,
+}
+
+/// Adds `(name, value)` pairs into running sums, keeping first-appearance order.
+pub fn add_diagnostics(sums: &mut Vec<(String, f64)>, add: &[(impl AsRef<str>, f64)]) {
+    for (name, v) in add {
+        match sums.iter_mut().find(|(n, _)| n == name.as_ref()) {
+            Some(slot) => slot.1 += v,
+            None => sums.push((name.as_ref().to_string(), *v)),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -91,6 +91,26 @@ pub struct RunReport {
     pub rows: Vec<SummaryRow>,
     /// Paper label per estimator name (legend text).
     pub labels: Vec<(String, String)>,
+    /// Mean per estimate of each diagnostic an estimator noted (cache bytes, cells, ESS, ...).
+    #[serde(default)]
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// The mean of one estimator diagnostic over a cell's estimates.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Diagnostic {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// Budget.
+    pub budget: u64,
+    /// Diagnostic name.
+    pub name: String,
+    /// Mean per estimate.
+    pub mean: f64,
 }
 
 /// One row of `integrals.csv` (SPEC §8) with the test bed's geometry columns appended.

@@ -8,7 +8,7 @@ use estimators::budget::BudgetKind;
 use estimators::estimator::Estimator;
 use estimators::registry::{self, EstimatorEntry};
 use estimators::testbed::{Needs, TestBed};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A built test bed.
 pub struct PreparedBed {
@@ -40,7 +40,7 @@ pub struct PreparedEstimator {
 }
 
 /// A pair that does not run, and why.
-#[derive(Clone, Debug, Serialize, PartialEq)]
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Skipped {
     /// Test bed id.
     pub testbed: String,

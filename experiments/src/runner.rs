@@ -2,7 +2,7 @@
 //! estimate on its own counter-derived stream, reduced in index order so results are bit-identical
 //! whatever the thread count; finished cells are stored and read back on a re-run (resume).
 
-use crate::cell::{CellKey, CellResult, TimeStats};
+use crate::cell::{add_diagnostics, CellKey, CellResult, TimeStats};
 use crate::error::{HarnessError, Result};
 use crate::output::write_atomic;
 use crate::plan::Plan;
@@ -49,6 +49,7 @@ struct Item {
     values: Vec<Rgb>,
     costs: Costs,
     time: TimeStats,
+    diagnostics: Vec<(String, f64)>,
 }
 
 fn add(a: &mut Costs, b: &Costs) {
@@ -69,7 +70,7 @@ pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Cel
         .into_par_iter()
         .map(|item| {
             let (rep, batch) = (item / batches, item % batches);
-            let mut out = Item { values: Vec::with_capacity(BATCH), costs: Costs::default(), time: TimeStats::default() };
+            let mut out = Item { values: Vec::with_capacity(BATCH), costs: Costs::default(), time: TimeStats::default(), diagnostics: Vec::new() };
             for i in batch * BATCH..((batch + 1) * BATCH).min(n) {
                 let key = StreamKey { seed: plan.sweep.seed, testbed: &label, estimator: &e.name, budget: budget.amount, rep: rep as u64, integral: i as u64 };
                 let mut rng = key.rng();
@@ -80,13 +81,14 @@ pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Cel
                 let v = v.and_then(|v| if v.is_finite() { Ok(v) } else { Err(EstimateError::NonFinite { integral: i, value: v.0 }) });
                 let v = v.map_err(|source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.clone(), source })?;
                 add(&mut out.costs, &task.costs());
+                add_diagnostics(&mut out.diagnostics, &task.diagnostics());
                 out.values.push(v);
             }
             Ok(out)
         })
         .collect();
     let mut moments = vec![[Moments::default(), Moments::default(), Moments::default()]; n];
-    let (mut costs, mut time) = (Costs::default(), TimeStats::default());
+    let (mut costs, mut time, mut diagnostics) = (Costs::default(), TimeStats::default(), Vec::new());
     for (item, r) in items.into_iter().enumerate() {
         let r = r?;
         let batch = item % batches;
@@ -97,9 +99,10 @@ pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Cel
         }
         add(&mut costs, &r.costs);
         time.merge(&r.time);
+        add_diagnostics(&mut diagnostics, &r.diagnostics);
     }
     let key = cell_key(plan, bi, ei, budget);
-    Ok(CellResult { key, moments, costs, estimates: (reps * n) as u64, time })
+    Ok(CellResult { key, moments, costs, estimates: (reps * n) as u64, time, diagnostics })
 }
 
 /// The key of a cell.

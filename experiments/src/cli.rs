@@ -1,0 +1,301 @@
+//! The `mcbench` command line (SPEC §9): `list`, `run`, `reference`, `plot`, and the default quick
+//! suite. Bad input is one line on stderr naming the field, exit code 2, and nothing written.
+
+use crate::config::{Mode, SweepFile};
+use crate::error::{HarnessError, Result};
+use crate::execute::{self, ExecOptions};
+use crate::progress::Progress;
+use crate::report::{markdown_table, sig};
+use crate::suite::{self, EXPERIMENTS};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use estimators::params::Params;
+use estimators::registry::{ESTIMATORS, TESTBEDS};
+use std::ffi::OsString;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Convergence-study harness for adaptive Monte Carlo rendering estimators.
+#[derive(Parser, Debug)]
+#[command(name = "mcbench", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Settings for the default suite (no subcommand).
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// List test beds, estimators (with the test beds each runs on) or experiments.
+    List {
+        /// What to list (all when omitted).
+        what: Option<ListWhat>,
+    },
+    /// Run experiments by name, or a custom sweep from --config.
+    Run {
+        /// Experiment names (see `mcbench list experiments`).
+        experiments: Vec<String>,
+        #[command(flatten)]
+        args: RunArgs,
+    },
+    /// Compute and store the reference of a test bed.
+    Reference {
+        /// Test bed id.
+        testbed: String,
+        /// Variant (the first when omitted).
+        #[arg(long)]
+        variant: Option<String>,
+        /// Results root.
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
+    },
+    /// Redraw the plots and report of a results folder.
+    Plot {
+        /// A results folder holding summary.csv and summary.json.
+        results_dir: PathBuf,
+        /// Plots root (the experiment's folder is created below it).
+        #[arg(long, default_value = "plots")]
+        plots: PathBuf,
+    },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum ListWhat {
+    Testbeds,
+    Estimators,
+    Experiments,
+}
+
+#[derive(Args, Debug)]
+struct RunArgs {
+    /// Small sizes (the default).
+    #[arg(long, conflicts_with = "full")]
+    quick: bool,
+    /// The papers' sizes.
+    #[arg(long)]
+    full: bool,
+    /// Experiment seed.
+    #[arg(long, value_name = "N")]
+    seed: Option<u64>,
+    /// Repetitions per integral (>= 2).
+    #[arg(long, value_name = "R", value_parser = clap::value_parser!(u64).range(2..=1_000_000))]
+    reps: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "T", value_parser = clap::value_parser!(u64).range(1..=1024))]
+    threads: Option<u64>,
+    /// Results root.
+    #[arg(long, value_name = "DIR", default_value = "results")]
+    results: PathBuf,
+    /// Plots root.
+    #[arg(long, value_name = "DIR", default_value = "plots")]
+    plots: PathBuf,
+    /// A TOML or JSON file describing a custom sweep or overriding the named experiments.
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Skip plots and reports.
+    #[arg(long)]
+    no_plots: bool,
+}
+
+impl RunArgs {
+    fn mode(&self) -> Mode {
+        if self.full {
+            Mode::Full
+        } else {
+            Mode::Quick
+        }
+    }
+}
+
+/// Runs the CLI on `args` and returns the exit code.
+pub fn main_with_args(args: impl IntoIterator<Item = impl Into<OsString> + Clone>) -> i32 {
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind::*;
+            return match e.kind() {
+                DisplayHelp | DisplayVersion | DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let _ = e.print();
+                    0
+                }
+                _ => {
+                    let text = e.render().to_string();
+                    eprintln!("{}", text.lines().next().unwrap_or("error: bad arguments"));
+                    2
+                }
+            };
+        }
+    };
+    match dispatch(cli) {
+        Ok(()) => 0,
+        Err(e) => {
+            eprintln!("error: {e}");
+            e.exit_code()
+        }
+    }
+}
+
+fn dispatch(cli: Cli) -> Result<()> {
+    match cli.command {
+        None => {
+            let names: Vec<String> = EXPERIMENTS.iter().map(|e| e.name.to_string()).collect();
+            run(&names, &cli.run)
+        }
+        Some(Command::Run { experiments, args }) => run(&experiments, &args),
+        Some(Command::List { what }) => {
+            list(what);
+            Ok(())
+        }
+        Some(Command::Reference { testbed, variant, results }) => reference(&testbed, variant, &results),
+        Some(Command::Plot { results_dir, plots }) => {
+            let report = crate::output::read_results(&results_dir)?;
+            let dir = plots.join(&report.meta.experiment);
+            execute::draw(&report, &dir, &results_dir)?;
+            println!("plots and report.md written to {}", dir.display());
+            Ok(())
+        }
+    }
+}
+
+fn run(names: &[String], args: &RunArgs) -> Result<()> {
+    let mode = args.mode();
+    let file = args.config.as_deref().map(SweepFile::read).transpose()?;
+    // Build every plan first: any bad name or value stops here, before a file is written.
+    let mut plans = Vec::new();
+    if names.is_empty() {
+        let file = file.ok_or_else(|| {
+            estimators::error::ConfigError::invalid("experiment", "(none)", format!("name one (valid: {}) or give --config", valid_experiments()))
+        })?;
+        plans.push((None, file.apply(None, mode)?));
+    } else {
+        for name in names {
+            let def = suite::experiment(name)?;
+            let sweep = (def.sweep)(mode);
+            let sweep = match &file {
+                Some(f) => f.clone().apply(Some(sweep), mode)?,
+                None => sweep,
+            };
+            plans.push((Some(def), sweep));
+        }
+    }
+    let mut prepared = Vec::new();
+    for (def, mut sweep) in plans {
+        if let Some(s) = args.seed {
+            sweep.seed = s;
+        }
+        if let Some(r) = args.reps {
+            sweep.reps = r as usize;
+        }
+        prepared.push((def, execute::prepare(sweep)?));
+    }
+    let progress = Progress::new();
+    let opts = ExecOptions {
+        results_root: args.results.clone(),
+        plots_root: args.plots.clone(),
+        threads: args.threads.map(|t| t as usize),
+        observer: &progress,
+        plots: !args.no_plots,
+    };
+    let started = Instant::now();
+    for (def, plan) in &prepared {
+        let t0 = Instant::now();
+        let out = execute::execute(plan, *def, &opts)?;
+        progress.finish();
+        print_summary(&out.report, t0.elapsed().as_secs_f64());
+        println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
+    }
+    println!("\ntotal wall time {:.1} s", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn valid_experiments() -> String {
+    EXPERIMENTS.iter().map(|e| e.name).collect::<Vec<_>>().join(", ")
+}
+
+fn print_summary(r: &crate::output::RunReport, seconds: f64) {
+    println!("\n== {} ({} mode, seed {}, {} reps, {:.1} s) ==", r.meta.experiment, r.meta.mode, r.meta.seed, r.meta.reps, seconds);
+    let fits: Vec<Vec<String>> = r
+        .fits
+        .iter()
+        .map(|f| {
+            let t = r.tests.iter().find(|t| t.testbed == f.testbed && t.variant == f.variant && t.estimator == f.estimator && t.test.starts_with("holm"));
+            vec![
+                format!("{}/{}", f.testbed, f.variant),
+                f.estimator.clone(),
+                format!("{:.3} [{:.3}, {:.3}]", f.slope, f.slope_ci_low, f.slope_ci_high),
+                t.map(|t| sig(t.p_value, 3)).unwrap_or_else(|| "-".into()),
+                t.map(|t| format!("{} ({})", t.verdict, t.claim)).unwrap_or_else(|| "-".into()),
+            ]
+        })
+        .collect();
+    println!("{}", markdown_table(&["test bed", "estimator", "slope [95% CI]", "Holm p", "unbiasedness (claim)"], &fits));
+    let claims: Vec<Vec<String>> = r
+        .paper
+        .iter()
+        .map(|c| {
+            let held = match c.held {
+                Some(true) => "held",
+                Some(false) => "did NOT hold",
+                None => "not measured",
+            };
+            vec![c.claim.clone(), c.paper_value.map(|v| sig(v, 3)).unwrap_or_default(), c.our_value.map(|v| sig(v, 3)).unwrap_or_else(|| "-".into()), held.into()]
+        })
+        .collect();
+    println!("{}", markdown_table(&["paper claim", "paper", "ours", "verdict"], &claims));
+    if !r.unavailable.is_empty() {
+        println!("not available yet: {}", r.unavailable.join(", "));
+    }
+    for s in &r.skipped {
+        println!("skipped {} on {}/{}: {}", s.estimator, s.testbed, s.variant, s.reason);
+    }
+}
+
+fn list(what: Option<ListWhat>) {
+    let all = what.is_none();
+    if all || matches!(what, Some(ListWhat::Testbeds)) {
+        let rows: Vec<Vec<String>> =
+            TESTBEDS.iter().map(|t| vec![t.id.into(), t.variants.join(", "), t.provides.to_string(), t.summary.into()]).collect();
+        println!("{}", markdown_table(&["test bed", "variants", "provides", "summary"], &rows));
+    }
+    if all || matches!(what, Some(ListWhat::Estimators)) {
+        let rows: Vec<Vec<String>> = ESTIMATORS
+            .iter()
+            .map(|e| {
+                let on: Vec<&str> = TESTBEDS.iter().filter(|t| e.skip_reason(t.provides).is_none()).map(|t| t.id).collect();
+                vec![e.id.into(), e.paper.into(), e.bias.name().into(), e.needs.to_string(), on.join(", "), e.summary.into()]
+            })
+            .collect();
+        println!("{}", markdown_table(&["estimator", "paper", "claim", "needs", "runs on", "summary"], &rows));
+    }
+    if all || matches!(what, Some(ListWhat::Experiments)) {
+        let rows: Vec<Vec<String>> = EXPERIMENTS.iter().map(|e| vec![e.name.into(), e.reproduces.into(), e.summary.into()]).collect();
+        println!("{}", markdown_table(&["experiment", "reproduces", "summary"], &rows));
+    }
+}
+
+fn reference(testbed: &str, variant: Option<String>, results: &std::path::Path) -> Result<()> {
+    let entry = estimators::registry::testbed(testbed)?;
+    let variant = variant.unwrap_or_else(|| entry.variants[0].to_string());
+    entry.check_variant(&variant)?;
+    let t0 = Instant::now();
+    let bed = (entry.build)(&variant, &Params::new())?;
+    let r = bed.reference();
+    let path = results.join("references").join(format!("{testbed}_{variant}.json"));
+    let doc = serde_json::json!({
+        "testbed": testbed,
+        "variant": variant,
+        "command": format!("mcbench reference {testbed} --variant {variant}"),
+        "resolution": bed.resolution(),
+        "reference": r,
+    });
+    let text = serde_json::to_string(&doc).map_err(|e| HarnessError::write(&path, e))?;
+    crate::output::write_atomic(&path, text.as_bytes())?;
+    let kind = match &r.kind {
+        estimators::testbed::ReferenceKind::Exact { method, bound } => format!("exact: {method}; absolute error bound {bound:.3e}"),
+        estimators::testbed::ReferenceKind::Stored { command, samples } => format!("stored: `{command}`, {samples} samples per value"),
+    };
+    println!("{testbed}/{variant}: {} integrals, {kind}, computed in {:.2} s", r.value.len(), t0.elapsed().as_secs_f64());
+    println!("written to {}", path.display());
+    Ok(())
+}

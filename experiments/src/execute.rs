@@ -1,0 +1,179 @@
+//! One experiment end to end: plan (all validation before any file is touched), run (with
+//! resume), metrics, fits, tests, claims, result files, plots and report.
+
+use crate::analysis::{self, TestRow};
+use crate::cell::CellResult;
+use crate::config::Sweep;
+use crate::error::Result;
+use crate::metrics::{summarize, SummaryRow};
+use crate::output::{self, Diagnostic, IntegralRow, Meta, RunReport};
+use crate::plan::Plan;
+use crate::runner::{self, Observer, RunOptions};
+use crate::suite::ExperimentDef;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Where and how to run.
+pub struct ExecOptions<'a> {
+    /// Root of result folders (`results/`).
+    pub results_root: PathBuf,
+    /// Root of plot folders (`plots/`).
+    pub plots_root: PathBuf,
+    /// Worker threads (None: all cores).
+    pub threads: Option<usize>,
+    /// Progress receiver.
+    pub observer: &'a dyn Observer,
+    /// Draw plots and the report.
+    pub plots: bool,
+}
+
+/// What a finished experiment produced.
+pub struct Outcome {
+    /// Everything in summary.json plus the rows.
+    pub report: RunReport,
+    /// The results folder.
+    pub results_dir: PathBuf,
+    /// The plots folder.
+    pub plots_dir: PathBuf,
+}
+
+/// Builds the plan of a sweep (validation only; nothing is written).
+pub fn prepare(sweep: Sweep) -> Result<Plan> {
+    Plan::prepare(sweep)
+}
+
+/// Runs a prepared plan and writes every output.
+pub fn execute(plan: &Plan, def: Option<&ExperimentDef>, opts: &ExecOptions<'_>) -> Result<Outcome> {
+    let started = Instant::now();
+    let sweep = &plan.sweep;
+    let results_dir = opts.results_root.join(&sweep.experiment);
+    let plots_dir = opts.plots_root.join(&sweep.experiment);
+    let run = runner::run(
+        plan,
+        &RunOptions { threads: opts.threads, cell_dir: Some(results_dir.join("cells")), observer: opts.observer },
+    )?;
+    let mut rows: Vec<SummaryRow> = Vec::new();
+    let mut tests: Vec<TestRow> = Vec::new();
+    let mut integrals: Vec<IntegralRow> = Vec::new();
+    let mut diagnostics = Vec::new();
+    let last_budget = sweep.budgets.last().map(|b| b.amount);
+    for (bi, ei, cell) in &run.cells {
+        let (bed, est) = (&plan.beds[*bi], &plan.estimators[*ei]);
+        let reference = bed.bed.reference();
+        rows.push(summarize(cell, reference));
+        for (name, sum) in &cell.diagnostics {
+            diagnostics.push(Diagnostic {
+                testbed: cell.key.testbed.clone(),
+                variant: cell.key.variant.clone(),
+                estimator: cell.key.estimator.clone(),
+                budget: cell.key.budget.amount,
+                name: name.clone(),
+                mean: sum / cell.estimates.max(1) as f64,
+            });
+        }
+        if Some(cell.key.budget.amount) == last_budget {
+            tests.extend(analysis::unbiasedness(cell, reference, est.entry.bias));
+            integrals.extend(integral_rows(cell, bed.bed.as_ref()));
+        }
+    }
+    let fits = analysis::fits(&rows);
+    let speedups = sweep.baseline.as_deref().map(|b| analysis::speedups(&rows, &fits, b)).unwrap_or_default();
+    let mut notes = Vec::new();
+    for b in &plan.beds {
+        notes.push(match &b.bed.reference().kind {
+            estimators::testbed::ReferenceKind::Exact { method, bound } => {
+                format!("{}: exact reference ({method}), absolute error bound {bound:.3e}", b.label())
+            }
+            estimators::testbed::ReferenceKind::Stored { command, samples } => format!(
+                "{}: stored reference from `{command}` ({samples} samples per value); its variance is subtracted from the MSE",
+                b.label()
+            ),
+        });
+    }
+    let threads = rayon::ThreadPoolBuilder::new().num_threads(opts.threads.unwrap_or(0)).build().map(|p| p.current_num_threads()).unwrap_or(1);
+    let mut report = RunReport {
+        meta: Meta {
+            experiment: sweep.experiment.clone(),
+            seed: sweep.seed,
+            git_commit: git_commit(),
+            threads,
+            cpu: cpu_model(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            mode: sweep.mode.name().to_string(),
+            reps: sweep.reps,
+            wall_seconds: 0.0,
+            notes,
+        },
+        fits,
+        tests,
+        paper: Vec::new(),
+        speedups,
+        skipped: plan.skipped.clone(),
+        unavailable: def.map(|d| d.unavailable()).unwrap_or_default(),
+        rows,
+        labels: plan.estimators.iter().map(|e| (e.name.clone(), e.entry.label.to_string())).collect(),
+        diagnostics,
+    };
+    if let Some(d) = def {
+        report.paper = (d.claims)(&report);
+    }
+    report.meta.wall_seconds = started.elapsed().as_secs_f64();
+    output::write_summary_csv(&results_dir.join("summary.csv"), &report.rows)?;
+    output::write_integrals_csv(&results_dir.join("integrals.csv"), &integrals)?;
+    output::write_summary_json(&results_dir.join("summary.json"), &report)?;
+    if opts.plots {
+        draw(&report, &plots_dir, &results_dir)?;
+    }
+    Ok(Outcome { report, results_dir, plots_dir })
+}
+
+/// Draws the plots and the report of a finished run.
+pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path) -> Result<()> {
+    let files = crate::plot::write_plots(report, plots_dir)?;
+    crate::report::write_report(report, &files, plots_dir, results_dir)?;
+    Ok(())
+}
+
+fn integral_rows(cell: &CellResult, bed: &dyn estimators::testbed::TestBed) -> Vec<IntegralRow> {
+    let (w, _) = bed.resolution();
+    let reference = bed.reference();
+    let mut out = Vec::with_capacity(cell.moments.len() * 3);
+    for (i, m) in cell.moments.iter().enumerate() {
+        let geometry = bed.geometry(i);
+        for (c, mc) in m.iter().enumerate() {
+            out.push(IntegralRow {
+                testbed: cell.key.testbed.clone(),
+                variant: cell.key.variant.clone(),
+                estimator: cell.key.estimator.clone(),
+                integral: i,
+                px: i % w,
+                py: i / w,
+                channel: c,
+                reference: reference.value[i][c],
+                reference_se: reference.std_err[i][c],
+                mean: mc.mean(),
+                std_err: mc.std_err(),
+                geometry: geometry.clone(),
+            });
+        }
+    }
+    out
+}
+
+fn git_commit() -> String {
+    std::process::Command::new("git")
+        .args(["rev-parse", "HEAD"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .map(|s| s.trim().to_string())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| t.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).map(|s| s.trim().to_string()))
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}

@@ -1,0 +1,59 @@
+//! The named experiments (SPEC §7): each builds a sweep for quick or full mode and states the
+//! paper's claims, which are judged against what the run measured.
+
+pub mod claims;
+pub mod surface_smc;
+
+use crate::config::{EstimatorSpec, Mode, Sweep};
+use crate::output::{Claim, RunReport};
+use estimators::error::ConfigError;
+use estimators::registry;
+
+/// A named experiment.
+pub struct ExperimentDef {
+    /// Name (results folder, CLI argument).
+    pub name: &'static str,
+    /// The paper figure or table it reproduces.
+    pub reproduces: &'static str,
+    /// One line for `mcbench list experiments`.
+    pub summary: &'static str,
+    /// Every estimator id it runs (ids not registered yet are reported as unavailable).
+    pub ids: &'static [&'static str],
+    /// The sweep for a mode.
+    pub sweep: fn(Mode) -> Sweep,
+    /// The paper's claims judged on a finished run.
+    pub claims: fn(&RunReport) -> Vec<Claim>,
+}
+
+/// Every experiment, in the order the default suite runs them.
+pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF];
+
+/// Looks an experiment up by name.
+pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {
+    EXPERIMENTS
+        .iter()
+        .copied()
+        .find(|e| e.name == name)
+        .ok_or_else(|| ConfigError::unknown("experiment", name, EXPERIMENTS.iter().map(|e| e.name)))
+}
+
+/// Splits the ids an experiment names into registered estimators and ids not available yet
+/// (estimator families land issue by issue; the run says which ones it could not include).
+pub fn available(ids: &[&str]) -> (Vec<EstimatorSpec>, Vec<String>) {
+    let (mut have, mut missing) = (Vec::new(), Vec::new());
+    for id in ids {
+        match registry::estimator(id) {
+            Ok(_) => have.push(EstimatorSpec::new(id)),
+            Err(_) => missing.push(id.to_string()),
+        }
+    }
+    (have, missing)
+}
+
+
+impl ExperimentDef {
+    /// The ids this experiment names that are not registered yet.
+    pub fn unavailable(&self) -> Vec<String> {
+        available(self.ids).1
+    }
+}

@@ -1,0 +1,100 @@
+//! Integration tests of the `mcbench` binary (SPEC §9): exit codes, one-line errors naming the
+//! field, no files written on bad input, and a small custom sweep end to end.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn mcbench(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mcbench")).current_dir(dir).args(args).output().expect("binary runs")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+/// Exit code 2, exactly one line on stderr containing `needle`, and nothing under results/ or plots/.
+fn assert_bad_input(dir: &Path, args: &[&str], needle: &str) {
+    let o = mcbench(dir, args);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: not one line: {err}");
+    assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(!dir.join("results").exists() && !dir.join("plots").exists(), "{args:?} wrote files");
+}
+
+const SMALL: &str = "name = 'tiny'\nreps = 3\nbudgets = [4, 16, 64]\n[[testbeds]]\nid = 'gradient-plane'\nparams = { resolution = 4 }\n[[estimators]]\nid = 'is0_cv0'\n[[estimators]]\nid = 'clamped_is0_cv0'\nparams = { clamp = 1.5 }\n";
+
+#[test]
+fn bad_input_exits_2_with_one_line_and_writes_nothing() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    assert_bad_input(d, &["run", "no-such-experiment"], "surface-smc");
+    assert_bad_input(d, &["run", "surface-smc", "--reps", "0"], "--reps");
+    assert_bad_input(d, &["run", "surface-smc", "--seed", "abc"], "--seed");
+    assert_bad_input(d, &["run", "surface-smc", "--threads", "0"], "--threads");
+    assert_bad_input(d, &["run"], "experiment");
+    assert_bad_input(d, &["frobnicate"], "frobnicate");
+    assert_bad_input(d, &["reference", "gradient-plane", "--variant", "shiny"], "gradient-plane/shiny");
+    assert_bad_input(d, &["plot", "nowhere"], "nowhere");
+    let cases = [
+        ("malformed.toml", "name = 'x'\nreps = [", "malformed.toml"),
+        ("unknown_field.toml", "name = 'x'\nrep = 3\n", "rep"),
+        ("bad_reps.toml", SMALL.replace("reps = 3", "reps = 0").as_str(), "reps"),
+        ("bad_budget.toml", SMALL.replace("[4, 16, 64]", "[4, 0]").as_str(), "budget"),
+        ("bad_param.toml", SMALL.replace("clamp = 1.5", "clamp = -1.0").as_str(), "clamp"),
+        ("typo_param.toml", SMALL.replace("clamp = 1.5", "clmap = 1.5").as_str(), "clmap"),
+        ("bad_estimator.toml", SMALL.replace("'is0_cv0'", "'is9_cv9'").as_str(), "is9_cv9"),
+        ("bad_testbed.json", r#"{"name":"x","budgets":[4],"testbeds":[{"id":"nope"}],"estimators":[{"id":"is0_cv0"}]}"#, "nope"),
+        ("bad_kind.toml", "name='x'\nbudget_kind='parsecs'\n", "parsecs"),
+        ("notes.txt", "name = 'x'", ".toml or .json"),
+    ];
+    for (name, text, needle) in cases {
+        let path = d.join(name);
+        std::fs::write(&path, text).expect("write config");
+        assert_bad_input(d, &["run", "--config", path.to_str().expect("utf8")], needle);
+    }
+    assert_bad_input(d, &["run", "--config", "missing.toml"], "missing.toml");
+}
+
+#[test]
+fn list_shows_what_runs_where() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = mcbench(dir.path(), &["list", "estimators"]);
+    assert_eq!(o.status.code(), Some(0));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("is0_cv0") && out.contains("gradient-plane"), "{out}");
+    let o = mcbench(dir.path(), &["list"]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("surface-smc"));
+}
+
+#[test]
+fn a_custom_sweep_runs_end_to_end_and_plots_can_be_redrawn() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    std::fs::write(d.join("tiny.toml"), SMALL).expect("write");
+    let o = mcbench(d, &["run", "--config", "tiny.toml", "--threads", "2"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    for f in ["results/tiny/summary.csv", "results/tiny/integrals.csv", "results/tiny/summary.json", "plots/tiny/report.md"] {
+        assert!(d.join(f).is_file(), "{f} missing");
+    }
+    assert!(String::from_utf8_lossy(&o.stdout).contains("clamped_is0_cv0[clamp=1.5]"));
+    std::fs::remove_dir_all(d.join("plots")).expect("rm");
+    let o = mcbench(d, &["plot", "results/tiny"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(d.join("plots/tiny/report.md").is_file());
+    // A corrupt result file is bad input, not a panic.
+    std::fs::write(d.join("results/tiny/summary.json"), "{").expect("write");
+    let o = mcbench(d, &["plot", "results/tiny"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("summary.json"));
+}
+
+#[test]
+fn reference_command_stores_the_exact_reference() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = mcbench(dir.path(), &["reference", "gradient-plane", "--variant", "stiff"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(dir.path().join("results/references/gradient-plane_stiff.json").is_file());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("error bound"));
+}
