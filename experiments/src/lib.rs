@@ -21,3 +21,8 @@ pub mod progress;
 pub mod report;
 pub mod runner;
 pub mod suite;
+
+/// The README's code blocks, compiled and run as doc tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;
