@@ -38,16 +38,16 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
     assert_bad_input(d, &["reference", "gradient-plane", "--variant", "shiny"], "gradient-plane/shiny");
     assert_bad_input(d, &["plot", "nowhere"], "nowhere");
     let cases = [
-        ("malformed.toml", "name = 'x'\nreps = [", "malformed.toml"),
-        ("unknown_field.toml", "name = 'x'\nrep = 3\n", "rep"),
-        ("bad_reps.toml", SMALL.replace("reps = 3", "reps = 0").as_str(), "reps"),
-        ("bad_budget.toml", SMALL.replace("[4, 16, 64]", "[4, 0]").as_str(), "budget"),
-        ("bad_param.toml", SMALL.replace("clamp = 1.5", "clamp = -1.0").as_str(), "clamp"),
-        ("typo_param.toml", SMALL.replace("clamp = 1.5", "clmap = 1.5").as_str(), "clmap"),
-        ("bad_estimator.toml", SMALL.replace("'is0_cv0'", "'is9_cv9'").as_str(), "is9_cv9"),
-        ("bad_testbed.json", r#"{"name":"x","budgets":[4],"testbeds":[{"id":"nope"}],"estimators":[{"id":"is0_cv0"}]}"#, "nope"),
-        ("bad_kind.toml", "name='x'\nbudget_kind='parsecs'\n", "parsecs"),
-        ("notes.txt", "name = 'x'", ".toml or .json"),
+        ("malformed.toml", "name = 'x'\nreps = [".to_string(), "malformed.toml"),
+        ("unknown_field.toml", "name = 'x'\nrep = 3\n".to_string(), "rep"),
+        ("bad_reps.toml", SMALL.replace("reps = 3", "reps = 0"), "reps"),
+        ("bad_budget.toml", SMALL.replace("[4, 16, 64]", "[4, 0]"), "budget"),
+        ("bad_param.toml", SMALL.replace("clamp = 1.5", "clamp = -1.0"), "clamp"),
+        ("typo_param.toml", SMALL.replace("clamp = 1.5", "clmap = 1.5"), "clmap"),
+        ("bad_estimator.toml", SMALL.replace("'is0_cv0'", "'is9_cv9'"), "is9_cv9"),
+        ("bad_testbed.json", r#"{"name":"x","budgets":[4],"testbeds":[{"id":"nope"}],"estimators":[{"id":"is0_cv0"}]}"#.to_string(), "nope"),
+        ("bad_kind.toml", "name='x'\nbudget_kind='parsecs'\n".to_string(), "parsecs"),
+        ("notes.txt", "name = 'x'".to_string(), ".toml or .json"),
     ];
     for (name, text, needle) in cases {
         let path = d.join(name);

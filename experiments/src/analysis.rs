@@ -226,3 +226,131 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str) -> Vec<SpeedU
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cell::{CellKey, TimeStats};
+    use crate::metrics::summarize;
+    use estimators::budget::Budget;
+    use estimators::math::Rgb;
+    use estimators::stats::Moments;
+    use estimators::task::Costs;
+
+    fn cell(values: &[[f64; 3]], reps: usize) -> CellResult {
+        // Integral i gets `reps` estimates v_i + k * 0.1 for k in -(reps/2)..
+        let moments = values
+            .iter()
+            .map(|v| {
+                let mut m = [Moments::default(), Moments::default(), Moments::default()];
+                for k in 0..reps {
+                    for c in 0..3 {
+                        m[c].push(v[c] + 0.1 * (k as f64 - (reps as f64 - 1.0) / 2.0));
+                    }
+                }
+                m
+            })
+            .collect();
+        let key = CellKey {
+            testbed: "t".into(),
+            variant: "v".into(),
+            testbed_params: "{}".into(),
+            estimator: "e".into(),
+            budget: Budget::samples(4).unwrap(),
+            reps,
+            seed: 1,
+            version: "0".into(),
+        };
+        let mut time = TimeStats::default();
+        time.push(1e-3);
+        CellResult { key, moments, costs: Costs { samples: 4, ..Costs::default() }, estimates: 1, time, diagnostics: vec![] }
+    }
+
+    fn exact(values: &[[f64; 3]]) -> Reference {
+        Reference {
+            kind: ReferenceKind::Exact { method: "test".into(), bound: 0.0 },
+            value: values.iter().map(|v| Rgb(*v)).collect(),
+            std_err: vec![Rgb::ZERO; values.len()],
+        }
+    }
+
+    #[test]
+    fn metrics_follow_their_definitions() {
+        let c = cell(&[[1.0, 2.0, 3.0], [1.0, 1.0, 1.0]], 4);
+        // Reference off by +0.5 in every channel: bias -0.5, MSE = 0.25 + population variance.
+        let r = exact(&[[1.5, 2.5, 3.5], [1.5, 1.5, 1.5]]);
+        let row = summarize(&c, &r);
+        let pop_var = (0.15f64.powi(2) * 2.0 + 0.05f64.powi(2) * 2.0) / 4.0;
+        assert!((row.bias + 0.5).abs() < 1e-12);
+        assert!((row.mse - (0.25 + pop_var)).abs() < 1e-12, "{}", row.mse);
+        assert!((row.variance - pop_var * 4.0 / 3.0).abs() < 1e-12);
+        assert!((row.efficiency.unwrap() - 1.0 / (row.variance * 1e-3)).abs() < 1e-6);
+        assert_eq!(row.fom, None);
+    }
+
+    #[test]
+    fn stored_reference_variance_is_subtracted_and_welch_is_used() {
+        let c = cell(&[[1.0, 1.0, 1.0]], 8);
+        let mut r = exact(&[[1.0, 1.0, 1.0]]);
+        r.kind = ReferenceKind::Stored { command: "x".into(), samples: 100 };
+        r.std_err = vec![Rgb::splat(0.01)];
+        let exact_row = summarize(&c, &exact(&[[1.0, 1.0, 1.0]]));
+        let row = summarize(&c, &r);
+        assert!((exact_row.mse - row.mse - 1e-4).abs() < 1e-12);
+        let tests = unbiasedness(&c, &r, Bias::Unbiased);
+        assert_eq!(tests[0].test, "holm_welch");
+        assert_eq!(tests[0].verdict, "pass");
+    }
+
+    #[test]
+    fn the_test_flags_a_shift_and_reports_its_power() {
+        let c = cell(&[[1.0, 1.0, 1.0], [2.0, 2.0, 2.0]], 16);
+        let t = unbiasedness(&c, &exact(&[[1.2, 1.2, 1.2], [2.2, 2.2, 2.2]]), Bias::Biased);
+        assert_eq!(t[0].verdict, "biased");
+        assert!(t[0].agrees && t[0].p_value < 1e-6);
+        // se = 0.1 * sqrt(sum k^2 / 15) / 4; the detectable shift is a few se, relative to ~1.2-2.2.
+        assert!(t[0].detectable_rel_bias > 0.0 && t[0].detectable_rel_bias < 0.2);
+        let ok = unbiasedness(&c, &exact(&[[1.0, 1.0, 1.0], [2.0, 2.0, 2.0]]), Bias::Unbiased);
+        assert!(ok.iter().all(|t| t.verdict == "pass" && t.agrees));
+    }
+
+    #[test]
+    fn speedup_uses_the_baseline_fit() {
+        let mk = |est: &str, budget: u64, rmse: f64, seconds: f64| SummaryRow {
+            testbed: "t".into(),
+            variant: "v".into(),
+            estimator: est.into(),
+            budget_kind: "samples".into(),
+            budget,
+            reps: 2,
+            integrals: 1,
+            rmse,
+            mse: rmse * rmse,
+            variance: rmse * rmse,
+            bias: 0.0,
+            bias_se: 0.0,
+            samples: budget as f64,
+            fetches: 0.0,
+            rays: 0.0,
+            seconds,
+            efficiency: None,
+            fom: None,
+            rel_rmse: 0.0,
+            reference_var: 0.0,
+            cheap_fetches: 0.0,
+            seconds_median: seconds,
+            efficiency_mse: None,
+        };
+        let mut rows = Vec::new();
+        for b in [4u64, 16, 64] {
+            rows.push(mk("base", b, 1.0 / (b as f64).sqrt(), b as f64));
+            rows.push(mk("fast", b, 1.0 / b as f64, 2.0 * b as f64));
+        }
+        let f = fits(&rows);
+        let s = speedups(&rows, &f, "base");
+        // At 64 spp the fast method's RMSE 1/64 needs 4096 baseline samples: 64x, overhead 2x.
+        assert_eq!(s.len(), 1);
+        assert!((s[0].sample_ratio - 64.0).abs() < 1e-6 && (s[0].overhead - 2.0).abs() < 1e-12);
+        assert!((s[0].speedup - 32.0).abs() < 1e-6);
+    }
+}
