@@ -262,7 +262,7 @@ pub fn gauss_kronrod_multi<const N: usize>(
         heap.push(left);
         heap.push(right);
         steps += 1;
-        if steps % 64 == 0 {
+        if steps.is_multiple_of(64) {
             (val, err) = totals(heap.iter().chain(done.iter()));
         }
     }

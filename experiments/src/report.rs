@@ -3,7 +3,7 @@
 
 use crate::error::Result;
 use crate::metrics::SummaryRow;
-use crate::output::{write_atomic, RunReport};
+use crate::output::{write_atomic, Diagnostic, RunReport};
 use crate::plot::{budget_axis_label, label_of, plot_stem, PlotKind};
 use std::fmt::Write as _;
 use std::path::{Component, Path, PathBuf};
@@ -33,6 +33,15 @@ pub fn sig(x: f64, digits: usize) -> String {
 /// `sig(x, 4)` for a present value, `-` for a missing one.
 fn opt(x: Option<f64>) -> String {
     x.map(|v| sig(v, 4)).unwrap_or_else(|| "-".to_string())
+}
+
+/// A cost: whole numbers as integers, others with 4 significant digits.
+fn count(x: f64) -> String {
+    if x.fract() == 0.0 && x.abs() < 1e12 {
+        format!("{}", x as i64)
+    } else {
+        sig(x, 4)
+    }
 }
 
 fn cell(text: &str) -> String {
@@ -91,7 +100,7 @@ fn relative(from: &Path, to: &Path) -> String {
 fn name(report: &RunReport, id: &str) -> String {
     match label_of(report, id) {
         l if l == id => id.to_string(),
-        l => format!("{id} ({l})"),
+        l => format!("{id}: {l}"),
     }
 }
 
@@ -108,7 +117,9 @@ fn section(out: &mut String, title: &str, header: &[&str], rows: Vec<Vec<String>
     }
 }
 
-/// The text of `report.md` (see [`write_report`]).
+/// The text of `report.md` (see [`write_report`]): metadata, then the tables of paper claims,
+/// fits, speed-ups, unbiasedness tests, skipped pairs and unavailable estimators, then per
+/// (test bed, variant) the summary rows, the estimators' diagnostics and the plots.
 pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, results_dir: &Path) -> String {
     let m = &report.meta;
     let mut out = format!("# mcbench report: {}\n\n", m.experiment);
@@ -154,7 +165,16 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
 
     let speedups = report.speedups.iter().map(|s| {
         let (sr, ov, su) = (sig(s.sample_ratio, 4), sig(s.overhead, 4), sig(s.speedup, 4));
-        vec![s.testbed.clone(), s.variant.clone(), name(report, &s.estimator), s.baseline.clone(), s.budget.to_string(), sr, ov, su]
+        vec![
+            s.testbed.clone(),
+            s.variant.clone(),
+            name(report, &s.estimator),
+            s.baseline.clone(),
+            s.budget.to_string(),
+            sr,
+            ov,
+            su,
+        ]
     });
     let header = ["testbed", "variant", "estimator", "baseline", "budget", "sample ratio", "overhead", "speed-up"];
     section(&mut out, "Speed-ups", &header, speedups.collect(), "No speed-ups computed.");
@@ -187,7 +207,10 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
     ];
     section(&mut out, "Unbiasedness tests", &header, tests.collect(), "No tests in this run.");
 
-    let skipped = report.skipped.iter().map(|s| vec![s.testbed.clone(), s.variant.clone(), s.estimator.clone(), s.reason.clone()]);
+    let skipped = report
+        .skipped
+        .iter()
+        .map(|s| vec![s.testbed.clone(), s.variant.clone(), s.estimator.clone(), s.reason.clone()]);
     let header = ["testbed", "variant", "estimator", "reason"];
     section(&mut out, "Skipped pairs", &header, skipped.collect(), "None.");
     let unavailable = report.unavailable.iter().map(|u| vec![u.clone(), "not registered in this build".to_string()]);
@@ -196,17 +219,20 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
     let mut used = vec![false; plots.len()];
     out.push_str("\n## Results\n");
     let mut groups: Vec<(&str, &str)> = Vec::new();
-    for r in &report.rows {
-        if !groups.contains(&(r.testbed.as_str(), r.variant.as_str())) {
-            groups.push((&r.testbed, &r.variant));
+    let keys = report.rows.iter().map(|r| (&r.testbed, &r.variant));
+    for (t, v) in keys.chain(report.diagnostics.iter().map(|d| (&d.testbed, &d.variant))) {
+        if !groups.contains(&(t.as_str(), v.as_str())) {
+            groups.push((t, v));
         }
     }
     if groups.is_empty() {
         out.push_str("\nNo result rows.\n");
     }
     for (testbed, variant) in groups {
-        let rows: Vec<&SummaryRow> = report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
+        let rows: Vec<&SummaryRow> =
+            report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
         results_table(&mut out, report, testbed, variant, &rows);
+        diagnostics_table(&mut out, report, testbed, variant);
         for kind in PlotKind::ALL {
             let png = format!("{}.png", plot_stem(testbed, variant, kind));
             if let Some(i) = plots.iter().position(|p| p.file_name().is_some_and(|n| n.to_string_lossy() == png)) {
@@ -246,9 +272,45 @@ fn embed(out: &mut String, plot: &Path, plots: &[PathBuf], used: &mut [bool], pl
     out.push('\n');
 }
 
+/// The estimators' diagnostics of one group, one column per diagnostic name.
+fn diagnostics_table(out: &mut String, report: &RunReport, testbed: &str, variant: &str) {
+    let diags: Vec<&Diagnostic> =
+        report.diagnostics.iter().filter(|d| d.testbed == testbed && d.variant == variant).collect();
+    let (mut names, mut keys): (Vec<&str>, Vec<(&str, u64)>) = (Vec::new(), Vec::new());
+    for d in &diags {
+        if !names.contains(&d.name.as_str()) {
+            names.push(&d.name);
+        }
+        if !keys.contains(&(d.estimator.as_str(), d.budget)) {
+            keys.push((&d.estimator, d.budget));
+        }
+    }
+    if diags.is_empty() {
+        return;
+    }
+    let header: Vec<&str> = ["estimator", "budget"].into_iter().chain(names.iter().copied()).collect();
+    let rows: Vec<Vec<String>> = keys
+        .iter()
+        .map(|&(e, b)| {
+            let values = names.iter().map(|n| {
+                let d = diags.iter().find(|d| d.estimator == e && d.budget == b && d.name == *n);
+                d.map(|d| count(d.mean)).unwrap_or_else(|| "-".to_string())
+            });
+            [name(report, e), b.to_string()].into_iter().chain(values).collect()
+        })
+        .collect();
+    out.push_str("\nEstimator diagnostics (mean per estimate):\n\n");
+    out.push_str(&markdown_table(&header, &rows));
+}
+
 fn results_table(out: &mut String, report: &RunReport, testbed: &str, variant: &str, rows: &[&SummaryRow]) {
     let kind = rows.first().map(|r| r.budget_kind.as_str()).unwrap_or("samples");
-    let _ = write!(out, "\n### {testbed} / {variant}\n\nBudget: {}.\n\n", budget_axis_label(kind));
+    let _ = write!(out, "\n### {testbed} / {variant}\n\n");
+    if rows.is_empty() {
+        out.push_str("No result rows.\n");
+        return;
+    }
+    let _ = write!(out, "Budget: {}.\n\n", budget_axis_label(kind));
     let fetches = rows.iter().any(|r| r.fetches > 0.0);
     let mut header = vec!["estimator", "budget", "rmse", "variance", "bias ± se", "samples"];
     if fetches {
@@ -267,10 +329,10 @@ fn results_table(out: &mut String, report: &RunReport, testbed: &str, variant: &
                 sig(r.rmse, 4),
                 sig(r.variance, 4),
                 format!("{} ± {}", sig(r.bias, 4), sig(r.bias_se, 4)),
-                sig(r.samples, 4),
+                count(r.samples),
             ];
             if fetches {
-                v.push(sig(r.fetches, 4));
+                v.push(count(r.fetches));
             }
             v.extend([sig(r.seconds, 4), opt(r.efficiency)]);
             if fetches {
@@ -331,7 +393,7 @@ mod tests {
         for h in [
             "# mcbench report: surface-smc",
             "## Paper claims",
-            "| testbed | claim",
+            "paper value",
             "## Convergence fits",
             "95% CI",
             "## Speed-ups",
@@ -342,6 +404,9 @@ mod tests {
             "needs a medium",
             "## Unavailable estimators",
             "brdf_is1_cv2",
+            "Estimator diagnostics (mean per estimate)",
+            "| cache_bytes |",
+            "| 4096        |",
             "## Results",
             "bias ± se",
             "3.10e-7",

@@ -1,6 +1,6 @@
 use super::*;
 use crate::analysis::{fits, SpeedUp, TestRow};
-use crate::output::{Claim, Meta};
+use crate::output::{Claim, Diagnostic, Meta};
 use crate::plan::Skipped;
 
 fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
@@ -97,6 +97,14 @@ pub(crate) fn synthetic_report() -> RunReport {
         unavailable: vec!["brdf_is1_cv2".into()],
         rows,
         labels: vec![("is0_cv0".into(), "MCMC (independent MC)".into()), ("is1_cv2".into(), "IS1 + CV2".into())],
+        diagnostics: vec![Diagnostic {
+            testbed: "gradient-plane".into(),
+            variant: "default".into(),
+            estimator: "is1_cv2".into(),
+            budget: 64,
+            name: "cache_bytes".into(),
+            mean: 4096.0,
+        }],
     }
 }
 

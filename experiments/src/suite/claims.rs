@@ -77,7 +77,7 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
         claim: format!("harness (SPEC §6): the biased control {control} is flagged at p < 1e-6"),
         paper_value: Some(1e-6),
         our_value: rows.first().map(|_| min_p),
-        held: (!rows.is_empty()).then(|| min_p < 1e-6),
+        held: (!rows.is_empty()).then_some(min_p < 1e-6),
         note: "smallest Holm-adjusted p-value of the per-integral t-tests".into(),
     }
 }
