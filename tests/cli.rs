@@ -45,7 +45,11 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
         ("bad_param.toml", SMALL.replace("clamp = 1.5", "clamp = -1.0"), "clamp"),
         ("typo_param.toml", SMALL.replace("clamp = 1.5", "clmap = 1.5"), "clmap"),
         ("bad_estimator.toml", SMALL.replace("'is0_cv0'", "'is9_cv9'"), "is9_cv9"),
-        ("bad_testbed.json", r#"{"name":"x","budgets":[4],"testbeds":[{"id":"nope"}],"estimators":[{"id":"is0_cv0"}]}"#.to_string(), "nope"),
+        (
+            "bad_testbed.json",
+            r#"{"name":"x","budgets":[4],"testbeds":[{"id":"nope"}],"estimators":[{"id":"is0_cv0"}]}"#.to_string(),
+            "nope",
+        ),
         ("bad_kind.toml", "name='x'\nbudget_kind='parsecs'\n".to_string(), "parsecs"),
         ("notes.txt", "name = 'x'".to_string(), ".toml or .json"),
     ];
@@ -75,7 +79,9 @@ fn a_custom_sweep_runs_end_to_end_and_plots_can_be_redrawn() {
     std::fs::write(d.join("tiny.toml"), SMALL).expect("write");
     let o = mcbench(d, &["run", "--config", "tiny.toml", "--threads", "2"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    for f in ["results/tiny/summary.csv", "results/tiny/integrals.csv", "results/tiny/summary.json", "plots/tiny/report.md"] {
+    for f in
+        ["results/tiny/summary.csv", "results/tiny/integrals.csv", "results/tiny/summary.json", "plots/tiny/report.md"]
+    {
         assert!(d.join(f).is_file(), "{f} missing");
     }
     assert!(String::from_utf8_lossy(&o.stdout).contains("clamped_is0_cv0[clamp=1.5]"));

@@ -36,7 +36,14 @@ pub struct Task<'a> {
 impl<'a> Task<'a> {
     /// A task for integral `integral` of `bed` (the harness builds these).
     pub fn new(bed: &'a dyn TestBed, integral: usize, budget: Budget) -> Self {
-        Task { bed, integral, budget, costs: Cell::new(Costs::default()), started: Instant::now(), diagnostics: RefCell::new(Vec::new()) }
+        Task {
+            bed,
+            integral,
+            budget,
+            costs: Cell::new(Costs::default()),
+            started: Instant::now(),
+            diagnostics: RefCell::new(Vec::new()),
+        }
     }
     /// The integral index.
     pub fn integral(&self) -> usize {

@@ -169,7 +169,15 @@ mod tests {
 
     #[test]
     fn bad_variant_and_resolution_are_refused_naming_the_field() {
-        assert!(GradientPlane::new("shiny", &Params::new()).err().unwrap().to_string().contains("gradient-plane/shiny"));
-        assert!(GradientPlane::new("default", &Params::new().with("resolution", 0.0)).err().unwrap().to_string().contains("resolution"));
+        assert!(GradientPlane::new("shiny", &Params::new())
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("gradient-plane/shiny"));
+        assert!(GradientPlane::new("default", &Params::new().with("resolution", 0.0))
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("resolution"));
     }
 }

@@ -50,7 +50,6 @@ pub fn available(ids: &[&str]) -> (Vec<EstimatorSpec>, Vec<String>) {
     (have, missing)
 }
 
-
 impl ExperimentDef {
     /// The ids this experiment names that are not registered yet.
     pub fn unavailable(&self) -> Vec<String> {
