@@ -6,6 +6,12 @@ use crate::estimator::{Bias, Estimator};
 use crate::params::Params;
 use crate::testbed::{Needs, TestBed};
 
+/// Builds a configured estimator from its parameters.
+pub type BuildEstimator = fn(&Params) -> Result<Box<dyn Estimator>, ConfigError>;
+
+/// Builds a test-bed variant from its parameters.
+pub type BuildTestBed = fn(&str, &Params) -> Result<Box<dyn TestBed>, ConfigError>;
+
 /// The static description of an estimator and how to build it from parameters.
 pub struct EstimatorEntry {
     /// Stable id used in files and plots.
@@ -21,7 +27,7 @@ pub struct EstimatorEntry {
     /// One line for `mcbench list estimators`.
     pub summary: &'static str,
     /// Builds a configured instance (validates the parameters).
-    pub build: fn(&Params) -> Result<Box<dyn Estimator>, ConfigError>,
+    pub build: BuildEstimator,
 }
 
 /// The static description of a test bed.
@@ -35,7 +41,7 @@ pub struct TestBedEntry {
     /// One line for `mcbench list testbeds`.
     pub summary: &'static str,
     /// Builds a variant (computes or loads its reference).
-    pub build: fn(&str, &Params) -> Result<Box<dyn TestBed>, ConfigError>,
+    pub build: BuildTestBed,
 }
 
 /// Every registered estimator.
@@ -43,6 +49,12 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::independent::is0_cv0::ENTRY,
     &crate::independent::brdf_is0_cv0::ENTRY,
     &crate::independent::clamped_is0_cv0::ENTRY,
+    &crate::smc_surface::is0_cv1::ENTRY,
+    &crate::smc_surface::is0_cv2::ENTRY,
+    &crate::smc_surface::is1_cv0::ENTRY,
+    &crate::smc_surface::is1_cv1::ENTRY,
+    &crate::smc_surface::is1_cv2::ENTRY,
+    &crate::smc_surface::brdf_is1_cv2::ENTRY,
 ];
 
 /// Every registered test bed.
@@ -50,12 +62,20 @@ pub static TESTBEDS: &[&TestBedEntry] = &[&crate::testbeds::gradient_plane::ENTR
 
 /// Looks an estimator up by id.
 pub fn estimator(id: &str) -> Result<&'static EstimatorEntry, ConfigError> {
-    ESTIMATORS.iter().copied().find(|e| e.id == id).ok_or_else(|| ConfigError::unknown("estimator", id, ESTIMATORS.iter().map(|e| e.id)))
+    ESTIMATORS
+        .iter()
+        .copied()
+        .find(|e| e.id == id)
+        .ok_or_else(|| ConfigError::unknown("estimator", id, ESTIMATORS.iter().map(|e| e.id)))
 }
 
 /// Looks a test bed up by id.
 pub fn testbed(id: &str) -> Result<&'static TestBedEntry, ConfigError> {
-    TESTBEDS.iter().copied().find(|e| e.id == id).ok_or_else(|| ConfigError::unknown("test bed", id, TESTBEDS.iter().map(|e| e.id)))
+    TESTBEDS
+        .iter()
+        .copied()
+        .find(|e| e.id == id)
+        .ok_or_else(|| ConfigError::unknown("test bed", id, TESTBEDS.iter().map(|e| e.id)))
 }
 
 impl TestBedEntry {

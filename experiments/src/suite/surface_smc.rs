@@ -33,7 +33,7 @@ fn sweep(mode: Mode) -> Sweep {
     let (estimators, _) = available(IDS);
     let bed = |v: &str| TestBedSpec { id: "gradient-plane".into(), variant: Some(v.into()), params: Params::new() };
     let (testbeds, budgets, reps) = match mode {
-        Mode::Quick => (vec![bed("default")], powers_of_four(1..=6), 16),
+        Mode::Quick => (vec![bed("default")], powers_of_four(1..=6), 8),
         Mode::Full => (vec![bed("default"), bed("stiff")], powers_of_four(1..=7), 32),
     };
     Sweep {

@@ -1,0 +1,19 @@
+//! `is0_cv2` (paper 001 Fig. 4): uniform hemisphere sampling, bilinear (order 1) cache control
+//! variate; one adaptive cache per estimate (see [`super`]).
+
+use super::{Sampling, SmcSurface};
+use crate::cache::ControlVariate;
+use crate::estimator::Bias;
+use crate::registry::EstimatorEntry;
+use crate::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "is0_cv2",
+    paper: "001",
+    label: "is0_cv2",
+    bias: Bias::Unbiased,
+    needs: Needs::SURFACE,
+    summary: "SMC surface cache: uniform sampling, bilinear control variate (cv2)",
+    build: |p| SmcSurface::build("is0_cv2", Sampling::Uniform, ControlVariate::Bilinear, p),
+};

@@ -1,0 +1,19 @@
+//! `is1_cv1` (paper 001 Fig. 4): cache PDF importance sampling with the piecewise constant control
+//! variate; one adaptive cache per estimate (see [`super`]).
+
+use super::{Sampling, SmcSurface};
+use crate::cache::ControlVariate;
+use crate::estimator::Bias;
+use crate::registry::EstimatorEntry;
+use crate::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "is1_cv1",
+    paper: "001",
+    label: "is1_cv1",
+    bias: Bias::Unbiased,
+    needs: Needs::SURFACE,
+    summary: "SMC surface cache: cache-PDF importance sampling, piecewise-constant control variate",
+    build: |p| SmcSurface::build("is1_cv1", Sampling::Cache, ControlVariate::Constant, p),
+};

@@ -1,0 +1,218 @@
+//! Sequential Monte Carlo adaptation on surfaces (paper 001 §4, SPEC §4.1 "Surface"): one adaptive
+//! hemispherical [`RadianceCache`] per estimate (per pixel), started with one cell and adapted over
+//! the samples of that estimate.
+//!
+//! Every sample `k` is estimated from the snapshot of the cache *before* its record is added (§4.6,
+//! Fig. 3 lines 12-17): `X_k = G + (f(w_k) - g(w_k)) / p(w_k)` with `w_k ~ p`. Given the past,
+//! `E[X_k] = G + integral of (f - g) = F` because `G` is the exact integral of `g` (closed form,
+//! [`ControlVariate::integral`]), the reported `p` is exactly the sampling density (integer
+//! partial-sum tree), and `p > 0` wherever `f != 0` (inheritance rule, no clamp). The estimate is
+//! the compensated average of the `X_k`, so it is unbiased at every sample count.
+//!
+//! The ids are thin entries over one generic core, [`SmcSurface`]: `is0_cv1`, `is0_cv2`,
+//! `is1_cv0`, `is1_cv1`, `is1_cv2` and `brdf_is1_cv2` (the §4.5 variance tracker choosing between
+//! BRDF importance sampling and `is1_cv2` from the same sample). Parameters: `criterion`
+//! (default 8, paper 001 Table 1), `max_depth` (default 8) and `storage` (`"f64"` or `"f32"`).
+
+pub mod brdf_is1_cv2;
+pub mod is0_cv1;
+pub mod is0_cv2;
+pub mod is1_cv0;
+pub mod is1_cv1;
+pub mod is1_cv2;
+pub mod variance_tracker;
+
+use crate::accumulate::RgbMean;
+use crate::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, Storage, MAX_DEPTH_LIMIT};
+use crate::error::{ConfigError, EstimateError};
+use crate::estimator::Estimator;
+use crate::math::{Frame, Rgb};
+use crate::params::Params;
+use crate::rng::StreamRng;
+use crate::task::{HemisphereProbe, Task};
+use variance_tracker::VarianceTracker;
+
+/// The parameters every surface SMC id accepts.
+pub const PARAMS: &[&str] = &["criterion", "max_depth", "storage"];
+
+/// How directions are drawn.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sampling {
+    /// `is0`: uniform over the hemisphere.
+    Uniform,
+    /// `is1`: the cache PDF (uniform until the first refinement).
+    Cache,
+    /// `brdf_is1`: the variance tracker of paper 001 §4.5 picks BRDF importance sampling or the
+    /// cache PDF for each sample.
+    BrdfTracked,
+}
+
+/// Which cache snapshot an estimate reads. Only `BeforeRecord` is unbiased; `AfterRecord` exists
+/// to show that the unbiasedness test catches the mistake the snapshot rule prevents.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Snapshot {
+    BeforeRecord,
+    #[cfg_attr(not(test), allow(dead_code))]
+    AfterRecord,
+}
+
+/// The generic surface SMC estimator (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct SmcSurface {
+    sampling: Sampling,
+    cv: ControlVariate,
+    config: CacheConfig,
+    storage: Storage,
+    snapshot: Snapshot,
+}
+
+impl SmcSurface {
+    /// Builds the estimator `id` from its parameters (`criterion` in `[1, 1e9]`, `max_depth` in
+    /// `[1, 12]`, `storage` `"f64"` or `"f32"`), refusing unknown ones.
+    pub fn from_params(id: &str, sampling: Sampling, cv: ControlVariate, params: &Params) -> Result<Self, ConfigError> {
+        params.reject_unknown(id, PARAMS)?;
+        let criterion = params.f64_in("criterion", 8.0, 1.0, 1e9)?;
+        let max_depth = params.count("max_depth", 8, MAX_DEPTH_LIMIT as usize)? as u32;
+        let storage = Storage::from_params(params, "storage")?;
+        let config = CacheConfig { criterion, max_depth, ..CacheConfig::surface(sampling != Sampling::Uniform) };
+        Ok(SmcSurface { sampling, cv, config, storage, snapshot: Snapshot::BeforeRecord })
+    }
+
+    /// [`SmcSurface::from_params`], boxed for a registry entry.
+    pub fn build(
+        id: &str,
+        sampling: Sampling,
+        cv: ControlVariate,
+        params: &Params,
+    ) -> Result<Box<dyn Estimator>, ConfigError> {
+        Ok(Box::new(Self::from_params(id, sampling, cv, params)?))
+    }
+
+    /// The biased control of the tests: estimates read the cache after their own record.
+    #[cfg(test)]
+    fn reading_after_record(mut self) -> Self {
+        self.snapshot = Snapshot::AfterRecord;
+        self
+    }
+
+    /// The cache configuration.
+    pub fn config(&self) -> &CacheConfig {
+        &self.config
+    }
+
+    fn run<S: Scalar>(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let probe =
+            task.hemisphere().ok_or_else(|| EstimateError::Refused("the test bed has no surface integrals".into()))?;
+        let mut state = State::<S> {
+            cache: RadianceCache::new(self.config),
+            frame: Frame::around(probe.point().normal),
+            tracker: VarianceTracker::new(self.config.criterion),
+            smc_chosen: 0,
+        };
+        let mut mean = RgbMean::new();
+        while task.more() {
+            mean.push(self.step(&mut state, &probe, rng));
+        }
+        let value = mean.mean();
+        let grid = state.cache.grid();
+        task.note("cells", grid.cells() as f64);
+        task.note("refinements", f64::from(grid.refinements()));
+        task.note("cache_bytes", state.cache.bytes() as f64);
+        task.note("cell_bytes", grid.cell_bytes() as f64);
+        if self.sampling == Sampling::BrdfTracked && mean.count() > 0 {
+            task.note("smc_share", state.smc_chosen as f64 / mean.count() as f64);
+        }
+        if !value.is_finite() {
+            return Err(EstimateError::NonFinite { integral: task.integral(), value: value.0 });
+        }
+        Ok(value)
+    }
+
+    /// One sample: draw, evaluate, estimate from the snapshot, then record (and maybe refine).
+    fn step<S: Scalar>(&self, state: &mut State<S>, probe: &HemisphereProbe<'_>, rng: &mut StreamRng) -> Rgb {
+        let cache = &mut state.cache;
+        let domain = cache.domain();
+        let big_g = cache.integral(self.cv);
+        let draw = match self.sampling {
+            Sampling::Uniform => cache.sample_uniform(rng),
+            Sampling::Cache => cache.sample(rng),
+            Sampling::BrdfTracked => return self.tracked_step(state, probe, rng),
+        };
+        // `draw.pdf > 0`: uniform, or a tree leaf that can only be drawn when its weight is >= 1.
+        let f = probe.integrand(state.frame.to_world(domain.direction(draw.st)));
+        let g = cache.g(self.cv, draw.st);
+        match self.snapshot {
+            Snapshot::BeforeRecord => {
+                let estimate = big_g + (f - g) / draw.pdf;
+                cache.add_record(draw.cell, f, g);
+                estimate
+            }
+            Snapshot::AfterRecord => {
+                cache.add_record(draw.cell, f, g);
+                cache.integral(self.cv) + (f - cache.g(self.cv, draw.st)) / draw.pdf
+            }
+        }
+    }
+
+    /// `brdf_is1_cv2` (paper 001 §4.5-4.6, Fig. 3): the tracker picks the estimator, the direction is
+    /// drawn from its density, both estimates are computed from the one sample, only the picked one
+    /// contributes, and the record goes into the cache either way.
+    fn tracked_step<S: Scalar>(&self, state: &mut State<S>, probe: &HemisphereProbe<'_>, rng: &mut StreamRng) -> Rgb {
+        let cache = &mut state.cache;
+        let domain = cache.domain();
+        let point = probe.point();
+        let brdf = &point.brdf;
+        let big_g = cache.integral(self.cv);
+        let use_smc = state.tracker.prefers_smc();
+        let (w, st, p_cache, p_brdf) = if use_smc {
+            let s = cache.sample(rng);
+            let w = state.frame.to_world(domain.direction(s.st));
+            (w, Some(s.st), s.pdf, brdf.pdf(w, point.wo, point.normal))
+        } else {
+            let d = brdf.sample(point.wo, point.normal, rng);
+            // Below the horizon the direction is outside the cache's domain (and f = 0 there).
+            let st = domain.st_of(state.frame.to_local(d.w));
+            (d.w, st, st.map_or(0.0, |st| cache.pdf(st)), d.pdf)
+        };
+        let f = probe.integrand(w);
+        let (smc, g) = match st {
+            // p_cache > 0 on the whole hemisphere (uniform, or every tree leaf >= 1).
+            Some(st) if p_cache > 0.0 => {
+                let g = cache.g(self.cv, st);
+                (big_g + (f - g) / p_cache, g)
+            }
+            _ => (big_g, Rgb::ZERO),
+        };
+        // The Phong mixture density is positive wherever f is (cosine lobe for kd > 0, Phong lobe
+        // over the support of the glossy term); a zero density comes with f = 0.
+        let mcmc = if p_brdf > 0.0 { f / p_brdf } else { Rgb::ZERO };
+        let chosen = if use_smc { smc } else { mcmc };
+        state.tracker.update(smc, mcmc, chosen);
+        state.smc_chosen += u64::from(use_smc);
+        if let Some(st) = st {
+            let cell = cache.grid().cell_at(st);
+            cache.add_record(cell, f, g);
+        }
+        chosen
+    }
+}
+
+/// The adaptive state of one estimate.
+struct State<S: Scalar> {
+    cache: RadianceCache<S>,
+    frame: Frame,
+    tracker: VarianceTracker,
+    smc_chosen: u64,
+}
+
+impl Estimator for SmcSurface {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        match self.storage {
+            Storage::F64 => self.run::<f64>(task, rng),
+            Storage::F32 => self.run::<f32>(task, rng),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
