@@ -11,6 +11,7 @@
 pub mod accumulate;
 pub mod brdf;
 pub mod budget;
+pub mod envmap;
 pub mod error;
 pub mod estimator;
 pub mod independent;
@@ -21,6 +22,7 @@ pub mod quadrature;
 pub mod registry;
 pub mod rng;
 pub mod samplers;
+pub mod smc;
 pub mod stats;
 pub mod task;
 pub mod testbed;

@@ -43,10 +43,17 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::independent::is0_cv0::ENTRY,
     &crate::independent::brdf_is0_cv0::ENTRY,
     &crate::independent::clamped_is0_cv0::ENTRY,
+    &crate::smc::bidirectional_is::ENTRY,
+    &crate::smc::bidirectional_is_sn::ENTRY,
+    &crate::smc::smc::ENTRY,
+    &crate::smc::smc_bridge::ENTRY,
+    &crate::smc::smc_path::ENTRY,
+    &crate::smc::smc_adaptive::ENTRY,
 ];
 
 /// Every registered test bed.
-pub static TESTBEDS: &[&TestBedEntry] = &[&crate::testbeds::gradient_plane::ENTRY];
+pub static TESTBEDS: &[&TestBedEntry] =
+    &[&crate::testbeds::gradient_plane::ENTRY, &crate::testbeds::envmap_sequence::ENTRY];
 
 /// Looks an estimator up by id.
 pub fn estimator(id: &str) -> Result<&'static EstimatorEntry, ConfigError> {
