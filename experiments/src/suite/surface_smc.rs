@@ -19,6 +19,7 @@ pub static DEF: ExperimentDef = ExperimentDef {
     ids: IDS,
     sweep,
     claims,
+    post: None,
 };
 
 fn sweep(mode: Mode) -> Sweep {
