@@ -15,8 +15,10 @@
 //! Visibility (an infinite ground plane at z = -1, `V = 1` iff `w_z >= 0`) coincides with the
 //! equator, a row edge of every map with an even number of rows.
 //!
-//! The rigorous part of the bound is the skipped mass; the quadrature's own error is below 1e-10
-//! relative, checked against a brute-force quadrature with 16x more panels per texel in the tests.
+//! The rigorous part of the bound is the skipped mass; the quadrature's own error is stated as
+//! 1e-7 relative, the level at which the tests check it against a brute-force quadrature with 16x
+//! more panels per texel (SPEC §3.7 asks for 1e-9: the rules used should reach it on smooth
+//! texels, but the brute force cannot show it, so it is not claimed).
 
 use crate::brdf::Phong;
 use crate::envmap::EnvMap;
@@ -24,8 +26,8 @@ use crate::math::{Rgb, Vec3};
 use crate::quadrature::gauss_legendre;
 use std::f64::consts::{PI, TAU};
 
-/// Relative quadrature accuracy promised beyond the skipped mass (checked by the tests).
-pub const QUADRATURE_REL_ERROR: f64 = 1e-10;
+/// Relative quadrature accuracy promised beyond the skipped mass (the level the tests check).
+pub const QUADRATURE_REL_ERROR: f64 = 1e-7;
 
 /// Per-texel precomputation shared by every pixel and frame of a map grid.
 pub struct TexelTable {
