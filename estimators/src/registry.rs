@@ -55,10 +55,17 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::smc_surface::is1_cv1::ENTRY,
     &crate::smc_surface::is1_cv2::ENTRY,
     &crate::smc_surface::brdf_is1_cv2::ENTRY,
+    &crate::smc::bidirectional_is::ENTRY,
+    &crate::smc::bidirectional_is_sn::ENTRY,
+    &crate::smc::smc::ENTRY,
+    &crate::smc::smc_bridge::ENTRY,
+    &crate::smc::smc_path::ENTRY,
+    &crate::smc::smc_adaptive::ENTRY,
 ];
 
 /// Every registered test bed.
-pub static TESTBEDS: &[&TestBedEntry] = &[&crate::testbeds::gradient_plane::ENTRY];
+pub static TESTBEDS: &[&TestBedEntry] =
+    &[&crate::testbeds::gradient_plane::ENTRY, &crate::testbeds::envmap_sequence::ENTRY];
 
 /// Looks an estimator up by id.
 pub fn estimator(id: &str) -> Result<&'static EstimatorEntry, ConfigError> {

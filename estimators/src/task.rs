@@ -3,9 +3,12 @@
 //! Estimators reach the scene only through a [`Task`] and its probes, and the probes count every
 //! sample, ray and fetch, so no plug-in can forget to count (the argmin `Problem` wrapper idea).
 
+use crate::brdf::DirectionSample;
 use crate::budget::{Budget, BudgetKind};
+use crate::envmap::EnvFrame;
 use crate::math::{Rgb, Vec3};
-use crate::testbed::{HemisphereScene, ShadingPoint, TestBed};
+use crate::testbed::{EnvQuantity, EnvSequenceScene, HemisphereScene, ShadingPoint, TestBed};
+use rand::Rng;
 use serde::{Deserialize, Serialize};
 use std::cell::{Cell, RefCell};
 use std::time::Instant;
@@ -84,6 +87,14 @@ impl<'a> Task<'a> {
         let scene = self.bed.hemisphere()?;
         Some(HemisphereProbe { point: scene.shading(self.integral), scene, task: self })
     }
+    /// The environment-sequence probe of this integral (frame `i % F` of pixel `i / F`), when the
+    /// scene has one.
+    pub fn env_sequence(&self) -> Option<EnvProbe<'_>> {
+        let scene = self.bed.env_sequence()?;
+        let frames = scene.frames().max(1);
+        let (pixel, frame) = (self.integral / frames, self.integral % frames);
+        Some(EnvProbe { scene, task: self, pixel, frame, point: scene.shading(pixel), env: scene.environment(frame) })
+    }
     fn count(&self, f: impl FnOnce(&mut Costs)) {
         let mut c = self.costs.get();
         f(&mut c);
@@ -114,5 +125,80 @@ impl HemisphereProbe<'_> {
         }
         self.task.count(|c| c.rays += 1);
         self.scene.incident(self.task.integral, wi) * p.brdf.eval(wi, p.wo, p.normal) * cos
+    }
+}
+
+/// Counted access to one frame of one pixel of an environment sequence (paper 004). Every
+/// evaluation of the product `L_i f cos` counts one sample and every visibility test one ray.
+pub struct EnvProbe<'a> {
+    scene: &'a dyn EnvSequenceScene,
+    task: &'a Task<'a>,
+    pixel: usize,
+    frame: usize,
+    point: ShadingPoint,
+    env: EnvFrame<'a>,
+}
+
+impl EnvProbe<'_> {
+    /// The shading point (geometry and BRDF are known locally and cost nothing).
+    pub fn point(&self) -> &ShadingPoint {
+        &self.point
+    }
+    /// This integral's frame (0-based).
+    pub fn frame(&self) -> usize {
+        self.frame
+    }
+    /// The pixel.
+    pub fn pixel(&self) -> usize {
+        self.pixel
+    }
+    /// The quantity asked for (`L_r` or `L_ns`).
+    pub fn quantity(&self) -> EnvQuantity {
+        self.scene.quantity()
+    }
+    /// The unnormalised product `p~_n(w) = L_n(w) f(w, w_o) cos(theta)` of this frame per channel,
+    /// without visibility (paper 004 Eq. 2): one sample.
+    pub fn target(&self, wi: Vec3) -> Rgb {
+        self.eval(&self.env, wi)
+    }
+    /// The same product for another frame of the sequence (bridges between frames need
+    /// `p~_{n-1}` at new points, paper 004 Eq. 11): one sample, counted on this integral.
+    pub fn target_in_frame(&self, frame: usize, wi: Vec3) -> Rgb {
+        self.eval(&self.scene.environment(frame), wi)
+    }
+    fn eval(&self, env: &EnvFrame<'_>, wi: Vec3) -> Rgb {
+        self.task.count(|c| c.samples += 1);
+        let p = &self.point;
+        let cos = wi.dot(p.normal);
+        if cos <= 0.0 {
+            return Rgb::ZERO;
+        }
+        env.radiance(wi) * p.brdf.eval(wi, p.wo, p.normal) * cos
+    }
+    /// This frame's environment (radiance and sampler), for MH proposals.
+    pub fn environment_frame(&self) -> EnvFrame<'_> {
+        self.env
+    }
+    /// Records a diagnostic on this integral's task ([`Task::note`]).
+    pub fn note(&self, name: &'static str, value: f64) {
+        self.task.note(name, value);
+    }
+    /// Visibility of `wi` from the shading point: one shadow ray.
+    pub fn visible(&self, wi: Vec3) -> bool {
+        self.task.count(|c| c.rays += 1);
+        self.scene.visible(self.pixel, wi)
+    }
+    /// A direction from this frame's environment-map sampler (density proportional to the
+    /// channel-mean radiance per solid angle) with its density.
+    pub fn sample_environment<R: Rng + ?Sized>(&self, rng: &mut R) -> DirectionSample {
+        self.env.sample(rng)
+    }
+    /// The density of [`EnvProbe::sample_environment`] at `wi`.
+    pub fn environment_pdf(&self, wi: Vec3) -> f64 {
+        self.env.pdf(wi)
+    }
+    /// The environment-map density of another frame.
+    pub fn environment_pdf_in_frame(&self, frame: usize, wi: Vec3) -> f64 {
+        self.scene.environment(frame).pdf(wi)
     }
 }

@@ -146,9 +146,43 @@ pub trait TestBed: Send + Sync {
     fn hemisphere(&self) -> Option<&dyn HemisphereScene> {
         None
     }
-    /// Number of integrals.
+    /// The environment-sequence view of the scene (paper 004), when it has one.
+    fn env_sequence(&self) -> Option<&dyn EnvSequenceScene> {
+        None
+    }
+    /// How many consecutive integrals form one sequence (frames of one pixel, paper 004): integral
+    /// `i` is frame `i % F` of pixel `i / F`. The runner hands whole sequences to
+    /// [`crate::estimator::Estimator::estimate_sequence`]. 1 (the default) for static scenes.
+    fn sequence_length(&self) -> usize {
+        1
+    }
+    /// Number of integrals: pixels times [`TestBed::sequence_length`].
     fn integrals(&self) -> usize {
         let (w, h) = self.resolution();
-        w * h
+        w * h * self.sequence_length()
     }
+}
+
+/// Which quantity of paper 004 an environment-sequence integral asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum EnvQuantity {
+    /// `L_r`: reflected radiance with visibility (paper 004 Eq. 1).
+    Reflected,
+    /// `L_ns`: unoccluded reflected radiance, the normaliser of the product distribution (Eq. 2).
+    Unoccluded,
+}
+
+/// A scene whose integrals are per-pixel, per-frame reflections of a dynamic environment map
+/// (paper 004): integral `pixel * frames + frame`.
+pub trait EnvSequenceScene: Send + Sync {
+    /// Frames per sequence.
+    fn frames(&self) -> usize;
+    /// The quantity every integral asks for.
+    fn quantity(&self) -> EnvQuantity;
+    /// The shading point of a pixel (the same in every frame: relighting mode).
+    fn shading(&self, pixel: usize) -> ShadingPoint;
+    /// The environment of a frame: radiance lookup and its importance sampler.
+    fn environment(&self, frame: usize) -> crate::envmap::EnvFrame<'_>;
+    /// Binary visibility of direction `wi` from the shading point of `pixel` (one shadow ray).
+    fn visible(&self, pixel: usize, wi: Vec3) -> bool;
 }

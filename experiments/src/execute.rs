@@ -121,12 +121,18 @@ pub fn execute(plan: &Plan, def: Option<&ExperimentDef>, opts: &ExecOptions<'_>)
     if let Some(d) = def {
         report.paper = (d.claims)(&report);
     }
+    let mut extra_plots = Vec::new();
+    if let Some(post) = def.and_then(|d| d.post) {
+        extra_plots = post(plan, &run, &mut report, &results_dir, opts.plots.then_some(plots_dir.as_path()))?;
+    }
     report.meta.wall_seconds = started.elapsed().as_secs_f64();
     output::write_summary_csv(&results_dir.join("summary.csv"), &report.rows)?;
     output::write_integrals_csv(&results_dir.join("integrals.csv"), &integrals)?;
     output::write_summary_json(&results_dir.join("summary.json"), &report)?;
     if opts.plots {
-        draw(&report, &plots_dir, &results_dir)?;
+        let mut files = crate::plot::write_plots(&report, &plots_dir)?;
+        files.extend(extra_plots);
+        crate::report::write_report(&report, &files, &plots_dir, &results_dir)?;
     }
     Ok(Outcome { report, results_dir, plots_dir })
 }
@@ -140,6 +146,7 @@ pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path) -> Result<
 
 fn integral_rows(cell: &CellResult, bed: &dyn estimators::testbed::TestBed) -> Vec<IntegralRow> {
     let (w, _) = bed.resolution();
+    let frames = bed.sequence_length().max(1);
     let reference = bed.reference();
     let mut out = Vec::with_capacity(cell.moments.len() * 3);
     for (i, m) in cell.moments.iter().enumerate() {
@@ -150,8 +157,8 @@ fn integral_rows(cell: &CellResult, bed: &dyn estimators::testbed::TestBed) -> V
                 variant: cell.key.variant.clone(),
                 estimator: cell.key.estimator.clone(),
                 integral: i,
-                px: i % w,
-                py: i / w,
+                px: (i / frames) % w,
+                py: (i / frames) / w,
                 channel: c,
                 reference: reference.value[i][c],
                 reference_se: reference.std_err[i][c],

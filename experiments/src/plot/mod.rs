@@ -151,6 +151,16 @@ pub fn write_plots(report: &RunReport, dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(written)
 }
 
+/// Writes one figure as `<stem>.svg` and `<stem>.png` in `dir` (for experiments' own plots).
+pub(crate) fn write_figure(dir: &Path, stem: &str, fig: &Figure) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
+    ensure_font(dir)?;
+    let (svg, png) = (dir.join(format!("{stem}.svg")), dir.join(format!("{stem}.png")));
+    write_svg(&svg, fig)?;
+    write_png(&png, fig)?;
+    Ok(vec![svg, png])
+}
+
 fn positive(x: f64, y: f64) -> Option<(f64, f64)> {
     (x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite()).then_some((x, y))
 }

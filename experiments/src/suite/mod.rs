@@ -2,12 +2,18 @@
 //! paper's claims, which are judged against what the run measured.
 
 pub mod claims;
+pub mod envmap_smc;
+pub mod envmap_smc_post;
+pub mod envmap_unbiasedness;
 pub mod surface_smc;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};
 use crate::output::{Claim, RunReport};
+use crate::plan::Plan;
+use crate::runner::RunResults;
 use estimators::error::ConfigError;
 use estimators::registry;
+use std::path::{Path, PathBuf};
 
 /// A named experiment.
 pub struct ExperimentDef {
@@ -23,10 +29,17 @@ pub struct ExperimentDef {
     pub sweep: fn(Mode) -> Sweep,
     /// The paper's claims judged on a finished run.
     pub claims: fn(&RunReport) -> Vec<Claim>,
+    /// Optional analysis beyond the summary rows, run after the claims with the cells of the run:
+    /// it may add claims and write extra result files and plots (returned for the report).
+    pub post: Option<PostFn>,
 }
 
+/// An experiment's own analysis: (plan, finished cells, report to extend, results folder, plots
+/// folder when plots are drawn) -> extra plot files.
+pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &Path, Option<&Path>) -> crate::error::Result<Vec<PathBuf>>;
+
 /// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF];
+pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF, &envmap_smc::DEF];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {

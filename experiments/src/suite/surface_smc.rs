@@ -27,6 +27,7 @@ pub static DEF: ExperimentDef = ExperimentDef {
     ids: IDS,
     sweep,
     claims,
+    post: None,
 };
 
 fn sweep(mode: Mode) -> Sweep {

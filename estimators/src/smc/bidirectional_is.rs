@@ -1,0 +1,20 @@
+//! `bidirectional_is` (Burke, Ghosh and Heidrich 2005; paper 004 §2.1, the baseline of Fig. 1,
+//! 4, 5): on every frame, M candidates from the environment map weighted `p~ / q`, N of them
+//! resampled; `L_r = L^_ns * (1/N) sum (p~_c / p~) V` with `L^_ns = mean(p~ / q)`, and `L_ns` by
+//! the Rao-Blackwellised `mean(p~_c / q)`. Both unbiased (the resampled set is properly weighted).
+
+use crate::estimator::Bias;
+use crate::registry::EstimatorEntry;
+use crate::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "bidirectional_is",
+    paper: "004",
+    label: "bidirectional IS",
+    bias: Bias::Unbiased,
+    needs: Needs::ENV_SEQUENCE,
+    summary:
+        "SIR: M environment-map candidates (`candidates`, default 128), N = budget resampled by BRDF cos, every frame",
+    build: |p| Ok(Box::new(super::SmcEstimator(super::config(p, "bidirectional_is", &[], 128, None)?))),
+};

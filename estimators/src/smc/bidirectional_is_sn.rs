@@ -1,0 +1,70 @@
+//! `bidirectional_is_sn`: a deliberately biased control for the paper 004 tests (SPEC §6
+//! "Teeth"). `L_ns` from one set of M candidates times the plain average of `(p~_c / p~) V` over
+//! N points resampled from a second, independent set of M candidates: the resampled points follow
+//! the product only as M grows (self-normalised importance resampling), so at the default M = 4
+//! the expectation is off by O(1/M). Consistent, not unbiased; the harness must flag it.
+
+use super::resampling::{normalise_log_weights, resample, Scheme};
+use crate::error::EstimateError;
+use crate::estimator::{Bias, Estimator};
+use crate::math::Rgb;
+use crate::registry::EstimatorEntry;
+use crate::rng::StreamRng;
+use crate::task::Task;
+use crate::testbed::{EnvQuantity, Needs};
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "bidirectional_is_sn",
+    paper: "harness",
+    label: "self-normalised SIR (biased control)",
+    bias: Bias::Biased,
+    needs: Needs::ENV_SEQUENCE,
+    summary: "biased control: independent L_ns times the self-normalised SIR mean of V at tiny M (default 4)",
+    build: |p| Ok(Box::new(BidirectionalSn(super::config(p, "bidirectional_is_sn", &[], 4, None)?))),
+};
+
+/// The control.
+pub struct BidirectionalSn(pub super::engine::Config);
+
+impl Estimator for BidirectionalSn {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let probe = task
+            .env_sequence()
+            .ok_or_else(|| EstimateError::Refused("the test bed has no environment sequence".into()))?;
+        let n = super::engine::particles(task)?;
+        let m = self.0.candidates;
+        // An independent, unbiased scalar L_ns = mean(p~ / q) (per channel for the L_ns quantity).
+        let mut lns = Rgb::ZERO;
+        for _ in 0..m {
+            let s = probe.sample_environment(rng);
+            lns += probe.target(s.w) / s.pdf;
+        }
+        let lns = lns / m as f64;
+        if probe.quantity() == EnvQuantity::Unoccluded {
+            return Ok(lns);
+        }
+        // The plain average of (p~_c / p~) V over N points resampled from M fresh candidates.
+        let (mut cand, mut log_w) = (Vec::with_capacity(m), Vec::with_capacity(m));
+        for _ in 0..m {
+            let s = probe.sample_environment(rng);
+            let t = probe.target(s.w);
+            log_w.push(if t.mean() > 0.0 { t.mean().ln() - s.pdf.ln() } else { f64::NEG_INFINITY });
+            cand.push((s.w, t));
+        }
+        let Some((w, _)) = normalise_log_weights(&log_w) else {
+            return Ok(Rgb::ZERO);
+        };
+        let mut mean = Rgb::ZERO;
+        for i in resample(Scheme::Multinomial, &w, n, rng) {
+            let (d, t) = cand[i];
+            if probe.visible(d) {
+                mean += t / t.mean();
+            }
+        }
+        Ok(mean * (lns.mean() / n as f64))
+    }
+    fn estimate_sequence(&self, tasks: &[Task<'_>], rng: &mut StreamRng) -> Result<Vec<Rgb>, EstimateError> {
+        tasks.iter().map(|t| self.estimate(t, rng)).collect()
+    }
+}

@@ -1,0 +1,25 @@
+//! `smc` (paper 004 Algorithm 1): the first frame by `bidirectional_is` (equal weights, normaliser
+//! `mean(p~ / q)`), then per frame: incremental weights `p~_n / p~_{n-1}` (Eq. 3-4, log space),
+//! `L_ns,n = L_ns,n-1 sum_j W_{n-1,j} w~_j` (Eq. 10), resampling when ESS < N/2, K MH moves of the
+//! Eq. 6-8 mixture kernel, and `L_r` by Eq. 9. The product of Eq. 10 increments times the weighted
+//! mean is the unbiased SMC estimate (Del Moral, Doucet and Jasra 2006), so the claim is unbiased.
+//! Parameters: `moves` (K, default 5) and the common ones of [`super::config`].
+
+use super::engine::Transition;
+use crate::estimator::Bias;
+use crate::registry::EstimatorEntry;
+use crate::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "smc",
+    paper: "004",
+    label: "SMC (single distribution, K MH moves)",
+    bias: Bias::Unbiased,
+    needs: Needs::ENV_SEQUENCE,
+    summary: "Algorithm 1: propagate, reweight p~_n/p~_{n-1}, resample at ESS < N/2, K MH moves (`moves`, default 5)",
+    build: |p| {
+        let moves = p.count("moves", 5, 10_000)?;
+        Ok(Box::new(super::SmcEstimator(super::config(p, "smc", &["moves"], 128, Some(Transition::Single { moves }))?)))
+    },
+};

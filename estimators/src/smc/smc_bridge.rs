@@ -1,0 +1,29 @@
+//! `smc_bridge` (paper 004 Algorithm 2): P intermediate distributions
+//! `p~_{n-1}^(1-g) p~_n^g`, g = k/P (Eq. 11), one MH move each, incremental weights the product of
+//! Eq. 12 (annealed importance sampling per particle), `L_ns` by the standard ratio (Eq. 10):
+//! unbiased. Parameters: `bridges` (P, default 5) and the common ones.
+
+use super::engine::Transition;
+use crate::estimator::Bias;
+use crate::registry::EstimatorEntry;
+use crate::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "smc_bridge",
+    paper: "004",
+    label: "SMC, P intermediate distributions (ratio)",
+    bias: Bias::Unbiased,
+    needs: Needs::ENV_SEQUENCE,
+    summary: "Algorithm 2: P bridges (`bridges`, default 5) with one MH move each, L_ns by the standard ratio (Eq. 10)",
+    build: |p| {
+        let bridges = p.count("bridges", 5, 10_000)?;
+        Ok(Box::new(super::SmcEstimator(super::config(
+            p,
+            "smc_bridge",
+            &["bridges"],
+            128,
+            Some(Transition::Bridged { bridges, path: false }),
+        )?)))
+    },
+};
