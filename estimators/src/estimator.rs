@@ -57,6 +57,14 @@ pub trait Estimator: Send + Sync {
     /// One estimate of `task.integral()` spending `task.budget()` (loop while `task.more()`).
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError>;
 
+    /// Estimates of a whole sequence of integrals (the frames of one pixel, see
+    /// [`TestBed::sequence_length`]), in order, from one random stream: estimators that carry state
+    /// from frame to frame (paper 004's SMC) override this. Each task still counts its own costs.
+    /// The default estimates each task independently with [`Estimator::estimate`].
+    fn estimate_sequence(&self, tasks: &[Task<'_>], rng: &mut StreamRng) -> Result<Vec<Rgb>, EstimateError> {
+        tasks.iter().map(|t| self.estimate(t, rng)).collect()
+    }
+
     /// Whether this configured estimator can run on `bed` beyond the static needs of its registry
     /// entry; `Err(reason)` makes the harness skip the pair and report the reason.
     fn supports(&self, _bed: &dyn TestBed) -> Result<(), String> {

@@ -59,52 +59,61 @@ fn add(a: &mut Costs, b: &Costs) {
     a.rays += b.rays;
 }
 
-/// Runs one cell (no resume logic).
+/// Runs one cell (no resume logic). Work items are whole sequences (test beds whose integrals
+/// come in frames, [`estimators::testbed::TestBed::sequence_length`]), batched to about `BATCH`
+/// integrals; each sequence draws from the stream of its first integral, so a static test bed
+/// (sequence length 1) keeps exactly the per-integral streams and batches it always had.
 pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<CellResult> {
     let (b, e) = (&plan.beds[bi], &plan.estimators[ei]);
     let label = b.label();
     let n = b.bed.integrals();
+    let frames = b.bed.sequence_length().max(1);
+    let sequences = n / frames;
+    let per_item = BATCH.div_ceil(frames);
     let reps = plan.sweep.reps;
-    let batches = n.div_ceil(BATCH);
+    let batches = sequences.div_ceil(per_item);
     let items: Vec<Result<Item>> = (0..reps * batches)
         .into_par_iter()
         .map(|item| {
             let (rep, batch) = (item / batches, item % batches);
             let mut out = Item {
-                values: Vec::with_capacity(BATCH),
+                values: Vec::with_capacity(per_item * frames),
                 costs: Costs::default(),
                 time: TimeStats::default(),
                 diagnostics: Vec::new(),
             };
-            for i in batch * BATCH..((batch + 1) * BATCH).min(n) {
+            for s in batch * per_item..((batch + 1) * per_item).min(sequences) {
+                let first = s * frames;
                 let key = StreamKey {
                     seed: plan.sweep.seed,
                     testbed: &label,
                     estimator: &e.name,
                     budget: budget.amount,
                     rep: rep as u64,
-                    integral: i as u64,
+                    integral: first as u64,
                 };
                 let mut rng = key.rng();
-                let task = Task::new(b.bed.as_ref(), i, budget);
+                let tasks: Vec<Task<'_>> =
+                    (first..first + frames).map(|i| Task::new(b.bed.as_ref(), i, budget)).collect();
                 let t0 = Instant::now();
-                let v = e.estimator.estimate(&task, &mut rng);
-                out.time.push(t0.elapsed().as_secs_f64());
-                let v = v.and_then(|v| {
-                    if v.is_finite() {
-                        Ok(v)
-                    } else {
-                        Err(EstimateError::NonFinite { integral: i, value: v.0 })
+                let values = e.estimator.estimate_sequence(&tasks, &mut rng);
+                let seconds = t0.elapsed().as_secs_f64() / frames as f64;
+                let wrap =
+                    |source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.clone(), source };
+                let values = values.map_err(wrap)?;
+                if values.len() != frames {
+                    let msg = format!("estimate_sequence returned {} values for {frames} integrals", values.len());
+                    return Err(wrap(EstimateError::Refused(msg)));
+                }
+                for (k, (v, task)) in values.into_iter().zip(&tasks).enumerate() {
+                    if !v.is_finite() {
+                        return Err(wrap(EstimateError::NonFinite { integral: first + k, value: v.0 }));
                     }
-                });
-                let v = v.map_err(|source| HarnessError::Estimate {
-                    estimator: e.name.clone(),
-                    testbed: label.clone(),
-                    source,
-                })?;
-                add(&mut out.costs, &task.costs());
-                add_diagnostics(&mut out.diagnostics, &task.diagnostics());
-                out.values.push(v);
+                    out.time.push(seconds);
+                    add(&mut out.costs, &task.costs());
+                    add_diagnostics(&mut out.diagnostics, &task.diagnostics());
+                    out.values.push(v);
+                }
             }
             Ok(out)
         })
@@ -116,7 +125,7 @@ pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Cel
         let batch = item % batches;
         for (k, v) in r.values.iter().enumerate() {
             for c in 0..3 {
-                moments[batch * BATCH + k][c].push(v[c]);
+                moments[batch * per_item * frames + k][c].push(v[c]);
             }
         }
         add(&mut costs, &r.costs);
