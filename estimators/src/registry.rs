@@ -35,6 +35,7 @@ pub struct TestBedEntry {
     /// One line for `mcbench list testbeds`.
     pub summary: &'static str,
     /// Builds a variant (computes or loads its reference).
+    #[allow(clippy::type_complexity)]
     pub build: fn(&str, &Params) -> Result<Box<dyn TestBed>, ConfigError>,
 }
 
@@ -43,19 +44,30 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::independent::is0_cv0::ENTRY,
     &crate::independent::brdf_is0_cv0::ENTRY,
     &crate::independent::clamped_is0_cv0::ENTRY,
+    &crate::pmc::mis::ENTRY,
+    &crate::pmc::hi::ENTRY,
+    &crate::pmc::hi::FEEDBACK,
 ];
 
 /// Every registered test bed.
-pub static TESTBEDS: &[&TestBedEntry] = &[&crate::testbeds::gradient_plane::ENTRY];
+pub static TESTBEDS: &[&TestBedEntry] = &[&crate::testbeds::gradient_plane::ENTRY, &crate::testbeds::checker::ENTRY];
 
 /// Looks an estimator up by id.
 pub fn estimator(id: &str) -> Result<&'static EstimatorEntry, ConfigError> {
-    ESTIMATORS.iter().copied().find(|e| e.id == id).ok_or_else(|| ConfigError::unknown("estimator", id, ESTIMATORS.iter().map(|e| e.id)))
+    ESTIMATORS
+        .iter()
+        .copied()
+        .find(|e| e.id == id)
+        .ok_or_else(|| ConfigError::unknown("estimator", id, ESTIMATORS.iter().map(|e| e.id)))
 }
 
 /// Looks a test bed up by id.
 pub fn testbed(id: &str) -> Result<&'static TestBedEntry, ConfigError> {
-    TESTBEDS.iter().copied().find(|e| e.id == id).ok_or_else(|| ConfigError::unknown("test bed", id, TESTBEDS.iter().map(|e| e.id)))
+    TESTBEDS
+        .iter()
+        .copied()
+        .find(|e| e.id == id)
+        .ok_or_else(|| ConfigError::unknown("test bed", id, TESTBEDS.iter().map(|e| e.id)))
 }
 
 impl TestBedEntry {

@@ -24,6 +24,6 @@ mod tests {
     #[test]
     fn chi_square_cosine_hemisphere() {
         let grid = SphereGrid::upper(16, 16);
-        assert_sampler_fits("cosine hemisphere", &grid, 200_000, 2, |r| sample_local(r), |d| pdf(d.z));
+        assert_sampler_fits("cosine hemisphere", &grid, 200_000, 2, sample_local, |d| pdf(d.z));
     }
 }

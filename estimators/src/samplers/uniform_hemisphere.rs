@@ -29,6 +29,6 @@ mod tests {
     #[test]
     fn chi_square_uniform_hemisphere() {
         let grid = SphereGrid::upper(16, 16);
-        assert_sampler_fits("uniform hemisphere", &grid, 200_000, 1, |r| sample_local(r), |d| pdf(d.z));
+        assert_sampler_fits("uniform hemisphere", &grid, 200_000, 1, sample_local, |d| pdf(d.z));
     }
 }

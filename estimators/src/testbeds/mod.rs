@@ -1,5 +1,7 @@
 //! The analytic test beds (SPEC §3), each with its exact or stored reference.
 
+pub mod checker;
+pub mod checker_reference;
 pub mod gradient_plane;
 pub mod phong_lobe;
 pub mod pinhole;

@@ -2,6 +2,7 @@
 //! paper's claims, which are judged against what the run measured.
 
 pub mod claims;
+pub mod pmc_hi;
 pub mod surface_smc;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};
@@ -26,7 +27,7 @@ pub struct ExperimentDef {
 }
 
 /// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF];
+pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF, &pmc_hi::DEF];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {
