@@ -24,7 +24,7 @@ pub static DEF: ExperimentDef = ExperimentDef {
 fn sweep(mode: Mode) -> Sweep {
     let (estimators, _) = available(IDS);
     let (res, budgets, reps) = match mode {
-        Mode::Quick => (16.0, vec![16, 32, 64], 16),
+        Mode::Quick => (24.0, vec![16, 32, 64, 128], 64),
         Mode::Full => (48.0, vec![16, 32, 64, 128, 256], 32),
     };
     let bed = |v: &str| TestBedSpec {
