@@ -19,6 +19,8 @@ pub mod independent;
 pub mod lighting;
 pub mod math;
 pub mod params;
+pub mod perception;
+pub mod pmc;
 pub mod quadrature;
 pub mod registry;
 pub mod rng;

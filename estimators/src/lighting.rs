@@ -32,3 +32,38 @@ impl Gradient {
         }
     }
 }
+
+/// A rectangular area light facing down (emitting towards `-z`), axis-aligned in `x` and `y`:
+/// `[x0, x1] x [y0, y1]` at height `z` with constant radiance (paper 003 Fig. 6, SPEC §3.5).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RectLight {
+    /// Lower corner `(x0, y0)`.
+    pub min: [f64; 2],
+    /// Upper corner `(x1, y1)`.
+    pub max: [f64; 2],
+    /// Height of the light's plane.
+    pub z: f64,
+    /// Emitted radiance (towards `-z` only).
+    pub radiance: Rgb,
+}
+
+impl RectLight {
+    /// A `wx x wy` light centred at `(cx, cy, z)`.
+    pub fn centred(cx: f64, cy: f64, z: f64, wx: f64, wy: f64, radiance: Rgb) -> RectLight {
+        RectLight { min: [cx - 0.5 * wx, cy - 0.5 * wy], max: [cx + 0.5 * wx, cy + 0.5 * wy], z, radiance }
+    }
+    /// Area.
+    pub fn area(&self) -> f64 {
+        (self.max[0] - self.min[0]) * (self.max[1] - self.min[1])
+    }
+    /// Ray parameter `t` where the ray `p + t w` (unit `w`) crosses the light's rectangle from
+    /// below, if it does (`p.z < z`).
+    pub fn hit(&self, p: Vec3, w: Vec3) -> Option<f64> {
+        if w.z <= 0.0 || p.z >= self.z {
+            return None;
+        }
+        let t = (self.z - p.z) / w.z;
+        let (x, y) = (p.x + t * w.x, p.y + t * w.y);
+        (self.min[0] <= x && x <= self.max[0] && self.min[1] <= y && y <= self.max[1]).then_some(t)
+    }
+}

@@ -61,11 +61,17 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::smc::smc_bridge::ENTRY,
     &crate::smc::smc_path::ENTRY,
     &crate::smc::smc_adaptive::ENTRY,
+    &crate::pmc::mis::ENTRY,
+    &crate::pmc::hi::ENTRY,
+    &crate::pmc::hi::FEEDBACK,
 ];
 
 /// Every registered test bed.
-pub static TESTBEDS: &[&TestBedEntry] =
-    &[&crate::testbeds::gradient_plane::ENTRY, &crate::testbeds::envmap_sequence::ENTRY];
+pub static TESTBEDS: &[&TestBedEntry] = &[
+    &crate::testbeds::gradient_plane::ENTRY,
+    &crate::testbeds::envmap_sequence::ENTRY,
+    &crate::testbeds::checker::ENTRY,
+];
 
 /// Looks an estimator up by id.
 pub fn estimator(id: &str) -> Result<&'static EstimatorEntry, ConfigError> {

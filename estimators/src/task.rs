@@ -114,6 +114,11 @@ impl HemisphereProbe<'_> {
     pub fn point(&self) -> &ShadingPoint {
         &self.point
     }
+    /// The scene's area lights (geometry only, free); sample them, then evaluate the sampled
+    /// direction with [`HemisphereProbe::integrand`], which counts it.
+    pub fn lights(&self) -> &[crate::lighting::RectLight] {
+        self.scene.lights()
+    }
     /// The integrand `L_in(w_i) f(w_i, w_o) cos(theta_i)`: one sample and one ray. Zero below the
     /// horizon (still one sample: the estimator drew it).
     pub fn integrand(&self, wi: Vec3) -> Rgb {

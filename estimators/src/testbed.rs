@@ -114,6 +114,13 @@ pub trait HemisphereScene: Send + Sync {
     fn shading(&self, i: usize) -> ShadingPoint;
     /// Radiance arriving at the shading point of integral `i` from direction `wi` (one ray).
     fn incident(&self, i: usize, wi: Vec3) -> Rgb;
+    /// The area lights estimators may sample (paper 003's light components). Their geometry is
+    /// known to the estimator for free; what they contribute is only learnt through the counted
+    /// integrand, so a light sample costs one sample and one ray like a BRDF sample. Empty by
+    /// default (scenes without emitters, or lit by a background).
+    fn lights(&self) -> &[crate::lighting::RectLight] {
+        &[]
+    }
 }
 
 /// A test bed (SPEC §2). Integrals are pixels in row-major order, `i = py * width + px`.

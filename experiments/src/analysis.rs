@@ -360,6 +360,8 @@ mod tests {
             cheap_fetches: 0.0,
             seconds_median: seconds,
             efficiency_mse: None,
+            p_err: 0.0,
+            p_eff: None,
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {

@@ -56,10 +56,18 @@ pub struct SummaryRow {
     pub seconds_median: f64,
     /// 1 / (MSE x seconds) (timing).
     pub efficiency_mse: Option<f64>,
+    /// Paper 003's perceptual error `Err` = mean over integrals of `MSE / tvi(L_ref)` (channel-mean
+    /// MSE; reference luminance).
+    #[serde(default)]
+    pub p_err: f64,
+    /// Paper 003's `P-Eff = 1 / (T Err)` with `T` the single-thread seconds of a whole image
+    /// (seconds per estimate x integrals) (timing).
+    #[serde(default)]
+    pub p_eff: Option<f64>,
 }
 
 /// Column names whose values depend on the wall clock (excluded from determinism checks).
-pub const TIMING_COLUMNS: &[&str] = &["seconds", "efficiency", "seconds_median", "efficiency_mse"];
+pub const TIMING_COLUMNS: &[&str] = &["seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff"];
 
 fn inverse(x: f64) -> Option<f64> {
     (x > 0.0 && x.is_finite()).then(|| 1.0 / x)
@@ -77,7 +85,10 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         NeumaierSum::new(),
     );
     let mut rel_n = 0usize;
+    let mut p_err = NeumaierSum::new();
     for (i, m) in cell.moments.iter().enumerate() {
+        let tvi = estimators::perception::tvi(estimators::perception::luminance(reference.value[i]));
+        let mut e2_mean = 0.0;
         for (c, mc) in m.iter().enumerate() {
             let (r, rse2) = (reference.value[i][c], reference.std_err[i][c].powi(2));
             let sample_var = mc.variance();
@@ -85,6 +96,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
             // Mean over repetitions of (x - R)^2, minus the reference's own variance.
             let e2 = d * d + sample_var * (reps - 1.0) / reps - rse2;
             mse.add(e2);
+            e2_mean += e2 / 3.0;
             var.add(sample_var);
             bias.add(d);
             bias_var.add(sample_var / reps + rse2);
@@ -94,6 +106,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
                 rel_n += 1;
             }
         }
+        p_err.add(e2_mean / tvi);
     }
     let m = (cell.moments.len() * 3) as f64;
     let per = |x: u64| x as f64 / cell.estimates.max(1) as f64;
@@ -125,5 +138,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         cheap_fetches: per(cell.costs.cheap_fetches),
         seconds_median: cell.time.median(),
         efficiency_mse: inverse(mse_v * seconds),
+        p_err: p_err.value() / cell.moments.len().max(1) as f64,
+        p_eff: inverse(seconds * cell.moments.len() as f64 * p_err.value() / cell.moments.len().max(1) as f64),
     }
 }

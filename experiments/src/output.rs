@@ -184,6 +184,8 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "cheap_fetches",
     "seconds_median",
     "efficiency_mse",
+    "p_err",
+    "p_eff",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).

@@ -3,8 +3,11 @@
 //! Every sampler here has a chi-square goodness-of-fit test beside it (SPEC §6), built on
 //! [`testing::assert_sampler_fits`].
 
+pub mod cone;
 pub mod cosine_hemisphere;
+pub mod mixture;
 pub mod phong_lobe;
+pub mod rect_light;
 pub mod testing;
 pub mod uniform_hemisphere;
 

@@ -1,5 +1,7 @@
 //! The analytic test beds (SPEC §3), each with its exact or stored reference.
 
+pub mod checker;
+pub mod checker_reference;
 pub mod envmap_reference;
 pub mod envmap_sequence;
 pub mod gradient_plane;

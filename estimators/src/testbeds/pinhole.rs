@@ -24,8 +24,13 @@ impl Pinhole {
     /// Unit direction through the centre of pixel `(px, py)` of a `size x size` image (row 0 at
     /// the top).
     pub fn pixel_direction(&self, px: usize, py: usize, size: usize) -> Vec3 {
-        let x = (2.0 * (px as f64 + 0.5) / size as f64 - 1.0) * self.tan_half_fov;
-        let y = (1.0 - 2.0 * (py as f64 + 0.5) / size as f64) * self.tan_half_fov;
+        self.image_direction(px as f64 + 0.5, py as f64 + 0.5, size)
+    }
+    /// Unit direction through image position `(sx, sy)` in `[0, size)^2` (pixel `(px, py)` covers
+    /// `[px, px + 1) x [py, py + 1)`; row 0 at the top).
+    pub fn image_direction(&self, sx: f64, sy: f64, size: usize) -> Vec3 {
+        let x = (2.0 * sx / size as f64 - 1.0) * self.tan_half_fov;
+        let y = (1.0 - 2.0 * sy / size as f64) * self.tan_half_fov;
         (self.forward + self.right * x + self.up * y).normalize()
     }
 }

@@ -29,6 +29,8 @@ fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
         cheap_fetches: 0.0,
         seconds_median: seconds,
         efficiency_mse: Some(1.0 / (rmse * rmse * seconds)),
+        p_err: 0.0,
+        p_eff: None,
     }
 }
 

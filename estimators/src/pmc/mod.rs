@@ -1,0 +1,9 @@
+//! Population Monte Carlo for rendering (paper 003): the `mis` baseline, PMC-HI (§5) with its
+//! feedback variant (§6.1), and the image-plane samplers (§4).
+
+pub mod hi;
+pub mod kernel;
+pub mod mis;
+
+#[cfg(test)]
+mod tests;

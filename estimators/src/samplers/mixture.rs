@@ -1,0 +1,124 @@
+//! Deterministic mixture sampling (paper 003 §4.3, after Hesterberg 1995): for `N` draws from a
+//! mixture with weights `alpha_k`, component `k` gets `floor(N alpha_k)` draws and the
+//! `R = N - sum_k floor(N alpha_k)` remaining draws are taken i.i.d. from the residual
+//! distribution `(N alpha_k - floor(N alpha_k)) / R`. Then `E[n_k] = N alpha_k` exactly, so
+//! weighting every sample by `f / K` with the full mixture `K = sum_k alpha_k h_k` (paper 003
+//! Eq. 8) stays unbiased, with less variance than drawing components at random.
+
+use rand::Rng;
+
+/// Draws per component for `n` samples with weights `alphas` (non-negative, summing to 1 up to
+/// rounding). Components with `alpha_k = 0` never get a draw.
+pub fn dms_counts<R: Rng + ?Sized>(alphas: &[f64], n: usize, rng: &mut R) -> Vec<usize> {
+    let total: f64 = alphas.iter().sum();
+    let mut counts = Vec::with_capacity(alphas.len());
+    let mut residual = Vec::with_capacity(alphas.len());
+    for &a in alphas {
+        let target = n as f64 * a / total;
+        let base = target.floor();
+        counts.push(base as usize);
+        residual.push(target - base);
+    }
+    let assigned: usize = counts.iter().sum();
+    let rest = n.saturating_sub(assigned);
+    let rsum: f64 = residual.iter().sum();
+    for _ in 0..rest {
+        // Rounding can leave rsum = 0 with draws to place: fall back to the weights themselves.
+        let weights = if rsum > 0.0 { &residual } else { &alphas.to_vec() };
+        counts[pick(weights, rng)] += 1;
+    }
+    counts
+}
+
+/// Index drawn with probability proportional to `weights` (at least one positive).
+pub fn pick<R: Rng + ?Sized>(weights: &[f64], rng: &mut R) -> usize {
+    let total: f64 = weights.iter().sum();
+    let mut u = rng.gen::<f64>() * total;
+    let mut last = 0;
+    for (k, &w) in weights.iter().enumerate() {
+        if w > 0.0 {
+            if u < w {
+                return k;
+            }
+            u -= w;
+            last = k;
+        }
+    }
+    last
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{Frame, Vec3};
+    use crate::rng::stream;
+    use crate::samplers::testing::{assert_sampler_fits, SphereGrid};
+    use crate::samplers::{cone, cosine_hemisphere, phong_lobe};
+
+    #[test]
+    fn counts_are_floor_plus_residual_with_the_right_means() {
+        let alphas = [0.37, 0.05, 0.5, 0.08];
+        let mut rng = stream(3, "dms");
+        let n = 8;
+        let reps = 40_000;
+        let mut sums = [0.0f64; 4];
+        for _ in 0..reps {
+            let c = dms_counts(&alphas, n, &mut rng);
+            assert_eq!(c.iter().sum::<usize>(), n);
+            for k in 0..4 {
+                let t = n as f64 * alphas[k];
+                assert!(c[k] as f64 >= t.floor() && (c[k] as f64) <= t.floor() + (n - 5) as f64, "{c:?}");
+                sums[k] += c[k] as f64;
+            }
+        }
+        for k in 0..4 {
+            // Extra draws are Binomial(3, p_k): standard error of the mean below 0.01.
+            let mean = sums[k] / reps as f64;
+            assert!((mean - n as f64 * alphas[k]).abs() < 0.04, "component {k}: mean {mean}");
+        }
+        assert_eq!(dms_counts(&[0.0, 1.0, 0.0], 5, &mut rng), vec![0, 5, 0]);
+    }
+
+    /// Pooled DMS draws from a cosine + Phong lobe + cone mixture follow the full-mixture pdf.
+    #[test]
+    fn chi_square_mixture_with_deterministic_allocation() {
+        let alphas = [0.3, 0.45, 0.25];
+        let lobe_axis = Vec3::new(0.3, -0.2, 0.9).normalize();
+        // The cone about +z so its edge is a cell edge (the pdf is discontinuous there).
+        let cone_axis = Vec3::Z;
+        let cos_max = 0.25f64.cos();
+        let (lobe, cf) = (Frame::around(lobe_axis), Frame::around(cone_axis));
+        let pdf = move |d: Vec3| {
+            alphas[0] * cosine_hemisphere::pdf(d.z)
+                + alphas[1] * phong_lobe::pdf(lobe_axis.dot(d), 30.0)
+                + alphas[2] * cone::pdf(cone_axis.dot(d), cos_max)
+        };
+        let mut queue: Vec<Vec3> = Vec::new();
+        let mut edges: Vec<f64> = (0..=24).map(|k| -1.0 + 2.0 * k as f64 / 24.0).collect();
+        edges.push(cos_max);
+        edges.sort_by(f64::total_cmp);
+        let grid = SphereGrid::with_cos_edges(edges, 24);
+        assert_sampler_fits(
+            "DMS mixture",
+            &grid,
+            160_000,
+            41,
+            |r| {
+                if queue.is_empty() {
+                    let c = dms_counts(&alphas, 7, r);
+                    for _ in 0..c[0] {
+                        queue.push(cosine_hemisphere::sample_local(r));
+                    }
+                    for _ in 0..c[1] {
+                        queue.push(lobe.to_world(phong_lobe::sample_local(30.0, r)));
+                    }
+                    for _ in 0..c[2] {
+                        queue.push(cf.to_world(cone::sample_local(cos_max, r)));
+                    }
+                }
+                queue.pop().unwrap_or(Vec3::Z)
+            },
+            pdf,
+        );
+    }
+}

@@ -1,0 +1,208 @@
+//! `checker-direct` (paper 003 Fig. 6-8, Table 2; SPEC §3.5): an 8 x 8 checkerboard floor of
+//! diffuse and modified-Phong squares under two rectangular area lights, seen by a pinhole camera;
+//! one direct-lighting integral `int L_in f cos dw` per pixel (Eq. 4-5 without emission), with a
+//! quadrature reference (see [`super::checker_reference`]).
+//!
+//! Geometry (all fixed, grey so the three channels are equal):
+//! - floor `z = 0` over `[-2, 2]^2`, squares of side 0.5; square `(ix, iy)` is diffuse (kd 0.7)
+//!   when `ix + iy` is even, else glossy (kd 0.05, ks 0.8) with `n = 10 * 500^(iy / 7)`, growing
+//!   geometrically from 10 in the front row (`y` near -2) to 5000 in the back row; points off the
+//!   board are black (their integrand is zero: the "zero pixel" stability case);
+//! - a large dim light, 2 x 1 centred at (-1.0, 1.8) at height 2.0, radiance 3, and a small bright
+//!   one, 0.15 x 0.15 centred at (1.0, 0.9) at height 1.2, radiance 400, both facing down; the
+//!   small light can never hide the large one from the board (checked by a test), so each light's
+//!   contribution is an integral over its own rectangle;
+//! - variant `occluded`: an opaque 1 x 1 square centred at (0.5, 0.2) at height 0.6 casting
+//!   partial shadows; it is a shadow caster only (primary rays see the floor), so both variants
+//!   shade the same points;
+//! - pinhole at (0, -3.2, 4.6) looking at (0, 0.1, 0), vertical field of view 44 degrees, square
+//!   image (default 48 x 48), pixel centres; the top rows see past the board.
+
+use super::checker_reference::reference;
+use super::pinhole::Pinhole;
+use crate::brdf::Phong;
+use crate::error::ConfigError;
+use crate::lighting::RectLight;
+use crate::math::{Rgb, Vec3};
+use crate::params::Params;
+use crate::registry::TestBedEntry;
+use crate::testbed::{HemisphereScene, Needs, Reference, ShadingPoint, TestBed};
+
+/// Registry entry.
+pub static ENTRY: TestBedEntry = TestBedEntry {
+    id: "checker-direct",
+    variants: &["default", "occluded"],
+    provides: Needs::SURFACE.and(Needs::AREA_LIGHTS),
+    summary:
+        "checkerboard of diffuse/glossy squares under two area lights, direct lighting (paper 003 Fig. 6, Table 2)",
+    build: |variant, params| Ok(Box::new(CheckerDirect::new(variant, params)?)),
+};
+
+/// The axis-aligned opaque square of the `occluded` variant: `[x0, x1] x [y0, y1]` at height `z`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Occluder {
+    /// Lower corner.
+    pub min: [f64; 2],
+    /// Upper corner.
+    pub max: [f64; 2],
+    /// Height.
+    pub z: f64,
+}
+
+impl Occluder {
+    /// True when the ray `p + t w` crosses the square (from below, `p.z < z`).
+    pub fn blocks(&self, p: Vec3, w: Vec3) -> bool {
+        if w.z <= 0.0 || p.z >= self.z {
+            return false;
+        }
+        let t = (self.z - p.z) / w.z;
+        let (x, y) = (p.x + t * w.x, p.y + t * w.y);
+        self.min[0] <= x && x <= self.max[0] && self.min[1] <= y && y <= self.max[1]
+    }
+}
+
+/// The static geometry of the checker scene (shared with `checker-image`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CheckerGeometry {
+    /// The two lights (large dim first).
+    pub lights: Vec<RectLight>,
+    /// The occluder of the `occluded` variant.
+    pub occluder: Option<Occluder>,
+    /// The camera.
+    pub camera: Pinhole,
+}
+
+impl CheckerGeometry {
+    /// The geometry of a variant (`default` or `occluded`).
+    pub fn new(variant: &str) -> Result<Self, ConfigError> {
+        let occluder = match variant {
+            "default" => None,
+            "occluded" => Some(Occluder { min: [0.0, -0.3], max: [1.0, 0.7], z: 0.6 }),
+            _ => {
+                return Err(ConfigError::unknown(
+                    "variant",
+                    &format!("checker/{variant}"),
+                    ENTRY.variants.iter().copied(),
+                ))
+            }
+        };
+        let lights = vec![
+            RectLight::centred(-1.0, 1.8, 2.0, 2.0, 1.0, Rgb::splat(3.0)),
+            RectLight::centred(1.0, 0.9, 1.2, 0.15, 0.15, Rgb::splat(400.0)),
+        ];
+        let camera = Pinhole::look_at(Vec3::new(0.0, -3.2, 4.6), Vec3::new(0.0, 0.1, 0.0), Vec3::Z, 44.0);
+        Ok(CheckerGeometry { lights, occluder, camera })
+    }
+
+    /// The material at a floor point (black off the board).
+    pub fn material(x: f64, y: f64) -> Phong {
+        if !(-2.0..=2.0).contains(&x) || !(-2.0..=2.0).contains(&y) {
+            return Phong { kd: Rgb::ZERO, ks: Rgb::ZERO, n: 1.0 };
+        }
+        let ix = (((x + 2.0) / 0.5) as usize).min(7);
+        let iy = (((y + 2.0) / 0.5) as usize).min(7);
+        if (ix + iy) & 1 == 0 {
+            Phong { kd: Rgb::splat(0.7), ks: Rgb::ZERO, n: 1.0 }
+        } else {
+            Phong { kd: Rgb::splat(0.05), ks: Rgb::splat(0.8), n: 10.0 * 500f64.powf(iy as f64 / 7.0) }
+        }
+    }
+
+    /// The floor point seen through image position `(sx, sy)` in `[0, size)^2` (pixel `(px, py)`
+    /// covers `[px, px + 1) x [py, py + 1)`), or `None` when the ray misses the floor.
+    pub fn shade(&self, sx: f64, sy: f64, size: usize) -> Option<ShadingPoint> {
+        let d = self.camera.image_direction(sx, sy, size);
+        if d.z >= 0.0 {
+            return None;
+        }
+        let t = -self.camera.eye.z / d.z;
+        let p = self.camera.eye + d * t;
+        Some(ShadingPoint { position: p, normal: Vec3::Z, wo: -d, brdf: Self::material(p.x, p.y) })
+    }
+
+    /// Radiance arriving at floor point `p` from `w`: the nearest light hit unless the occluder
+    /// is crossed first (it lies below both lights).
+    pub fn incident(&self, p: Vec3, w: Vec3) -> Rgb {
+        if self.occluder.is_some_and(|o| o.blocks(p, w)) {
+            return Rgb::ZERO;
+        }
+        let mut best: Option<(f64, Rgb)> = None;
+        for l in &self.lights {
+            if let Some(t) = l.hit(p, w) {
+                if !matches!(best, Some((bt, _)) if bt <= t) {
+                    best = Some((t, l.radiance));
+                }
+            }
+        }
+        best.map_or(Rgb::ZERO, |(_, r)| r)
+    }
+}
+
+/// The `checker-direct` scene.
+pub struct CheckerDirect {
+    variant: String,
+    size: usize,
+    geometry: CheckerGeometry,
+    points: Vec<ShadingPoint>,
+    reference: Reference,
+}
+
+impl CheckerDirect {
+    /// Builds a variant; parameter `resolution` (default 48) sets the square image size.
+    pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+        params.reject_unknown("checker-direct", &["resolution"])?;
+        let size = params.count("resolution", 48, 512)?;
+        let geometry = CheckerGeometry::new(variant)?;
+        let mut points = Vec::with_capacity(size * size);
+        for py in 0..size {
+            for px in 0..size {
+                let p = geometry.shade(px as f64 + 0.5, py as f64 + 0.5, size);
+                // Every pixel centre sees the floor with this camera (a test checks it).
+                points.push(p.ok_or_else(|| ConfigError::invalid("resolution", size, "a pixel misses the floor"))?);
+            }
+        }
+        let reference = reference(&geometry, &points);
+        Ok(CheckerDirect { variant: variant.to_string(), size, geometry, points, reference })
+    }
+    /// The geometry.
+    pub fn geometry(&self) -> &CheckerGeometry {
+        &self.geometry
+    }
+}
+
+impl TestBed for CheckerDirect {
+    fn id(&self) -> &'static str {
+        ENTRY.id
+    }
+    fn variant(&self) -> &str {
+        &self.variant
+    }
+    fn provides(&self) -> Needs {
+        ENTRY.provides
+    }
+    fn resolution(&self) -> (usize, usize) {
+        (self.size, self.size)
+    }
+    fn reference(&self) -> &Reference {
+        &self.reference
+    }
+    fn geometry(&self, i: usize) -> Vec<(&'static str, f64)> {
+        let p = &self.points[i];
+        vec![("hit_x", p.position.x), ("hit_y", p.position.y), ("phong_n", p.brdf.n), ("ks", p.brdf.ks[0])]
+    }
+    fn hemisphere(&self) -> Option<&dyn HemisphereScene> {
+        Some(self)
+    }
+}
+
+impl HemisphereScene for CheckerDirect {
+    fn shading(&self, i: usize) -> ShadingPoint {
+        self.points[i]
+    }
+    fn incident(&self, i: usize, wi: Vec3) -> Rgb {
+        self.geometry.incident(self.points[i].position, wi)
+    }
+    fn lights(&self) -> &[RectLight] {
+        &self.geometry.lights
+    }
+}

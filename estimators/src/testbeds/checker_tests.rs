@@ -1,0 +1,124 @@
+//! Tests of the checker scene and its quadrature reference.
+
+use super::*;
+use crate::params::Params;
+use crate::testbed::{HemisphereScene, TestBed};
+use crate::testbeds::checker::CheckerDirect;
+
+/// Independent brute force: a uniform grid of `nx x ny` cells per light, 10-point Gauss-Legendre
+/// per cell and axis, visibility by the scene's own ray cast at every node.
+fn brute(geo: &CheckerGeometry, p: &ShadingPoint, nx: usize, ny: usize) -> f64 {
+    let (x, w) = gauss_legendre(10);
+    let mut total = 0.0;
+    for light in &geo.lights {
+        let f = AreaIntegrand { p, light };
+        let (hx, hy) = ((light.max[0] - light.min[0]) / nx as f64, (light.max[1] - light.min[1]) / ny as f64);
+        for i in 0..nx {
+            for j in 0..ny {
+                let mut s = 0.0;
+                for (xi, wi) in x.iter().zip(&w) {
+                    for (xj, wj) in x.iter().zip(&w) {
+                        let u = light.min[0] + hx * (i as f64 + 0.5 + 0.5 * xi);
+                        let v = light.min[1] + hy * (j as f64 + 0.5 + 0.5 * xj);
+                        let dir = (Vec3::new(u, v, light.z) - p.position).normalize();
+                        if geo.incident(p.position, dir)[0] > 0.0 {
+                            s += wi * wj * f.eval(u, v);
+                        }
+                    }
+                }
+                total += s * 0.25 * hx * hy;
+            }
+        }
+    }
+    total
+}
+
+/// Pixels of a 24 x 24 image: a diffuse one, glossy ones of low and high exponent, the
+/// reflections of both lights.
+fn probe_pixels(bed: &CheckerDirect) -> Vec<usize> {
+    let mut picks = Vec::new();
+    let mut best = [(0.0, 0usize); 3];
+    for i in 0..bed.integrals() {
+        let p = bed.shading(i);
+        let v = bed.reference().value[i][0];
+        let slot = if p.brdf.ks[0] == 0.0 {
+            0
+        } else if p.brdf.n < 100.0 {
+            1
+        } else {
+            2
+        };
+        if v > best[slot].0 {
+            best[slot] = (v, i);
+        }
+    }
+    picks.extend(best.iter().map(|b| b.1));
+    picks
+}
+
+#[test]
+fn unoccluded_reference_is_within_its_bound_and_1e_9_relative() {
+    let bed = CheckerDirect::new("default", &Params::new().with("resolution", 24.0)).unwrap();
+    let geo = bed.geometry();
+    let crate::testbed::ReferenceKind::Exact { bound, .. } = bed.reference().kind.clone() else { panic!() };
+    for i in probe_pixels(&bed) {
+        let p = bed.shading(i);
+        let r = bed.reference().value[i][0];
+        let (v, e, evals) = direct_lighting(geo, &p, REL_TOL);
+        let b = brute(geo, &p, 256, 128);
+        eprintln!(
+            "pixel {i} n {} value {r:.12e} brute {b:.12e} |diff| {:.2e} bound {e:.2e} ({evals} evaluations)",
+            p.brdf.n,
+            (r - b).abs()
+        );
+        assert_eq!(v, r);
+        assert!((r - b).abs() <= e.max(1e-13 * r), "pixel {i}: error {:e} above the bound {e:e}", (r - b).abs());
+        assert!(e <= 1e-9 * r && e <= bound, "pixel {i}: bound {e:e} vs value {r:e}");
+    }
+}
+
+#[test]
+fn occluded_reference_splits_exactly_at_shadow_edges() {
+    let bed = CheckerDirect::new("occluded", &Params::new().with("resolution", 24.0)).unwrap();
+    let free = CheckerDirect::new("default", &Params::new().with("resolution", 24.0)).unwrap();
+    let geo = bed.geometry();
+    // Pixels in the penumbra: occluded value strictly between 0 and the unoccluded value.
+    let mut penumbra: Vec<usize> = (0..bed.integrals())
+        .filter(|&i| {
+            let (a, b) = (bed.reference().value[i][0], free.reference().value[i][0]);
+            a > 0.05 * b && a < 0.95 * b
+        })
+        .collect();
+    assert!(penumbra.len() >= 5, "the occluder casts partial shadows ({} pixels)", penumbra.len());
+    penumbra.truncate(4);
+    for i in penumbra {
+        let p = bed.shading(i);
+        let r = bed.reference().value[i][0];
+        // The ray-cast brute force converges only at O(h) at the shadow edges.
+        let b = brute(geo, &p, 512, 256);
+        eprintln!("penumbra pixel {i}: quadrature {r:.9e}, ray-cast brute force {b:.9e}");
+        assert!((r - b).abs() <= 2e-3 * r, "pixel {i}: {r} vs {b}");
+    }
+}
+
+#[test]
+fn small_light_never_hides_the_large_one_and_every_pixel_sees_the_floor() {
+    let geo = CheckerGeometry::new("default").unwrap();
+    let (big, small) = (geo.lights[0], geo.lights[1]);
+    for a in 0..=20 {
+        for b in 0..=20 {
+            let x = Vec3::new(-2.0 + 0.2 * a as f64, -2.0 + 0.2 * b as f64, 0.0);
+            for u in 0..=4 {
+                for v in 0..=4 {
+                    let y = Vec3::new(big.min[0] + 0.5 * u as f64, big.min[1] + 0.25 * v as f64, big.z);
+                    assert!(small.hit(x, (y - x).normalize()).is_none());
+                }
+            }
+        }
+    }
+    let bed = CheckerDirect::new("default", &Params::new().with("resolution", 16.0)).unwrap();
+    assert_eq!(bed.integrals(), 256);
+    // Some pixels see past the board (zero integrand), most see it.
+    let zeros = bed.reference().value.iter().filter(|v| v[0] == 0.0).count();
+    assert!(zeros > 0 && zeros < 128, "{zeros}");
+}
