@@ -118,3 +118,31 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
         note: "smallest Holm-adjusted p-value of the per-integral t-tests".into(),
     }
 }
+
+/// A claim about the mean of an estimator diagnostic at one budget (e.g. paper 001 Table 1's cell
+/// count and memory): held when ours is within `rel_tol` of the paper's number. `at` is
+/// (estimator, budget, diagnostic name).
+pub fn diagnostic_claim(
+    report: &RunReport,
+    tb: (&str, &str),
+    at: (&str, u64, &str),
+    paper: f64,
+    rel_tol: f64,
+    claim: &str,
+) -> Claim {
+    let (estimator, budget, name) = at;
+    let d = report.diagnostics.iter().find(|d| {
+        d.testbed == tb.0 && d.variant == tb.1 && d.estimator == estimator && d.budget == budget && d.name == name
+    });
+    match d {
+        None => not_measured(tb.0, claim, paper, format!("no `{name}` diagnostic of {estimator} at budget {budget}")),
+        Some(d) => Claim {
+            testbed: format!("{}/{}", tb.0, tb.1),
+            claim: claim.into(),
+            paper_value: Some(paper),
+            our_value: Some(d.mean),
+            held: Some((d.mean - paper).abs() <= rel_tol * paper.abs()),
+            note: format!("mean `{name}` per estimate at {budget} spp; held if within {:.0}%", rel_tol * 100.0),
+        },
+    }
+}

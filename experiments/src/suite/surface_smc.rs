@@ -81,6 +81,22 @@ fn claims(r: &RunReport) -> Vec<Claim> {
             77.0,
             "paper 001 §5: is1_cv2 is 77x faster than independent MC at equal time (138x samples, 1.79x overhead)",
         ),
+        claims::diagnostic_claim(
+            r,
+            tb,
+            ("is1_cv2", 1024, "cells"),
+            256.0,
+            0.1,
+            "paper 001 Table 1: criterion 8 gives 256 cells (depth 4) at 1024 spp",
+        ),
+        claims::diagnostic_claim(
+            r,
+            tb,
+            ("is1_cv2", 1024, "cell_bytes"),
+            9216.0,
+            0.1,
+            "paper 001 Table 1: 9 KB of cell storage in doubles at 1024 spp",
+        ),
         claims::control_flagged(r, "clamped_is0_cv0"),
     ]
 }
