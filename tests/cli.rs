@@ -37,21 +37,25 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
     assert_bad_input(d, &["frobnicate"], "frobnicate");
     assert_bad_input(d, &["reference", "gradient-plane", "--variant", "shiny"], "gradient-plane/shiny");
     assert_bad_input(d, &["plot", "nowhere"], "nowhere");
-    let cases = [
-        ("malformed.toml", "name = 'x'\nreps = [", "malformed.toml"),
-        ("unknown_field.toml", "name = 'x'\nrep = 3\n", "rep"),
-        ("bad_reps.toml", SMALL.replace("reps = 3", "reps = 0").as_str(), "reps"),
-        ("bad_budget.toml", SMALL.replace("[4, 16, 64]", "[4, 0]").as_str(), "budget"),
-        ("bad_param.toml", SMALL.replace("clamp = 1.5", "clamp = -1.0").as_str(), "clamp"),
-        ("typo_param.toml", SMALL.replace("clamp = 1.5", "clmap = 1.5").as_str(), "clmap"),
-        ("bad_estimator.toml", SMALL.replace("'is0_cv0'", "'is9_cv9'").as_str(), "is9_cv9"),
-        ("bad_testbed.json", r#"{"name":"x","budgets":[4],"testbeds":[{"id":"nope"}],"estimators":[{"id":"is0_cv0"}]}"#, "nope"),
-        ("bad_kind.toml", "name='x'\nbudget_kind='parsecs'\n", "parsecs"),
-        ("notes.txt", "name = 'x'", ".toml or .json"),
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("malformed.toml", "name = 'x'\nreps = [".to_string(), "malformed.toml"),
+        ("unknown_field.toml", "name = 'x'\nrep = 3\n".to_string(), "rep"),
+        ("bad_reps.toml", SMALL.replace("reps = 3", "reps = 0"), "reps"),
+        ("bad_budget.toml", SMALL.replace("[4, 16, 64]", "[4, 0]"), "budget"),
+        ("bad_param.toml", SMALL.replace("clamp = 1.5", "clamp = -1.0"), "clamp"),
+        ("typo_param.toml", SMALL.replace("clamp = 1.5", "clmap = 1.5"), "clmap"),
+        ("bad_estimator.toml", SMALL.replace("'is0_cv0'", "'is9_cv9'"), "is9_cv9"),
+        (
+            "bad_testbed.json",
+            r#"{"name":"x","budgets":[4],"testbeds":[{"id":"nope"}],"estimators":[{"id":"is0_cv0"}]}"#.to_string(),
+            "nope",
+        ),
+        ("bad_kind.toml", "name='x'\nbudget_kind='parsecs'\n".to_string(), "parsecs"),
+        ("notes.txt", "name = 'x'".to_string(), ".toml or .json"),
     ];
     for (name, text, needle) in cases {
         let path = d.join(name);
-        std::fs::write(&path, text).expect("write config");
+        std::fs::write(&path, &text).expect("write config");
         assert_bad_input(d, &["run", "--config", path.to_str().expect("utf8")], needle);
     }
     assert_bad_input(d, &["run", "--config", "missing.toml"], "missing.toml");
@@ -75,7 +79,9 @@ fn a_custom_sweep_runs_end_to_end_and_plots_can_be_redrawn() {
     std::fs::write(d.join("tiny.toml"), SMALL).expect("write");
     let o = mcbench(d, &["run", "--config", "tiny.toml", "--threads", "2"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    for f in ["results/tiny/summary.csv", "results/tiny/integrals.csv", "results/tiny/summary.json", "plots/tiny/report.md"] {
+    for f in
+        ["results/tiny/summary.csv", "results/tiny/integrals.csv", "results/tiny/summary.json", "plots/tiny/report.md"]
+    {
         assert!(d.join(f).is_file(), "{f} missing");
     }
     assert!(String::from_utf8_lossy(&o.stdout).contains("clamped_is0_cv0[clamp=1.5]"));

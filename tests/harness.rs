@@ -2,17 +2,21 @@
 //! temp dir, the result files, determinism across thread counts, resume, and the unbiasedness
 //! test's teeth.
 
+use estimators::params::Params;
 use experiments::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use experiments::execute::{execute, prepare, ExecOptions};
 use experiments::metrics::TIMING_COLUMNS;
 use experiments::runner::Silent;
-use estimators::params::Params;
 use std::path::Path;
 
 fn sweep(ids: &[&str], reps: usize) -> Sweep {
     Sweep {
         experiment: "itest".into(),
-        testbeds: vec![TestBedSpec { id: "gradient-plane".into(), variant: Some("default".into()), params: Params::new().with("resolution", 6.0) }],
+        testbeds: vec![TestBedSpec {
+            id: "gradient-plane".into(),
+            variant: Some("default".into()),
+            params: Params::new().with("resolution", 6.0),
+        }],
         estimators: ids.iter().map(|id| EstimatorSpec::new(id)).collect(),
         budgets: powers_of_four(1..=4),
         reps,
@@ -24,7 +28,13 @@ fn sweep(ids: &[&str], reps: usize) -> Sweep {
 
 fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> experiments::execute::Outcome {
     let plan = prepare(sweep).expect("valid sweep");
-    let opts = ExecOptions { results_root: dir.join("results"), plots_root: dir.join("plots"), threads: Some(threads), observer: &Silent, plots };
+    let opts = ExecOptions {
+        results_root: dir.join("results"),
+        plots_root: dir.join("plots"),
+        threads: Some(threads),
+        observer: &Silent,
+        plots,
+    };
     execute(&plan, None, &opts).expect("run succeeds")
 }
 
@@ -50,15 +60,19 @@ fn writes_the_contract_files_with_the_contract_columns() {
     for f in ["summary.csv", "integrals.csv", "summary.json"] {
         assert!(res.join(f).is_file(), "{f} missing");
     }
-    let header = std::fs::read_to_string(res.join("summary.csv")).expect("read").lines().next().unwrap_or_default().to_string();
+    let header =
+        std::fs::read_to_string(res.join("summary.csv")).expect("read").lines().next().unwrap_or_default().to_string();
     let contract = "testbed,variant,estimator,budget_kind,budget,reps,integrals,rmse,mse,variance,bias,bias_se,samples,fetches,rays,seconds,efficiency,fom";
     assert!(header.starts_with(contract), "{header}");
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(res.join("summary.json")).expect("read")).expect("json");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(res.join("summary.json")).expect("read")).expect("json");
     for k in ["meta", "fits", "tests", "paper"] {
         assert!(json.get(k).is_some(), "summary.json lacks {k}");
     }
     let integrals = std::fs::read_to_string(res.join("integrals.csv")).expect("read");
-    assert!(integrals.starts_with("testbed,variant,estimator,integral,px,py,channel,reference,reference_se,mean,std_err"));
+    assert!(
+        integrals.starts_with("testbed,variant,estimator,integral,px,py,channel,reference,reference_se,mean,std_err")
+    );
     // 3 estimators x 36 pixels x 3 channels at the largest budget.
     assert_eq!(integrals.lines().count(), 1 + 3 * 36 * 3);
     assert_eq!(out.report.rows.len(), 3 * 4);
@@ -73,7 +87,10 @@ fn same_seed_same_results_whatever_the_thread_count() {
     let b = tempfile::tempdir().expect("tempdir");
     run_into(a.path(), sweep(&["is0_cv0", "brdf_is0_cv0"], 3), 1, false);
     run_into(b.path(), sweep(&["is0_cv0", "brdf_is0_cv0"], 3), 2, false);
-    let (x, y) = (deterministic_csv(&a.path().join("results/itest/summary.csv")), deterministic_csv(&b.path().join("results/itest/summary.csv")));
+    let (x, y) = (
+        deterministic_csv(&a.path().join("results/itest/summary.csv")),
+        deterministic_csv(&b.path().join("results/itest/summary.csv")),
+    );
     assert_eq!(x, y);
     let ia = std::fs::read(a.path().join("results/itest/integrals.csv")).expect("read");
     let ib = std::fs::read(b.path().join("results/itest/integrals.csv")).expect("read");
@@ -94,14 +111,19 @@ fn a_rerun_resumes_from_stored_cells() {
     let mut s = sweep(&["is0_cv0"], 3);
     s.seed = 43;
     run_into(dir.path(), s, 2, false);
-    assert_ne!(deterministic_csv(&dir.path().join("results/itest/summary.csv")), String::from_utf8_lossy(&first).to_string());
+    assert_ne!(
+        deterministic_csv(&dir.path().join("results/itest/summary.csv")),
+        String::from_utf8_lossy(&first).to_string()
+    );
 }
 
 #[test]
 fn unbiased_baselines_pass_and_the_biased_control_is_flagged() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = run_into(dir.path(), sweep(&["is0_cv0", "brdf_is0_cv0", "clamped_is0_cv0"], 16), 2, false);
-    let holm = |id: &str| out.report.tests.iter().find(|t| t.estimator == id && t.test == "holm_t").cloned().expect("test row");
+    let holm = |id: &str| {
+        out.report.tests.iter().find(|t| t.estimator == id && t.test == "holm_t").cloned().expect("test row")
+    };
     for id in ["is0_cv0", "brdf_is0_cv0"] {
         let t = holm(id);
         assert_eq!(t.verdict, "pass", "{id}: p = {}", t.p_value);
@@ -117,7 +139,13 @@ fn independent_mc_error_falls_as_the_inverse_square_root() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = run_into(dir.path(), sweep(&["is0_cv0"], 16), 2, false);
     let f = &out.report.fits[0];
-    assert!(f.slope_ci_low <= -0.5 && -0.5 <= f.slope_ci_high, "slope {} [{}, {}]", f.slope, f.slope_ci_low, f.slope_ci_high);
+    assert!(
+        f.slope_ci_low <= -0.5 && -0.5 <= f.slope_ci_high,
+        "slope {} [{}, {}]",
+        f.slope,
+        f.slope_ci_low,
+        f.slope_ci_high
+    );
 }
 
 #[test]

@@ -109,9 +109,14 @@ mod tests {
     fn mixture_sampler_matches_its_pdf() {
         let (brdf, wo) = glossy();
         let grid = SphereGrid::full(24, 16);
-        assert_sampler_fits("phong mixture", &grid, 400_000, 11, |rng| brdf.sample(wo, Vec3::Z, rng).w, |d| {
-            brdf.pdf(d, wo, Vec3::Z)
-        });
+        assert_sampler_fits(
+            "phong mixture",
+            &grid,
+            400_000,
+            11,
+            |rng| brdf.sample(wo, Vec3::Z, rng).w,
+            |d| brdf.pdf(d, wo, Vec3::Z),
+        );
     }
 
     #[test]

@@ -36,7 +36,11 @@ impl ConfigError {
     }
     /// Shorthand for [`ConfigError::UnknownName`] listing the valid names.
     pub fn unknown<'a>(kind: &'static str, name: &str, valid: impl IntoIterator<Item = &'a str>) -> Self {
-        ConfigError::UnknownName { kind, name: name.to_string(), valid: valid.into_iter().collect::<Vec<_>>().join(", ") }
+        ConfigError::UnknownName {
+            kind,
+            name: name.to_string(),
+            valid: valid.into_iter().collect::<Vec<_>>().join(", "),
+        }
     }
 }
 

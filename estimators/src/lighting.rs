@@ -20,12 +20,7 @@ pub struct Gradient {
 impl Gradient {
     /// The SPEC §3.1 coefficients: R (1.0, 1.0, 0.5), G (0.8, 1.2, 0.0), B (0.6, 1.5, -0.4).
     pub const fn papers() -> Gradient {
-        Gradient {
-            c0: Rgb([1.0, 0.8, 0.6]),
-            c1: Rgb([1.0, 1.2, 1.5]),
-            c2: Rgb([0.5, 0.0, -0.4]),
-            clamp: false,
-        }
+        Gradient { c0: Rgb([1.0, 0.8, 0.6]), c1: Rgb([1.0, 1.2, 1.5]), c2: Rgb([0.5, 0.0, -0.4]), clamp: false }
     }
     /// Radiance arriving from direction `w` (unit vector leaving the scene).
     pub fn eval(&self, w: Vec3) -> Rgb {

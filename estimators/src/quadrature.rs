@@ -128,12 +128,7 @@ impl<const N: usize> Ord for Panel<N> {
 }
 
 /// Applies the G7-K15 pair on `[a, b]` (15 evaluations).
-fn kronrod15<const N: usize>(
-    f: &mut impl FnMut(f64) -> [f64; N],
-    a: f64,
-    b: f64,
-    depth: usize,
-) -> Panel<N> {
+fn kronrod15<const N: usize>(f: &mut impl FnMut(f64) -> [f64; N], a: f64, b: f64, depth: usize) -> Panel<N> {
     let c = 0.5 * (a + b);
     let h = 0.5 * (b - a);
     let fc = f(c);
@@ -162,21 +157,8 @@ fn kronrod15<const N: usize>(
         value[i] = k[i] * h;
         error[i] = ((k[i] - g[i]) * h).abs() + ROUNDOFF * (abs[i] * h).abs();
     }
-    let key = error.iter().fold(0.0, |m: f64, &e| {
-        if m.is_nan() || e.is_nan() {
-            f64::NAN
-        } else {
-            m.max(e)
-        }
-    });
-    Panel {
-        a,
-        b,
-        depth,
-        value,
-        error,
-        key,
-    }
+    let key = error.iter().fold(0.0, |m: f64, &e| if m.is_nan() || e.is_nan() { f64::NAN } else { m.max(e) });
+    Panel { a, b, depth, value, error, key }
 }
 
 /// Compensated totals of values and errors over all panels.
@@ -193,12 +175,7 @@ fn totals<'a, const N: usize>(panels: impl Iterator<Item = &'a Panel<N>>) -> ([f
 }
 
 /// `Some(true)` when converged, `Some(false)` when not, `None` when something is not finite.
-fn converged<const N: usize>(
-    v: &[f64; N],
-    e: &[f64; N],
-    abs_tol: f64,
-    rel_tol: f64,
-) -> Option<bool> {
+fn converged<const N: usize>(v: &[f64; N], e: &[f64; N], abs_tol: f64, rel_tol: f64) -> Option<bool> {
     if v.iter().chain(e.iter()).any(|x| !x.is_finite()) {
         return None;
     }
@@ -267,11 +244,7 @@ pub fn gauss_kronrod_multi<const N: usize>(
         }
     }
     let (value, error) = totals(heap.iter().chain(done.iter()));
-    MultiQuadrature {
-        value,
-        error,
-        evaluations,
-    }
+    MultiQuadrature { value, error, evaluations }
 }
 
 /// Adaptive G7-K15 quadrature of `f` over `[a, b]` (see [`gauss_kronrod_multi`] for the rules).
@@ -287,11 +260,7 @@ pub fn gauss_kronrod(
     max_depth: usize,
 ) -> Quadrature {
     let q = gauss_kronrod_multi(|x| [f(x)], &[a, b], abs_tol, rel_tol, max_depth);
-    Quadrature {
-        value: q.value[0],
-        error: q.error[0],
-        evaluations: q.evaluations,
-    }
+    Quadrature { value: q.value[0], error: q.error[0], evaluations: q.evaluations }
 }
 
 /// Legendre polynomial `P_n(x)` and its derivative by the three-term recurrence (`n >= 1`).
@@ -364,16 +333,8 @@ mod tests {
             let (x, w) = gauss_legendre(n);
             assert!(x.windows(2).all(|p| p[0] < p[1]));
             for deg in 0..2 * n {
-                let q: f64 = x
-                    .iter()
-                    .zip(&w)
-                    .map(|(&xi, &wi)| wi * xi.powi(deg as i32))
-                    .sum();
-                let exact = if deg % 2 == 1 {
-                    0.0
-                } else {
-                    2.0 / (deg as f64 + 1.0)
-                };
+                let q: f64 = x.iter().zip(&w).map(|(&xi, &wi)| wi * xi.powi(deg as i32)).sum();
+                let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
                 assert!((q - exact).abs() < 4e-15, "n {n} deg {deg}: {q} vs {exact}");
             }
         }
@@ -399,27 +360,14 @@ mod tests {
     fn kronrod_table_degrees() {
         for deg in 0..=24i32 {
             let p = kronrod15(&mut |x: f64| [x.powi(deg)], -1.0, 1.0, 0);
-            let exact = if deg % 2 == 1 {
-                0.0
-            } else {
-                2.0 / (deg as f64 + 1.0)
-            };
+            let exact = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
             let gauss_exact = deg <= 13;
             let kronrod_err = (p.value[0] - exact).abs();
-            assert!(
-                deg > 22 || kronrod_err < 1e-15,
-                "K15 deg {deg}: {kronrod_err}"
-            );
+            assert!(deg > 22 || kronrod_err < 1e-15, "K15 deg {deg}: {kronrod_err}");
             // error = |K15 - G7| + 50 eps int |f|: only the allowance is left when G7 is exact.
             let allowance = ROUNDOFF * 2.0;
-            assert!(
-                !gauss_exact || p.error[0] < allowance + 1e-15,
-                "G7 deg {deg}"
-            );
-            assert!(
-                gauss_exact || deg % 2 == 1 || p.error[0] > allowance + 1e-6,
-                "G7 deg {deg} too exact"
-            );
+            assert!(!gauss_exact || p.error[0] < allowance + 1e-15, "G7 deg {deg}");
+            assert!(gauss_exact || deg % 2 == 1 || p.error[0] > allowance + 1e-6, "G7 deg {deg} too exact");
         }
     }
 
@@ -427,11 +375,7 @@ mod tests {
         let q = gauss_kronrod(f, a, b, 0.0, 1e-12, 60);
         let true_err = (q.value - exact).abs();
         assert!(q.error <= 1e-12 * q.value.abs(), "not converged: {q:?}");
-        assert!(
-            true_err <= q.error,
-            "bound fails: true {true_err:e}, reported {:e}",
-            q.error
-        );
+        assert!(true_err <= q.error, "bound fails: true {true_err:e}, reported {:e}", q.error);
         assert!(rel(q.value, exact) <= 1e-12, "{q:?} vs {exact}");
         q
     }

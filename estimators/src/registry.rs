@@ -36,26 +36,53 @@ pub struct TestBedEntry {
     pub summary: &'static str,
     /// Builds a variant (computes or loads its reference).
     pub build: fn(&str, &Params) -> Result<Box<dyn TestBed>, ConfigError>,
+    /// Computes a stored long-run reference for a variant (`mcbench reference`), for variants
+    /// without a closed form; `None` when every variant is exact.
+    pub compute_reference: Option<ComputeReference>,
 }
+
+/// Computes a stored reference: `(variant, params, worker threads)` to a reference whose kind is
+/// [`crate::testbed::ReferenceKind::Stored`], plus the resolution it was computed at.
+pub type ComputeReference =
+    fn(&str, &Params, usize) -> Result<(crate::testbed::Reference, (usize, usize)), ConfigError>;
 
 /// Every registered estimator.
 pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::independent::is0_cv0::ENTRY,
     &crate::independent::brdf_is0_cv0::ENTRY,
     &crate::independent::clamped_is0_cv0::ENTRY,
+    &crate::tracking::ray_marching::ENTRY,
+    &crate::tracking::delta_tracking::ENTRY,
+    &crate::tracking::ratio_tracking::ENTRY,
+    &crate::tracking::residual_ratio_tracking::ENTRY,
+    &crate::tracking::double_particle::ENTRY,
+    &crate::tracking::single_particle::TERMINATING,
+    &crate::tracking::single_particle::NONTERMINATING,
+    &crate::tracking::spm::TERMINATING,
+    &crate::tracking::spm::NONTERMINATING,
+    &crate::tracking::spm::ADAPTIVE,
 ];
 
 /// Every registered test bed.
-pub static TESTBEDS: &[&TestBedEntry] = &[&crate::testbeds::gradient_plane::ENTRY];
+pub static TESTBEDS: &[&TestBedEntry] =
+    &[&crate::testbeds::gradient_plane::ENTRY, &crate::media::EQ21, &crate::media::PERLIN];
 
 /// Looks an estimator up by id.
 pub fn estimator(id: &str) -> Result<&'static EstimatorEntry, ConfigError> {
-    ESTIMATORS.iter().copied().find(|e| e.id == id).ok_or_else(|| ConfigError::unknown("estimator", id, ESTIMATORS.iter().map(|e| e.id)))
+    ESTIMATORS
+        .iter()
+        .copied()
+        .find(|e| e.id == id)
+        .ok_or_else(|| ConfigError::unknown("estimator", id, ESTIMATORS.iter().map(|e| e.id)))
 }
 
 /// Looks a test bed up by id.
 pub fn testbed(id: &str) -> Result<&'static TestBedEntry, ConfigError> {
-    TESTBEDS.iter().copied().find(|e| e.id == id).ok_or_else(|| ConfigError::unknown("test bed", id, TESTBEDS.iter().map(|e| e.id)))
+    TESTBEDS
+        .iter()
+        .copied()
+        .find(|e| e.id == id)
+        .ok_or_else(|| ConfigError::unknown("test bed", id, TESTBEDS.iter().map(|e| e.id)))
 }
 
 impl TestBedEntry {

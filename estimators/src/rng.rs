@@ -38,22 +38,13 @@ pub fn splitmix64(mut z: u64) -> u64 {
 
 /// FNV-1a 64-bit hash of a string (stable across platforms and compiler versions).
 pub fn fnv1a(s: &str) -> u64 {
-    s.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01B3)
-    })
+    s.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01B3))
 }
 
 impl StreamKey<'_> {
     /// Two independent 64-bit digests of the key.
     fn digest(&self) -> (u64, u64) {
-        let parts = [
-            self.seed,
-            fnv1a(self.testbed),
-            fnv1a(self.estimator),
-            self.budget,
-            self.rep,
-            self.integral,
-        ];
+        let parts = [self.seed, fnv1a(self.testbed), fnv1a(self.estimator), self.budget, self.rep, self.integral];
         let mut a = 0x243F_6A88_85A3_08D3u64;
         let mut b = 0x1319_8A2E_0370_7344u64;
         for p in parts {

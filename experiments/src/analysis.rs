@@ -64,7 +64,10 @@ pub fn fits(rows: &[SummaryRow]) -> Vec<Fit> {
 pub fn group(rows: &[SummaryRow]) -> Vec<Vec<&SummaryRow>> {
     let mut groups: Vec<Vec<&SummaryRow>> = Vec::new();
     for r in rows {
-        match groups.iter_mut().find(|g| g[0].testbed == r.testbed && g[0].variant == r.variant && g[0].estimator == r.estimator) {
+        match groups
+            .iter_mut()
+            .find(|g| g[0].testbed == r.testbed && g[0].variant == r.variant && g[0].estimator == r.estimator)
+        {
             Some(g) => g.push(r),
             None => groups.push(vec![r]),
         }

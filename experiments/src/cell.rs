@@ -32,7 +32,9 @@ impl CellKey {
     /// A file name for the cell: readable prefix plus a digest of the whole key.
     pub fn file_name(&self) -> String {
         let text = serde_json::to_string(self).unwrap_or_default();
-        let clean = |s: &str| s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect::<String>();
+        let clean = |s: &str| {
+            s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect::<String>()
+        };
         format!(
             "{}_{}_{}_{}{}_{:016x}.json",
             clean(&self.testbed),

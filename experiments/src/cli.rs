@@ -46,6 +46,9 @@ enum Command {
         /// Variant (the first when omitted).
         #[arg(long)]
         variant: Option<String>,
+        /// Paths per integral for stored Monte Carlo references (the test bed's default when omitted).
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        samples: Option<u64>,
         /// Results root.
         #[arg(long, default_value = "results")]
         results: PathBuf,
@@ -147,7 +150,9 @@ fn dispatch(cli: Cli) -> Result<()> {
             list(what);
             Ok(())
         }
-        Some(Command::Reference { testbed, variant, results }) => reference(&testbed, variant, &results),
+        Some(Command::Reference { testbed, variant, samples, results }) => {
+            reference(&testbed, variant, samples, &results)
+        }
         Some(Command::Plot { results_dir, plots }) => {
             let report = crate::output::read_results(&results_dir)?;
             let dir = plots.join(&report.meta.experiment);
@@ -165,7 +170,11 @@ fn run(names: &[String], args: &RunArgs) -> Result<()> {
     let mut plans = Vec::new();
     if names.is_empty() {
         let file = file.ok_or_else(|| {
-            estimators::error::ConfigError::invalid("experiment", "(none)", format!("name one (valid: {}) or give --config", valid_experiments()))
+            estimators::error::ConfigError::invalid(
+                "experiment",
+                "(none)",
+                format!("name one (valid: {}) or give --config", valid_experiments()),
+            )
         })?;
         plans.push((None, file.apply(None, mode)?));
     } else {
@@ -214,12 +223,20 @@ fn valid_experiments() -> String {
 }
 
 fn print_summary(r: &crate::output::RunReport, seconds: f64) {
-    println!("\n== {} ({} mode, seed {}, {} reps, {:.1} s) ==", r.meta.experiment, r.meta.mode, r.meta.seed, r.meta.reps, seconds);
+    println!(
+        "\n== {} ({} mode, seed {}, {} reps, {:.1} s) ==",
+        r.meta.experiment, r.meta.mode, r.meta.seed, r.meta.reps, seconds
+    );
     let fits: Vec<Vec<String>> = r
         .fits
         .iter()
         .map(|f| {
-            let t = r.tests.iter().find(|t| t.testbed == f.testbed && t.variant == f.variant && t.estimator == f.estimator && t.test.starts_with("holm"));
+            let t = r.tests.iter().find(|t| {
+                t.testbed == f.testbed
+                    && t.variant == f.variant
+                    && t.estimator == f.estimator
+                    && t.test.starts_with("holm")
+            });
             vec![
                 format!("{}/{}", f.testbed, f.variant),
                 f.estimator.clone(),
@@ -229,7 +246,10 @@ fn print_summary(r: &crate::output::RunReport, seconds: f64) {
             ]
         })
         .collect();
-    println!("{}", markdown_table(&["test bed", "estimator", "slope [95% CI]", "Holm p", "unbiasedness (claim)"], &fits));
+    println!(
+        "{}",
+        markdown_table(&["test bed", "estimator", "slope [95% CI]", "Holm p", "unbiasedness (claim)"], &fits)
+    );
     let claims: Vec<Vec<String>> = r
         .paper
         .iter()
@@ -239,7 +259,12 @@ fn print_summary(r: &crate::output::RunReport, seconds: f64) {
                 Some(false) => "did NOT hold",
                 None => "not measured",
             };
-            vec![c.claim.clone(), c.paper_value.map(|v| sig(v, 3)).unwrap_or_default(), c.our_value.map(|v| sig(v, 3)).unwrap_or_else(|| "-".into()), held.into()]
+            vec![
+                c.claim.clone(),
+                c.paper_value.map(|v| sig(v, 3)).unwrap_or_default(),
+                c.our_value.map(|v| sig(v, 3)).unwrap_or_else(|| "-".into()),
+                held.into(),
+            ]
         })
         .collect();
     println!("{}", markdown_table(&["paper claim", "paper", "ours", "verdict"], &claims));
@@ -254,48 +279,84 @@ fn print_summary(r: &crate::output::RunReport, seconds: f64) {
 fn list(what: Option<ListWhat>) {
     let all = what.is_none();
     if all || matches!(what, Some(ListWhat::Testbeds)) {
-        let rows: Vec<Vec<String>> =
-            TESTBEDS.iter().map(|t| vec![t.id.into(), t.variants.join(", "), t.provides.to_string(), t.summary.into()]).collect();
+        let rows: Vec<Vec<String>> = TESTBEDS
+            .iter()
+            .map(|t| vec![t.id.into(), t.variants.join(", "), t.provides.to_string(), t.summary.into()])
+            .collect();
         println!("{}", markdown_table(&["test bed", "variants", "provides", "summary"], &rows));
     }
     if all || matches!(what, Some(ListWhat::Estimators)) {
         let rows: Vec<Vec<String>> = ESTIMATORS
             .iter()
             .map(|e| {
-                let on: Vec<&str> = TESTBEDS.iter().filter(|t| e.skip_reason(t.provides).is_none()).map(|t| t.id).collect();
-                vec![e.id.into(), e.paper.into(), e.bias.name().into(), e.needs.to_string(), on.join(", "), e.summary.into()]
+                let on: Vec<&str> =
+                    TESTBEDS.iter().filter(|t| e.skip_reason(t.provides).is_none()).map(|t| t.id).collect();
+                vec![
+                    e.id.into(),
+                    e.paper.into(),
+                    e.bias.name().into(),
+                    e.needs.to_string(),
+                    on.join(", "),
+                    e.summary.into(),
+                ]
             })
             .collect();
         println!("{}", markdown_table(&["estimator", "paper", "claim", "needs", "runs on", "summary"], &rows));
     }
     if all || matches!(what, Some(ListWhat::Experiments)) {
-        let rows: Vec<Vec<String>> = EXPERIMENTS.iter().map(|e| vec![e.name.into(), e.reproduces.into(), e.summary.into()]).collect();
+        let rows: Vec<Vec<String>> =
+            EXPERIMENTS.iter().map(|e| vec![e.name.into(), e.reproduces.into(), e.summary.into()]).collect();
         println!("{}", markdown_table(&["experiment", "reproduces", "summary"], &rows));
     }
 }
 
-fn reference(testbed: &str, variant: Option<String>, results: &std::path::Path) -> Result<()> {
+fn reference(testbed: &str, variant: Option<String>, samples: Option<u64>, results: &std::path::Path) -> Result<()> {
     let entry = estimators::registry::testbed(testbed)?;
     let variant = variant.unwrap_or_else(|| entry.variants[0].to_string());
     entry.check_variant(&variant)?;
     let t0 = Instant::now();
-    let bed = (entry.build)(&variant, &Params::new())?;
-    let r = bed.reference();
+    // Exact variants compute their reference when built; stored ones run the test bed's hook.
+    let built = (entry.build)(&variant, &Params::new());
+    let (r, resolution) = match (built, entry.compute_reference) {
+        (Ok(bed), None) => (bed.reference().clone(), bed.resolution()),
+        (Ok(bed), Some(_)) if bed.reference().is_exact() => (bed.reference().clone(), bed.resolution()),
+        (_, Some(compute)) => {
+            let mut params = Params::new();
+            if let Some(n) = samples {
+                params = params.with("samples", n as f64);
+            }
+            let threads = std::thread::available_parallelism().map(|t| t.get()).unwrap_or(1);
+            compute(&variant, &params, threads)?
+        }
+        (Err(e), None) => return Err(e.into()),
+    };
     let path = results.join("references").join(format!("{testbed}_{variant}.json"));
+    let command = match &r.kind {
+        estimators::testbed::ReferenceKind::Stored { command, .. } => command.clone(),
+        _ => format!("mcbench reference {testbed} --variant {variant}"),
+    };
     let doc = serde_json::json!({
         "testbed": testbed,
         "variant": variant,
-        "command": format!("mcbench reference {testbed} --variant {variant}"),
-        "resolution": bed.resolution(),
+        "command": command,
+        "resolution": resolution,
         "reference": r,
     });
     let text = serde_json::to_string(&doc).map_err(|e| HarnessError::write(&path, e))?;
     crate::output::write_atomic(&path, text.as_bytes())?;
     let kind = match &r.kind {
-        estimators::testbed::ReferenceKind::Exact { method, bound } => format!("exact: {method}; absolute error bound {bound:.3e}"),
-        estimators::testbed::ReferenceKind::Stored { command, samples } => format!("stored: `{command}`, {samples} samples per value"),
+        estimators::testbed::ReferenceKind::Exact { method, bound } => {
+            format!("exact: {method}; absolute error bound {bound:.3e}")
+        }
+        estimators::testbed::ReferenceKind::Stored { command, samples } => {
+            format!("stored: `{command}`, {samples} samples per value")
+        }
     };
-    println!("{testbed}/{variant}: {} integrals, {kind}, computed in {:.2} s", r.value.len(), t0.elapsed().as_secs_f64());
+    println!(
+        "{testbed}/{variant}: {} integrals, {kind}, computed in {:.2} s",
+        r.value.len(),
+        t0.elapsed().as_secs_f64()
+    );
     println!("written to {}", path.display());
     Ok(())
 }

@@ -157,7 +157,10 @@ impl SweepFile {
         let mut sweep = match base {
             Some(s) => s,
             None => Sweep {
-                experiment: self.name.clone().ok_or_else(|| ConfigError::invalid("name", "(missing)", "a custom sweep needs a name"))?,
+                experiment: self
+                    .name
+                    .clone()
+                    .ok_or_else(|| ConfigError::invalid("name", "(missing)", "a custom sweep needs a name"))?,
                 testbeds: Vec::new(),
                 estimators: Vec::new(),
                 budgets: Vec::new(),
@@ -205,16 +208,28 @@ impl Sweep {
             return Err(ConfigError::invalid("name", &self.experiment, "use letters, digits, '-' and '_'").into());
         }
         if self.reps < 2 {
-            return Err(ConfigError::invalid("reps", self.reps, "at least 2 repetitions are needed for variances").into());
+            return Err(
+                ConfigError::invalid("reps", self.reps, "at least 2 repetitions are needed for variances").into()
+            );
         }
         if self.budgets.is_empty() || self.testbeds.is_empty() || self.estimators.is_empty() {
-            return Err(ConfigError::invalid("sweep", &self.experiment, "needs at least one test bed, estimator and budget").into());
+            return Err(ConfigError::invalid(
+                "sweep",
+                &self.experiment,
+                "needs at least one test bed, estimator and budget",
+            )
+            .into());
         }
         if let Some(b) = self.budgets.iter().find(|b| b.amount == 0) {
             return Err(ConfigError::invalid("budgets", b.amount, "budgets must be >= 1").into());
         }
         if self.budgets.windows(2).any(|w| w[0].amount >= w[1].amount || w[0].kind != w[1].kind) {
-            return Err(ConfigError::invalid("budgets", format!("{:?}", self.budgets.iter().map(|b| b.amount).collect::<Vec<_>>()), "must be increasing and of one kind").into());
+            return Err(ConfigError::invalid(
+                "budgets",
+                format!("{:?}", self.budgets.iter().map(|b| b.amount).collect::<Vec<_>>()),
+                "must be increasing and of one kind",
+            )
+            .into());
         }
         Ok(())
     }
@@ -234,11 +249,15 @@ mod tests {
 
     #[test]
     fn custom_sweep_from_toml_and_validation() {
-        let f: SweepFile = toml::from_str("name='x'\nreps=4\nbudgets=[4,16]\n[[testbeds]]\nid='gradient-plane'\n[[estimators]]\nid='is0_cv0'\n").unwrap();
+        let f: SweepFile = toml::from_str(
+            "name='x'\nreps=4\nbudgets=[4,16]\n[[testbeds]]\nid='gradient-plane'\n[[estimators]]\nid='is0_cv0'\n",
+        )
+        .unwrap();
         let s = f.apply(None, Mode::Quick).unwrap();
         assert!(s.validate().is_ok());
         assert_eq!(s.budgets.len(), 2);
-        let bad: SweepFile = toml::from_str("name='x'\nreps=1\nbudgets=[4]\n[[testbeds]]\nid='a'\n[[estimators]]\nid='b'\n").unwrap();
+        let bad: SweepFile =
+            toml::from_str("name='x'\nreps=1\nbudgets=[4]\n[[testbeds]]\nid='a'\n[[estimators]]\nid='b'\n").unwrap();
         assert!(bad.apply(None, Mode::Quick).unwrap().validate().unwrap_err().to_string().contains("reps"));
         assert!(toml::from_str::<SweepFile>("rep = 3").is_err());
     }

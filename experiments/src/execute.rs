@@ -90,7 +90,11 @@ pub fn execute(plan: &Plan, def: Option<&ExperimentDef>, opts: &ExecOptions<'_>)
             ),
         });
     }
-    let threads = rayon::ThreadPoolBuilder::new().num_threads(opts.threads.unwrap_or(0)).build().map(|p| p.current_num_threads()).unwrap_or(1);
+    let threads = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads.unwrap_or(0))
+        .build()
+        .map(|p| p.current_num_threads())
+        .unwrap_or(1);
     let mut report = RunReport {
         meta: Meta {
             experiment: sweep.experiment.clone(),
@@ -174,6 +178,11 @@ fn git_commit() -> String {
 fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|t| t.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).map(|s| s.trim().to_string()))
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
         .unwrap_or_else(|| std::env::consts::ARCH.to_string())
 }

@@ -68,8 +68,14 @@ fn inverse(x: f64) -> Option<f64> {
 /// Computes the summary row of a cell.
 pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
     let reps = cell.key.reps as f64;
-    let (mut mse, mut var, mut bias, mut bias_var, mut rel, mut ref_var) =
-        (NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new());
+    let (mut mse, mut var, mut bias, mut bias_var, mut rel, mut ref_var) = (
+        NeumaierSum::new(),
+        NeumaierSum::new(),
+        NeumaierSum::new(),
+        NeumaierSum::new(),
+        NeumaierSum::new(),
+        NeumaierSum::new(),
+    );
     let mut rel_n = 0usize;
     for (i, m) in cell.moments.iter().enumerate() {
         for (c, mc) in m.iter().enumerate() {

@@ -161,9 +161,29 @@ pub fn write_summary_csv(path: &Path, rows: &[SummaryRow]) -> Result<()> {
 
 /// The header of summary.csv (used when there are no rows).
 pub const SUMMARY_HEADER: &[&str] = &[
-    "testbed", "variant", "estimator", "budget_kind", "budget", "reps", "integrals", "rmse", "mse", "variance", "bias",
-    "bias_se", "samples", "fetches", "rays", "seconds", "efficiency", "fom", "rel_rmse", "reference_var",
-    "cheap_fetches", "seconds_median", "efficiency_mse",
+    "testbed",
+    "variant",
+    "estimator",
+    "budget_kind",
+    "budget",
+    "reps",
+    "integrals",
+    "rmse",
+    "mse",
+    "variance",
+    "bias",
+    "bias_se",
+    "samples",
+    "fetches",
+    "rays",
+    "seconds",
+    "efficiency",
+    "fom",
+    "rel_rmse",
+    "reference_var",
+    "cheap_fetches",
+    "seconds_median",
+    "efficiency_mse",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).
@@ -178,7 +198,17 @@ pub fn write_integrals_csv(path: &Path, rows: &[IntegralRow]) -> Result<()> {
     }
     let bytes = csv_bytes(|w| {
         let mut header: Vec<&str> = vec![
-            "testbed", "variant", "estimator", "integral", "px", "py", "channel", "reference", "reference_se", "mean", "std_err",
+            "testbed",
+            "variant",
+            "estimator",
+            "integral",
+            "px",
+            "py",
+            "channel",
+            "reference",
+            "reference_se",
+            "mean",
+            "std_err",
         ];
         header.extend(&geo);
         w.write_record(&header)?;

@@ -154,7 +154,16 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
 
     let speedups = report.speedups.iter().map(|s| {
         let (sr, ov, su) = (sig(s.sample_ratio, 4), sig(s.overhead, 4), sig(s.speedup, 4));
-        vec![s.testbed.clone(), s.variant.clone(), name(report, &s.estimator), s.baseline.clone(), s.budget.to_string(), sr, ov, su]
+        vec![
+            s.testbed.clone(),
+            s.variant.clone(),
+            name(report, &s.estimator),
+            s.baseline.clone(),
+            s.budget.to_string(),
+            sr,
+            ov,
+            su,
+        ]
     });
     let header = ["testbed", "variant", "estimator", "baseline", "budget", "sample ratio", "overhead", "speed-up"];
     section(&mut out, "Speed-ups", &header, speedups.collect(), "No speed-ups computed.");
@@ -187,7 +196,10 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
     ];
     section(&mut out, "Unbiasedness tests", &header, tests.collect(), "No tests in this run.");
 
-    let skipped = report.skipped.iter().map(|s| vec![s.testbed.clone(), s.variant.clone(), s.estimator.clone(), s.reason.clone()]);
+    let skipped = report
+        .skipped
+        .iter()
+        .map(|s| vec![s.testbed.clone(), s.variant.clone(), s.estimator.clone(), s.reason.clone()]);
     let header = ["testbed", "variant", "estimator", "reason"];
     section(&mut out, "Skipped pairs", &header, skipped.collect(), "None.");
     let unavailable = report.unavailable.iter().map(|u| vec![u.clone(), "not registered in this build".to_string()]);
@@ -205,7 +217,8 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
         out.push_str("\nNo result rows.\n");
     }
     for (testbed, variant) in groups {
-        let rows: Vec<&SummaryRow> = report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
+        let rows: Vec<&SummaryRow> =
+            report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
         results_table(&mut out, report, testbed, variant, &rows);
         for kind in PlotKind::ALL {
             let png = format!("{}.png", plot_stem(testbed, variant, kind));

@@ -70,16 +70,38 @@ pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Cel
         .into_par_iter()
         .map(|item| {
             let (rep, batch) = (item / batches, item % batches);
-            let mut out = Item { values: Vec::with_capacity(BATCH), costs: Costs::default(), time: TimeStats::default(), diagnostics: Vec::new() };
+            let mut out = Item {
+                values: Vec::with_capacity(BATCH),
+                costs: Costs::default(),
+                time: TimeStats::default(),
+                diagnostics: Vec::new(),
+            };
             for i in batch * BATCH..((batch + 1) * BATCH).min(n) {
-                let key = StreamKey { seed: plan.sweep.seed, testbed: &label, estimator: &e.name, budget: budget.amount, rep: rep as u64, integral: i as u64 };
+                let key = StreamKey {
+                    seed: plan.sweep.seed,
+                    testbed: &label,
+                    estimator: &e.name,
+                    budget: budget.amount,
+                    rep: rep as u64,
+                    integral: i as u64,
+                };
                 let mut rng = key.rng();
                 let task = Task::new(b.bed.as_ref(), i, budget);
                 let t0 = Instant::now();
                 let v = e.estimator.estimate(&task, &mut rng);
                 out.time.push(t0.elapsed().as_secs_f64());
-                let v = v.and_then(|v| if v.is_finite() { Ok(v) } else { Err(EstimateError::NonFinite { integral: i, value: v.0 }) });
-                let v = v.map_err(|source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.clone(), source })?;
+                let v = v.and_then(|v| {
+                    if v.is_finite() {
+                        Ok(v)
+                    } else {
+                        Err(EstimateError::NonFinite { integral: i, value: v.0 })
+                    }
+                });
+                let v = v.map_err(|source| HarnessError::Estimate {
+                    estimator: e.name.clone(),
+                    testbed: label.clone(),
+                    source,
+                })?;
                 add(&mut out.costs, &task.costs());
                 add_diagnostics(&mut out.diagnostics, &task.diagnostics());
                 out.values.push(v);
@@ -159,7 +181,13 @@ pub fn run(plan: &Plan, opts: &RunOptions<'_>) -> Result<RunResults> {
                     c
                 }
             };
-            let label = format!("{} {} {}={}", plan.beds[bi].label(), plan.estimators[ei].name, budget.kind.name(), budget.amount);
+            let label = format!(
+                "{} {} {}={}",
+                plan.beds[bi].label(),
+                plan.estimators[ei].name,
+                budget.kind.name(),
+                budget.amount
+            );
             opts.observer.cell_done(cells.len() + 1, total, &label, resumed);
             cells.push((bi, ei, cell));
         }

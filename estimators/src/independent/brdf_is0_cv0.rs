@@ -1,8 +1,8 @@
 //! `brdf_is0_cv0`: BRDF importance sampling (paper 001 §4.5): the diffuse cosine lobe and the
 //! Phong lobe as a mixture, weighted by the exact mixture pdf ([`crate::brdf::Phong::pdf`]).
 
-use crate::estimator::{Bias, Estimator};
 use crate::error::EstimateError;
+use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;

@@ -2,8 +2,8 @@
 //! sample's contribution `f / p` clamped per channel at `clamp` (a "firefly clamp"). Its only
 //! purpose is to prove that the unbiasedness test can fail (SPEC §6 "Teeth").
 
-use crate::estimator::{Bias, Estimator};
 use crate::error::EstimateError;
+use crate::estimator::{Bias, Estimator};
 use crate::math::{Frame, Rgb};
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;

@@ -1,8 +1,8 @@
 //! `is0_cv0`: uniform hemisphere sampling without control variate, the independent-sample
 //! baseline of papers 000/001 (their "MCMC"): `(1/N) sum 2 pi f(w_k)`.
 
-use crate::estimator::{Bias, Estimator};
 use crate::error::EstimateError;
+use crate::estimator::{Bias, Estimator};
 use crate::math::{Frame, Rgb};
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;

@@ -17,7 +17,8 @@ pub(crate) fn average(
     rng: &mut StreamRng,
     mut sample: impl FnMut(&HemisphereProbe<'_>, &mut StreamRng) -> Rgb,
 ) -> Result<Rgb, EstimateError> {
-    let probe = task.hemisphere().ok_or_else(|| EstimateError::Refused("the test bed has no surface integrals".into()))?;
+    let probe =
+        task.hemisphere().ok_or_else(|| EstimateError::Refused("the test bed has no surface integrals".into()))?;
     let mut mean = RgbMean::new();
     while task.more() {
         mean.push(sample(&probe, rng));

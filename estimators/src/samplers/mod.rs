@@ -4,7 +4,9 @@
 //! [`testing::assert_sampler_fits`].
 
 pub mod cosine_hemisphere;
+pub mod free_flight;
 pub mod phong_lobe;
+pub mod rayleigh;
 pub mod testing;
 pub mod uniform_hemisphere;
 

@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 
 /// How many sampler chi-square tests the workspace runs (the Sidak family size). Raise it when
 /// adding a sampler test.
-pub const SAMPLER_TESTS: usize = 32;
+pub const SAMPLER_TESTS: usize = 36;
 
 /// The per-test significance level: Sidak-corrected 0.01 over [`SAMPLER_TESTS`].
 pub fn sampler_alpha() -> f64 {
@@ -115,7 +115,13 @@ pub fn assert_sampler_fits(
 ) {
     let c = sampler_chi_square(grid, n, seed, sample, pdf);
     let alpha = sampler_alpha();
-    assert!(c.p_value > alpha, "{name}: chi-square {} on {} dof, p = {:e} < alpha {alpha:e}", c.statistic, c.dof, c.p_value);
+    assert!(
+        c.p_value > alpha,
+        "{name}: chi-square {} on {} dof, p = {:e} < alpha {alpha:e}",
+        c.statistic,
+        c.dof,
+        c.p_value
+    );
 }
 
 #[cfg(test)]
@@ -128,7 +134,13 @@ mod tests {
     #[test]
     fn chi_square_rejects_a_mismatched_pdf() {
         let grid = SphereGrid::upper(16, 16);
-        let c = sampler_chi_square(&grid, 200_000, 5, |r| cosine_hemisphere::sample_local(r), |d| uniform_hemisphere::pdf(d.z));
+        let c = sampler_chi_square(
+            &grid,
+            200_000,
+            5,
+            |r| cosine_hemisphere::sample_local(r),
+            |d| uniform_hemisphere::pdf(d.z),
+        );
         assert!(c.p_value < 1e-12, "p = {}", c.p_value);
     }
 

@@ -109,11 +109,7 @@ pub struct ChiSquare {
 /// no observations, or fewer than two merged cells.
 pub fn chi_square_gof(observed: &[u64], expected_prob: &[f64]) -> Result<ChiSquare, StatsError> {
     if observed.len() != expected_prob.len() {
-        return Err(StatsError::LengthMismatch {
-            what: "observed",
-            left: observed.len(),
-            right: expected_prob.len(),
-        });
+        return Err(StatsError::LengthMismatch { what: "observed", left: observed.len(), right: expected_prob.len() });
     }
     let mut total_p = NeumaierSum::new();
     for (index, &value) in expected_prob.iter().enumerate() {
@@ -154,10 +150,7 @@ pub fn chi_square_gof(observed: &[u64], expected_prob: &[f64]) -> Result<ChiSqua
         }
     }
 
-    let impossible = observed
-        .iter()
-        .zip(expected_prob)
-        .any(|(&o, &p)| o > 0 && p == 0.0);
+    let impossible = observed.iter().zip(expected_prob).any(|(&o, &p)| o > 0 && p == 0.0);
     if impossible {
         return Ok(ChiSquare {
             statistic: f64::INFINITY,
@@ -178,16 +171,8 @@ pub fn chi_square_gof(observed: &[u64], expected_prob: &[f64]) -> Result<ChiSqua
     }
     let statistic = statistic.value();
     let dof = cells.len() - 1;
-    let p_value = ChiSquared::new(dof as f64)
-        .map(|d| d.sf(statistic))
-        .unwrap_or(f64::NAN);
-    Ok(ChiSquare {
-        statistic,
-        dof,
-        p_value,
-        cells: cells.len(),
-        merged_from: observed.len(),
-    })
+    let p_value = ChiSquared::new(dof as f64).map(|d| d.sf(statistic)).unwrap_or(f64::NAN);
+    Ok(ChiSquare { statistic, dof, p_value, cells: cells.len(), merged_from: observed.len() })
 }
 
 /// Counts `values` into the bins `[edges[i], edges[i+1])`, the last bin closed on the right.
@@ -205,11 +190,7 @@ pub fn histogram(values: impl IntoIterator<Item = f64>, edges: &[f64]) -> Vec<u6
         if !(v >= first && v <= last) {
             continue;
         }
-        let idx = if v == last {
-            bins - 1
-        } else {
-            (edges.partition_point(|&e| e <= v) - 1).min(bins - 1)
-        };
+        let idx = if v == last { bins - 1 } else { (edges.partition_point(|&e| e <= v) - 1).min(bins - 1) };
         counts[idx] += 1;
     }
     counts
@@ -231,26 +212,15 @@ mod tests {
         let r = chi_square_gof(&[60, 40], &[0.5, 0.5]).unwrap();
         assert!(close(r.statistic, 4.0, 1e-14));
         assert_eq!((r.dof, r.cells, r.merged_from), (1, 2, 2));
-        assert!(
-            close(r.p_value, 0.045_500_263_896_358_4, 1e-9),
-            "{}",
-            r.p_value
-        );
+        assert!(close(r.p_value, 0.045_500_263_896_358_4, 1e-9), "{}", r.p_value);
         // Dice: statistic 13.4, dof 5, p = 0.0199052203347744 (closed form for odd dof).
         // Unnormalised weights are normalised.
         let r = chi_square_gof(&[5, 8, 9, 8, 10, 20], &[1.0; 6]).unwrap();
         assert!(close(r.statistic, 13.4, 1e-13));
         assert_eq!(r.dof, 5);
-        assert!(
-            close(r.p_value, 0.019_905_220_334_774_4, 1e-8),
-            "{}",
-            r.p_value
-        );
+        assert!(close(r.p_value, 0.019_905_220_334_774_4, 1e-8), "{}", r.p_value);
         // Perfect agreement.
-        assert_eq!(
-            chi_square_gof(&[25, 75], &[0.25, 0.75]).unwrap().p_value,
-            1.0
-        );
+        assert_eq!(chi_square_gof(&[25, 75], &[0.25, 0.75]).unwrap().p_value, 1.0);
     }
 
     #[test]
@@ -281,33 +251,13 @@ mod tests {
     #[test]
     fn input_errors() {
         use StatsError::*;
-        assert!(matches!(
-            chi_square_gof(&[1, 2], &[0.5]),
-            Err(LengthMismatch { .. })
-        ));
-        assert!(matches!(
-            chi_square_gof(&[1, 2], &[0.5, -0.1]),
-            Err(InvalidProbability { index: 1, .. })
-        ));
-        assert!(matches!(
-            chi_square_gof(&[1, 2], &[f64::NAN, 0.5]),
-            Err(InvalidProbability { index: 0, .. })
-        ));
-        assert!(matches!(
-            chi_square_gof(&[1, 2], &[0.0, 0.0]),
-            Err(BadTotalProbability { .. })
-        ));
-        assert!(matches!(
-            chi_square_gof(&[0, 0], &[0.5, 0.5]),
-            Err(NoObservations)
-        ));
-        assert!(matches!(
-            chi_square_gof(&[1, 1, 1], &[1.0, 1.0, 1.0]),
-            Err(TooFewCells { cells: 1 })
-        ));
-        let msg = chi_square_gof(&[1, 1], &[0.5, 0.5])
-            .unwrap_err()
-            .to_string();
+        assert!(matches!(chi_square_gof(&[1, 2], &[0.5]), Err(LengthMismatch { .. })));
+        assert!(matches!(chi_square_gof(&[1, 2], &[0.5, -0.1]), Err(InvalidProbability { index: 1, .. })));
+        assert!(matches!(chi_square_gof(&[1, 2], &[f64::NAN, 0.5]), Err(InvalidProbability { index: 0, .. })));
+        assert!(matches!(chi_square_gof(&[1, 2], &[0.0, 0.0]), Err(BadTotalProbability { .. })));
+        assert!(matches!(chi_square_gof(&[0, 0], &[0.5, 0.5]), Err(NoObservations)));
+        assert!(matches!(chi_square_gof(&[1, 1, 1], &[1.0, 1.0, 1.0]), Err(TooFewCells { cells: 1 })));
+        let msg = chi_square_gof(&[1, 1], &[0.5, 0.5]).unwrap_err().to_string();
         assert!(msg.contains("cell"), "{msg}");
     }
 

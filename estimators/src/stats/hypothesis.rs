@@ -46,30 +46,14 @@ fn two_sided_t(t: f64, dof: f64) -> f64 {
 /// Shared core: statistic from a difference and its standard error, with the zero-error guard.
 fn outcome(diff: f64, std_err: f64, dof: f64, tail: impl Fn(f64) -> f64) -> TestOutcome {
     if diff.is_nan() || std_err.is_nan() || std_err < 0.0 {
-        return TestOutcome {
-            statistic: f64::NAN,
-            p_value: f64::NAN,
-            dof,
-        };
+        return TestOutcome { statistic: f64::NAN, p_value: f64::NAN, dof };
     }
     if std_err == 0.0 {
-        let (statistic, p_value) = if diff == 0.0 {
-            (0.0, 1.0)
-        } else {
-            (f64::INFINITY.copysign(diff), 0.0)
-        };
-        return TestOutcome {
-            statistic,
-            p_value,
-            dof,
-        };
+        let (statistic, p_value) = if diff == 0.0 { (0.0, 1.0) } else { (f64::INFINITY.copysign(diff), 0.0) };
+        return TestOutcome { statistic, p_value, dof };
     }
     let statistic = diff / std_err;
-    TestOutcome {
-        statistic,
-        p_value: tail(statistic),
-        dof,
-    }
+    TestOutcome { statistic, p_value: tail(statistic), dof }
 }
 
 /// One-sample two-sided t-test of `mean` against `reference`, given the standard error of the
@@ -114,11 +98,7 @@ pub fn welch(mean1: f64, se1: f64, n1: u64, mean2: f64, se2: f64, n2: u64) -> Te
             (n1 + n2 - 2) as f64
         }
     };
-    let se = if se1 < 0.0 || se2 < 0.0 {
-        f64::NAN
-    } else {
-        (v1 + v2).sqrt()
-    };
+    let se = if se1 < 0.0 || se2 < 0.0 { f64::NAN } else { (v1 + v2).sqrt() };
     let mut out = outcome(mean1 - mean2, se, dof, |t| two_sided_t(t, dof));
     if small {
         out.p_value = f64::NAN;
@@ -143,11 +123,7 @@ pub fn holm_bonferroni(p_values: &[f64]) -> Vec<f64> {
     for (rank, &i) in order.iter().enumerate() {
         let scaled = ((m - rank) as f64 * key(p_values[i])).min(1.0);
         running = running.max(scaled);
-        adjusted[i] = if p_values[i].is_nan() {
-            f64::NAN
-        } else {
-            running
-        };
+        adjusted[i] = if p_values[i].is_nan() { f64::NAN } else { running };
     }
     adjusted
 }
@@ -193,11 +169,7 @@ mod tests {
         let out = one_sample_t(3.0, 0.5, 11, 2.0);
         assert_eq!(out.statistic, 2.0);
         assert_eq!(out.dof, 10.0);
-        assert!(
-            close(out.p_value, 0.073_388_034_770_74, 1e-9),
-            "{}",
-            out.p_value
-        );
+        assert!(close(out.p_value, 0.073_388_034_770_74, 1e-9), "{}", out.p_value);
         // Sign does not matter for a two-sided test.
         let neg = one_sample_t(1.0, 0.5, 11, 2.0);
         assert_eq!(neg.statistic, -2.0);
@@ -234,11 +206,7 @@ mod tests {
         assert_eq!(out.dof, f64::INFINITY);
         // 2 * Phi(-37) = 1.1451e-299: representable, must not be 0.
         let deep = z_test(0.0, 1.0, 37.0);
-        assert!(
-            close(deep.p_value, 1.145_114e-299, 1e-5),
-            "{}",
-            deep.p_value
-        );
+        assert!(close(deep.p_value, 1.145_114e-299, 1e-5), "{}", deep.p_value);
         assert_eq!(z_test(1.0, 0.0, 1.0).p_value, 1.0);
         assert_eq!(z_test(1.0, 0.0, 0.0).p_value, 0.0);
     }
@@ -306,11 +274,7 @@ mod tests {
         let d = detectable_shift(2.0, 0.05, 0.8);
         assert!(close(d, 2.0 * 2.801_585_218_1, 1e-8), "{d}");
         // power = 0.5 leaves only the critical value.
-        assert!(close(
-            detectable_shift(1.0, 1e-3, 0.5),
-            3.290_526_731_5,
-            1e-8
-        ));
+        assert!(close(detectable_shift(1.0, 1e-3, 0.5), 3.290_526_731_5, 1e-8));
         assert!(detectable_shift(1.0, 0.0, 0.8).is_nan());
         assert!(detectable_shift(1.0, 0.05, 1.0).is_nan());
         // A bias of exactly that size is detected with about the stated power.

@@ -210,9 +210,7 @@ mod tests {
 
     #[test]
     fn moments_basic_values() {
-        let m: Moments = [2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0]
-            .into_iter()
-            .collect();
+        let m: Moments = [2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0].into_iter().collect();
         assert_eq!(m.count(), 8);
         assert_eq!(m.mean(), 5.0);
         assert!(rel(m.variance(), 32.0 / 7.0) < 1e-15);
@@ -232,18 +230,14 @@ mod tests {
     #[test]
     fn moments_stable_with_large_offset() {
         // Naive sum-of-squares would lose every digit here.
-        let m: Moments = [1e9 + 4.0, 1e9 + 7.0, 1e9 + 13.0, 1e9 + 16.0]
-            .into_iter()
-            .collect();
+        let m: Moments = [1e9 + 4.0, 1e9 + 7.0, 1e9 + 13.0, 1e9 + 16.0].into_iter().collect();
         assert!(rel(m.variance(), 30.0) < 1e-9, "{}", m.variance());
     }
 
     #[test]
     fn merge_equals_sequential_push() {
         let mut rng = Pcg64::seed_from_u64(0x5eed_0001);
-        let xs: Vec<f64> = (0..10_007)
-            .map(|_| 3.0 + rng.gen::<f64>().powi(3))
-            .collect();
+        let xs: Vec<f64> = (0..10_007).map(|_| 3.0 + rng.gen::<f64>().powi(3)).collect();
         let seq: Moments = xs.iter().copied().collect();
         let mut merged = Moments::new();
         for chunk in xs.chunks(997) {

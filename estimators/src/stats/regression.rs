@@ -35,11 +35,7 @@ impl SlopeFit {
 /// Validates that every value is finite, naming the first one that is not.
 fn check_finite(axis: &'static str, v: &[f64]) -> Result<(), StatsError> {
     match v.iter().position(|x| !x.is_finite()) {
-        Some(index) => Err(StatsError::NonFinite {
-            axis,
-            index,
-            value: v[index],
-        }),
+        Some(index) => Err(StatsError::NonFinite { axis, index, value: v[index] }),
         None => Ok(()),
     }
 }
@@ -51,11 +47,7 @@ fn check_finite(axis: &'static str, v: &[f64]) -> Result<(), StatsError> {
 /// Mismatched lengths, fewer than 3 points, a non-finite value, or all `x` equal.
 pub fn linear_fit(x: &[f64], y: &[f64]) -> Result<SlopeFit, StatsError> {
     if x.len() != y.len() {
-        return Err(StatsError::LengthMismatch {
-            what: "y",
-            left: y.len(),
-            right: x.len(),
-        });
+        return Err(StatsError::LengthMismatch { what: "y", left: y.len(), right: x.len() });
     }
     let n = x.len();
     if n < 3 {
@@ -88,24 +80,10 @@ pub fn linear_fit(x: &[f64], y: &[f64]) -> Result<SlopeFit, StatsError> {
         .sum();
     let dof = nf - 2.0;
     let slope_se = (sse / dof / sxx).sqrt();
-    let t = StudentsT::new(0.0, 1.0, dof)
-        .map(|d| d.inverse_cdf(0.975))
-        .unwrap_or(f64::NAN);
+    let t = StudentsT::new(0.0, 1.0, dof).map(|d| d.inverse_cdf(0.975)).unwrap_or(f64::NAN);
     let half = if slope_se == 0.0 { 0.0 } else { t * slope_se };
-    let r2 = if syy > 0.0 {
-        (1.0 - sse / syy).clamp(0.0, 1.0)
-    } else {
-        1.0
-    };
-    Ok(SlopeFit {
-        slope,
-        intercept,
-        slope_ci_low: slope - half,
-        slope_ci_high: slope + half,
-        slope_se,
-        r2,
-        points: n,
-    })
+    let r2 = if syy > 0.0 { (1.0 - sse / syy).clamp(0.0, 1.0) } else { 1.0 };
+    Ok(SlopeFit { slope, intercept, slope_ci_low: slope - half, slope_ci_high: slope + half, slope_se, r2, points: n })
 }
 
 /// Least squares of `ln y` on `ln x` (a power law `y = C x^slope`), as [`linear_fit`] on the logs.
@@ -114,24 +92,22 @@ pub fn linear_fit(x: &[f64], y: &[f64]) -> Result<SlopeFit, StatsError> {
 /// As [`linear_fit`], plus any `x` or `y` that is not `> 0` (named by axis and index).
 pub fn log_log_fit(x: &[f64], y: &[f64]) -> Result<SlopeFit, StatsError> {
     if x.len() != y.len() {
-        return Err(StatsError::LengthMismatch {
-            what: "y",
-            left: y.len(),
-            right: x.len(),
-        });
+        return Err(StatsError::LengthMismatch { what: "y", left: y.len(), right: x.len() });
     }
     check_finite("x", x)?;
     check_finite("y", y)?;
     let logs = |axis: &'static str, v: &[f64]| -> Result<Vec<f64>, StatsError> {
         v.iter()
             .enumerate()
-            .map(|(index, &value)| {
-                if value > 0.0 {
-                    Ok(value.ln())
-                } else {
-                    Err(StatsError::NonPositive { axis, index, value })
-                }
-            })
+            .map(
+                |(index, &value)| {
+                    if value > 0.0 {
+                        Ok(value.ln())
+                    } else {
+                        Err(StatsError::NonPositive { axis, index, value })
+                    }
+                },
+            )
             .collect()
     };
     linear_fit(&logs("x", x)?, &logs("y", y)?)
@@ -187,16 +163,10 @@ mod tests {
         let mut rng = Pcg64::seed_from_u64(0x10_6106);
         let noise = Normal::new(0.0, 0.05).unwrap();
         let x: Vec<f64> = (0..16).map(|i| 2f64.powf(4.0 + 0.5 * i as f64)).collect();
-        let y: Vec<f64> = x
-            .iter()
-            .map(|&v| 2.0 * v.powf(-0.5) * noise.sample(&mut rng).exp())
-            .collect();
+        let y: Vec<f64> = x.iter().map(|&v| 2.0 * v.powf(-0.5) * noise.sample(&mut rng).exp()).collect();
         let f = log_log_fit(&x, &y).unwrap();
         assert!(f.slope_ci_low < -0.5 && -0.5 < f.slope_ci_high, "{f:?}");
-        assert!(
-            f.slope_se > 0.0 && f.slope_ci_high - f.slope_ci_low < 0.1,
-            "{f:?}"
-        );
+        assert!(f.slope_se > 0.0 && f.slope_ci_high - f.slope_ci_low < 0.1, "{f:?}");
         assert!(f.r2 > 0.9 && f.r2 < 1.0, "{f:?}");
     }
 
@@ -209,10 +179,7 @@ mod tests {
         let trials = 4000;
         let covered = (0..trials)
             .filter(|_| {
-                let y: Vec<f64> = x
-                    .iter()
-                    .map(|&v| 1.0 - 0.7 * v + noise.sample(&mut rng))
-                    .collect();
+                let y: Vec<f64> = x.iter().map(|&v| 1.0 - 0.7 * v + noise.sample(&mut rng)).collect();
                 let f = linear_fit(&x, &y).unwrap();
                 f.slope_ci_low <= -0.7 && -0.7 <= f.slope_ci_high
             })
@@ -225,48 +192,22 @@ mod tests {
     #[test]
     fn errors_name_the_problem() {
         use StatsError::*;
-        assert!(matches!(
-            log_log_fit(&[1.0, 2.0], &[1.0, 2.0]),
-            Err(TooFewPoints { got: 2, needed: 3 })
-        ));
+        assert!(matches!(log_log_fit(&[1.0, 2.0], &[1.0, 2.0]), Err(TooFewPoints { got: 2, needed: 3 })));
         assert!(matches!(
             log_log_fit(&[1.0, 2.0, 0.0], &[1.0, 2.0, 3.0]),
-            Err(NonPositive {
-                axis: "x",
-                index: 2,
-                ..
-            })
+            Err(NonPositive { axis: "x", index: 2, .. })
         ));
         assert!(matches!(
             log_log_fit(&[1.0, 2.0, 3.0], &[1.0, -2.0, 3.0]),
-            Err(NonPositive {
-                axis: "y",
-                index: 1,
-                ..
-            })
+            Err(NonPositive { axis: "y", index: 1, .. })
         ));
         assert!(matches!(
             log_log_fit(&[1.0, 2.0, 3.0], &[1.0, f64::NAN, 3.0]),
-            Err(NonFinite {
-                axis: "y",
-                index: 1,
-                ..
-            })
+            Err(NonFinite { axis: "y", index: 1, .. })
         ));
-        assert!(matches!(
-            linear_fit(&[1.0, 2.0, 3.0], &[1.0, 2.0]),
-            Err(LengthMismatch { .. })
-        ));
-        assert!(matches!(
-            linear_fit(&[2.0, 2.0, 2.0], &[1.0, 2.0, 3.0]),
-            Err(DegenerateX)
-        ));
-        let msg = log_log_fit(&[1.0, 2.0, 3.0], &[1.0, 0.0, 3.0])
-            .unwrap_err()
-            .to_string();
-        assert!(
-            msg.contains("y value 0") && msg.contains("index 1"),
-            "{msg}"
-        );
+        assert!(matches!(linear_fit(&[1.0, 2.0, 3.0], &[1.0, 2.0]), Err(LengthMismatch { .. })));
+        assert!(matches!(linear_fit(&[2.0, 2.0, 2.0], &[1.0, 2.0, 3.0]), Err(DegenerateX)));
+        let msg = log_log_fit(&[1.0, 2.0, 3.0], &[1.0, 0.0, 3.0]).unwrap_err().to_string();
+        assert!(msg.contains("y value 0") && msg.contains("index 1"), "{msg}");
     }
 }

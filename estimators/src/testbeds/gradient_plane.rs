@@ -23,6 +23,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     provides: Needs::SURFACE,
     summary: "Phong plane under a gradient sky, pinhole 32x32, exact reference (paper 001 §5)",
     build: |variant, params| Ok(Box::new(GradientPlane::new(variant, params)?)),
+    compute_reference: None,
 };
 
 /// Relative tolerance of the glossy quadrature (the test bed promises 1e-9).
@@ -169,7 +170,15 @@ mod tests {
 
     #[test]
     fn bad_variant_and_resolution_are_refused_naming_the_field() {
-        assert!(GradientPlane::new("shiny", &Params::new()).err().unwrap().to_string().contains("gradient-plane/shiny"));
-        assert!(GradientPlane::new("default", &Params::new().with("resolution", 0.0)).err().unwrap().to_string().contains("resolution"));
+        assert!(GradientPlane::new("shiny", &Params::new())
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("gradient-plane/shiny"));
+        assert!(GradientPlane::new("default", &Params::new().with("resolution", 0.0))
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("resolution"));
     }
 }

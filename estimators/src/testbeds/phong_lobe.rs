@@ -66,15 +66,7 @@ impl Lobe {
         let sr = r.x.hypot(r.y);
         let ux = if sr > 0.0 { -r.z * r.x / sr } else { 1.0 };
         let norm = (n + 2.0) / (2.0 * PI);
-        Some(Lobe {
-            rx: r.x,
-            rz: r.z,
-            sr,
-            e: r.z.atan2(sr),
-            ux,
-            n,
-            norm,
-        })
+        Some(Lobe { rx: r.x, rz: r.z, sr, e: r.z.atan2(sr), ux, n, norm })
     }
 
     /// `(n + 2)/(2 pi) cos(a)^n sin(a)` (zero from `a = pi/2` on).
@@ -99,9 +91,7 @@ impl Lobe {
         [
             ca * rz * s[0] + sa * sr * s[1],
             ca * ca * rz * rz * s[0] + 2.0 * ca * sa * rz * sr * s[1] + sa * sa * sr * sr * s[2],
-            ca * ca * rx * rz * s[0]
-                + ca * sa * (rx * sr + ux * rz) * s[1]
-                + sa * sa * ux * sr * s[2],
+            ca * ca * rx * rz * s[0] + ca * sa * (rx * sr + ux * rz) * s[1] + sa * sa * ux * sr * s[2],
         ]
     }
 
@@ -119,11 +109,8 @@ impl Lobe {
             return [0.0; 3];
         }
         // 1 + cos P = sin(a - e) / d and 1 - cos P = sin(a + e) / d.
-        let (sm, sp) = if self.e >= 0.0 {
-            (delta.sin(), (a + self.e).sin())
-        } else {
-            ((a - self.e).sin(), delta.sin())
-        };
+        let (sm, sp) =
+            if self.e >= 0.0 { (delta.sin(), (a + self.e).sin()) } else { ((a - self.e).sin(), delta.sin()) };
         let c = (-self.rz * ca / d).clamp(-1.0, 1.0);
         let sin_p = ((sm / d).max(0.0) * (sp / d).max(0.0)).sqrt().min(1.0);
         let p = sin_p.atan2(c);
@@ -173,34 +160,12 @@ impl Lobe {
 /// non-finite `n` gives NaN moments with an infinite `error`.
 pub fn clipped_lobe_moments(r: Vec3, n: f64, rel_tol: f64) -> LobeMoments {
     let Some(lobe) = Lobe::new(r, n) else {
-        return LobeMoments {
-            i0: f64::NAN,
-            iz: f64::NAN,
-            ix: f64::NAN,
-            error: f64::INFINITY,
-        };
+        return LobeMoments { i0: f64::NAN, iz: f64::NAN, ix: f64::NAN, error: f64::INFINITY };
     };
-    let q = gauss_kronrod_multi(
-        |t| lobe.integrand(t),
-        &lobe.breaks(),
-        f64::MIN_POSITIVE,
-        rel_tol,
-        MAX_DEPTH,
-    );
+    let q = gauss_kronrod_multi(|t| lobe.integrand(t), &lobe.breaks(), f64::MIN_POSITIVE, rel_tol, MAX_DEPTH);
     // Maximum that propagates NaN (`f64::max` alone would drop it).
-    let error = q.error.iter().fold(0.0, |m: f64, &e| {
-        if m.is_nan() || e.is_nan() {
-            f64::NAN
-        } else {
-            m.max(e)
-        }
-    });
-    LobeMoments {
-        i0: q.value[0],
-        iz: q.value[1],
-        ix: q.value[2],
-        error,
-    }
+    let error = q.error.iter().fold(0.0, |m: f64, &e| if m.is_nan() || e.is_nan() { f64::NAN } else { m.max(e) });
+    LobeMoments { i0: q.value[0], iz: q.value[1], ix: q.value[2], error }
 }
 
 #[cfg(test)]
@@ -254,23 +219,12 @@ mod tests {
         let b = brute(r, n);
         let got = [m.i0, m.iz, m.ix];
         let dev = (0..3).fold(0.0f64, |d, k| d.max((got[k] - b[k]).abs()));
-        eprintln!(
-            "r {r:?} n {n}: {m:?}, max |quad - brute| / i0 = {:.2e}",
-            dev / m.i0
-        );
+        eprintln!("r {r:?} n {n}: {m:?}, max |quad - brute| / i0 = {:.2e}", dev / m.i0);
         for k in 0..3 {
             let dev = (got[k] - b[k]).abs() / m.i0;
-            assert!(
-                dev <= 1e-9,
-                "r {r:?} n {n} moment {k}: {} vs brute {} (rel {dev:e})",
-                got[k],
-                b[k]
-            );
+            assert!(dev <= 1e-9, "r {r:?} n {n} moment {k}: {} vs brute {} (rel {dev:e})", got[k], b[k]);
         }
-        assert!(
-            m.i0.is_finite() && m.i0 > 0.0 && m.error <= 1e-9 * m.i0,
-            "{m:?}"
-        );
+        assert!(m.i0.is_finite() && m.i0 > 0.0 && m.error <= 1e-9 * m.i0, "{m:?}");
         m
     }
 
@@ -284,21 +238,11 @@ mod tests {
         for n in [0.0, 1.0, 20.0, 200.0, 10000.0, 1e6] {
             let m = clipped_lobe_moments(Vec3::Z, n, DEFAULT_REL_TOL);
             let iz = (n + 2.0) / (n + 3.0);
-            eprintln!(
-                "n {n}: {m:?}, |i0 - 1| {:.1e}, |iz - exact| {:.1e}",
-                (m.i0 - 1.0).abs(),
-                (m.iz - iz).abs()
-            );
+            eprintln!("n {n}: {m:?}, |i0 - 1| {:.1e}, |iz - exact| {:.1e}", (m.i0 - 1.0).abs(), (m.iz - iz).abs());
             assert!((m.i0 - 1.0).abs() <= 1e-12, "n {n}: {m:?}");
-            assert!(
-                (m.iz - iz).abs() <= 1e-12 * iz && m.ix.abs() <= 1e-12,
-                "n {n}: {m:?}"
-            );
+            assert!((m.iz - iz).abs() <= 1e-12 * iz && m.ix.abs() <= 1e-12, "n {n}: {m:?}");
             assert!(m.error <= 1e-12 * m.i0, "n {n}: {m:?}");
-            assert!(
-                (m.i0 - 1.0).abs() <= m.error && (m.iz - iz).abs() <= m.error,
-                "n {n}: {m:?}"
-            );
+            assert!((m.i0 - 1.0).abs() <= m.error && (m.iz - iz).abs() <= m.error, "n {n}: {m:?}");
         }
     }
 
@@ -310,16 +254,9 @@ mod tests {
             let n = 10000.0;
             let (alpha, beta) = ((n + 2.0) / (n + 3.0), (n + 2.0) / ((n + 1.0) * (n + 3.0)));
             let m = clipped_lobe_moments(r, n, DEFAULT_REL_TOL);
-            let exact = [
-                r.z,
-                alpha * r.z * r.z + beta * (1.0 - r.z * r.z),
-                (alpha - beta) * r.x * r.z,
-            ];
+            let exact = [r.z, alpha * r.z * r.z + beta * (1.0 - r.z * r.z), (alpha - beta) * r.x * r.z];
             for (got, want) in [m.i0, m.iz, m.ix].into_iter().zip(exact) {
-                assert!(
-                    (got - want).abs() <= 1e-12 * m.i0 && (got - want).abs() <= m.error,
-                    "{m:?}"
-                );
+                assert!((got - want).abs() <= 1e-12 * m.i0 && (got - want).abs() <= m.error, "{m:?}");
             }
         }
     }

@@ -6,7 +6,7 @@
 
 mod draw;
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 use crate::error::{HarnessError, Result};
 use crate::metrics::SummaryRow;
@@ -45,10 +45,8 @@ impl PlotKind {
 
 /// Replaces every character other than ASCII letters, digits, `-` and `_` with `_`.
 pub fn sanitize(name: &str) -> String {
-    let s: String = name
-        .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
-        .collect();
+    let s: String =
+        name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect();
     if s.is_empty() {
         "_".to_string()
     } else {

@@ -97,6 +97,7 @@ pub(crate) fn synthetic_report() -> RunReport {
         unavailable: vec!["brdf_is1_cv2".into()],
         rows,
         labels: vec![("is0_cv0".into(), "MCMC (independent MC)".into()), ("is1_cv2".into(), "IS1 + CV2".into())],
+        diagnostics: Vec::new(),
     }
 }
 

@@ -9,7 +9,14 @@ pub fn fit<'a>(report: &'a RunReport, testbed: &str, variant: &str, estimator: &
 }
 
 fn not_measured(testbed: &str, claim: &str, paper: f64, why: String) -> Claim {
-    Claim { testbed: testbed.into(), claim: claim.into(), paper_value: Some(paper), our_value: None, held: None, note: why }
+    Claim {
+        testbed: testbed.into(),
+        claim: claim.into(),
+        paper_value: Some(paper),
+        our_value: None,
+        held: None,
+        note: why,
+    }
 }
 
 /// "Estimator X converges with slope `paper`": held when our 95% CI contains the paper's slope.
@@ -42,7 +49,13 @@ pub fn slope_steeper(report: &RunReport, tb: (&str, &str), estimator: &str, pape
                 "held if the 95% CI [{:.3}, {:.3}] lies below -0.5; the paper's {paper} is {} our CI",
                 f.slope_ci_low,
                 f.slope_ci_high,
-                if paper < f.slope_ci_low { "steeper than" } else if paper > f.slope_ci_high { "shallower than" } else { "inside" }
+                if paper < f.slope_ci_low {
+                    "steeper than"
+                } else if paper > f.slope_ci_high {
+                    "shallower than"
+                } else {
+                    "inside"
+                }
             ),
         },
     }
@@ -53,7 +66,12 @@ pub fn slope_steeper(report: &RunReport, tb: (&str, &str), estimator: &str, pape
 pub fn speedup_claim(report: &RunReport, tb: (&str, &str), estimator: &str, paper: f64, claim: &str) -> Claim {
     let s = report.speedups.iter().find(|s| s.testbed == tb.0 && s.variant == tb.1 && s.estimator == estimator);
     match s {
-        None => not_measured(tb.0, claim, paper, format!("no speed-up for {estimator} (not available, skipped, or no baseline fit)")),
+        None => not_measured(
+            tb.0,
+            claim,
+            paper,
+            format!("no speed-up for {estimator} (not available, skipped, or no baseline fit)"),
+        ),
         Some(s) => Claim {
             testbed: format!("{}/{}", tb.0, tb.1),
             claim: claim.into(),

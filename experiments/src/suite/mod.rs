@@ -2,7 +2,10 @@
 //! paper's claims, which are judged against what the run measured.
 
 pub mod claims;
+pub mod particle_sweep;
 pub mod surface_smc;
+pub mod transmittance;
+pub mod variance_claims;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};
 use crate::output::{Claim, RunReport};
@@ -26,7 +29,7 @@ pub struct ExperimentDef {
 }
 
 /// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF];
+pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF, &transmittance::DEF, &particle_sweep::DEF];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {
@@ -49,7 +52,6 @@ pub fn available(ids: &[&str]) -> (Vec<EstimatorSpec>, Vec<String>) {
     }
     (have, missing)
 }
-
 
 impl ExperimentDef {
     /// The ids this experiment names that are not registered yet.

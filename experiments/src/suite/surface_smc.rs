@@ -8,7 +8,15 @@ use estimators::params::Params;
 
 /// Every id the experiment runs (those not registered yet are reported as unavailable).
 pub const IDS: &[&str] = &[
-    "is0_cv0", "is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1", "is1_cv2", "brdf_is0_cv0", "brdf_is1_cv2", "clamped_is0_cv0",
+    "is0_cv0",
+    "is0_cv1",
+    "is0_cv2",
+    "is1_cv0",
+    "is1_cv1",
+    "is1_cv2",
+    "brdf_is0_cv0",
+    "brdf_is1_cv2",
+    "clamped_is0_cv0",
 ];
 
 /// Definition.
@@ -28,16 +36,43 @@ fn sweep(mode: Mode) -> Sweep {
         Mode::Quick => (vec![bed("default")], powers_of_four(1..=6), 16),
         Mode::Full => (vec![bed("default"), bed("stiff")], powers_of_four(1..=7), 32),
     };
-    Sweep { experiment: DEF.name.into(), testbeds, estimators, budgets, reps, seed: 1, mode, baseline: Some("is0_cv0".into()) }
+    Sweep {
+        experiment: DEF.name.into(),
+        testbeds,
+        estimators,
+        budgets,
+        reps,
+        seed: 1,
+        mode,
+        baseline: Some("is0_cv0".into()),
+    }
 }
 
 fn claims(r: &RunReport) -> Vec<Claim> {
     let tb = ("gradient-plane", "default");
     vec![
-        claims::slope_matches(r, tb, "is0_cv0", -0.5, "paper 001 Fig. 4: independent MC (is0_cv0) converges with slope -0.5"),
-        claims::slope_matches(r, tb, "brdf_is0_cv0", -0.5, "paper 001 Fig. 4: BRDF sampling without cache converges with slope -0.5"),
+        claims::slope_matches(
+            r,
+            tb,
+            "is0_cv0",
+            -0.5,
+            "paper 001 Fig. 4: independent MC (is0_cv0) converges with slope -0.5",
+        ),
+        claims::slope_matches(
+            r,
+            tb,
+            "brdf_is0_cv0",
+            -0.5,
+            "paper 001 Fig. 4: BRDF sampling without cache converges with slope -0.5",
+        ),
         claims::slope_steeper(r, tb, "is1_cv2", -0.94, "paper 001 §5: is1_cv2 reaches slope -0.94"),
-        claims::speedup_claim(r, tb, "is1_cv2", 77.0, "paper 001 §5: is1_cv2 is 77x faster than independent MC at equal time (138x samples, 1.79x overhead)"),
+        claims::speedup_claim(
+            r,
+            tb,
+            "is1_cv2",
+            77.0,
+            "paper 001 §5: is1_cv2 is 77x faster than independent MC at equal time (138x samples, 1.79x overhead)",
+        ),
         claims::control_flagged(r, "clamped_is0_cv0"),
     ]
 }
