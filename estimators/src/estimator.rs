@@ -70,4 +70,11 @@ pub trait Estimator: Send + Sync {
     fn supports(&self, _bed: &dyn TestBed) -> Result<(), String> {
         Ok(())
     }
+
+    /// Whether this configuration is *valid* on `bed` (e.g. a terminating particle model whose
+    /// sampling density makes `r > 2/(a+1)` somewhere): an error here is bad input (exit 2), not a
+    /// skipped pair, because the user asked for something that cannot be computed.
+    fn validate(&self, _bed: &dyn TestBed) -> Result<(), crate::error::ConfigError> {
+        Ok(())
+    }
 }

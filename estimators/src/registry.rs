@@ -42,7 +42,15 @@ pub struct TestBedEntry {
     pub summary: &'static str,
     /// Builds a variant (computes or loads its reference).
     pub build: BuildTestBed,
+    /// Computes a stored long-run reference for a variant (`mcbench reference`), for variants
+    /// without a closed form; `None` when every variant is exact.
+    pub compute_reference: Option<ComputeReference>,
 }
+
+/// Computes a stored reference: `(variant, params, worker threads)` to a reference whose kind is
+/// [`crate::testbed::ReferenceKind::Stored`], plus the resolution it was computed at.
+pub type ComputeReference =
+    fn(&str, &Params, usize) -> Result<(crate::testbed::Reference, (usize, usize)), ConfigError>;
 
 /// Every registered estimator.
 pub static ESTIMATORS: &[&EstimatorEntry] = &[
@@ -64,6 +72,16 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::pmc::mis::ENTRY,
     &crate::pmc::hi::ENTRY,
     &crate::pmc::hi::FEEDBACK,
+    &crate::tracking::ray_marching::ENTRY,
+    &crate::tracking::delta_tracking::ENTRY,
+    &crate::tracking::ratio_tracking::ENTRY,
+    &crate::tracking::residual_ratio_tracking::ENTRY,
+    &crate::tracking::double_particle::ENTRY,
+    &crate::tracking::single_particle::TERMINATING,
+    &crate::tracking::single_particle::NONTERMINATING,
+    &crate::tracking::spm::TERMINATING,
+    &crate::tracking::spm::NONTERMINATING,
+    &crate::tracking::spm::ADAPTIVE,
 ];
 
 /// Every registered test bed.
@@ -71,6 +89,8 @@ pub static TESTBEDS: &[&TestBedEntry] = &[
     &crate::testbeds::gradient_plane::ENTRY,
     &crate::testbeds::envmap_sequence::ENTRY,
     &crate::testbeds::checker::ENTRY,
+    &crate::media::EQ21,
+    &crate::media::PERLIN,
 ];
 
 /// Looks an estimator up by id.

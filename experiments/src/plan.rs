@@ -97,7 +97,11 @@ impl Plan {
                             .then(|| "a fetch budget needs a test bed with a medium".to_string())
                     });
                 match reason {
-                    None => pairs.push((bi, ei)),
+                    None => {
+                        // An invalid configuration (not merely an unsupported pair) is bad input.
+                        e.estimator.validate(b.bed.as_ref())?;
+                        pairs.push((bi, ei))
+                    }
                     Some(reason) => skipped.push(Skipped {
                         testbed: b.spec.id.clone(),
                         variant: b.variant.clone(),

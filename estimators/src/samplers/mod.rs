@@ -5,8 +5,10 @@
 
 pub mod cone;
 pub mod cosine_hemisphere;
+pub mod free_flight;
 pub mod mixture;
 pub mod phong_lobe;
+pub mod rayleigh;
 pub mod rect_light;
 pub mod testing;
 pub mod uniform_hemisphere;

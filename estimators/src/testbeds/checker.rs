@@ -36,6 +36,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     summary:
         "checkerboard of diffuse/glossy squares under two area lights, direct lighting (paper 003 Fig. 6, Table 2)",
     build: |variant, params| Ok(Box::new(CheckerDirect::new(variant, params)?)),
+    compute_reference: None,
 };
 
 /// The axis-aligned opaque square of the `occluded` variant: `[x0, x1] x [y0, y1]` at height `z`.

@@ -5,8 +5,11 @@ pub mod claims;
 pub mod envmap_smc;
 pub mod envmap_smc_post;
 pub mod envmap_unbiasedness;
+pub mod particle_sweep;
 pub mod pmc_hi;
 pub mod surface_smc;
+pub mod transmittance;
+pub mod variance_claims;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};
 use crate::output::{Claim, RunReport};
@@ -40,7 +43,8 @@ pub struct ExperimentDef {
 pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &Path, Option<&Path>) -> crate::error::Result<Vec<PathBuf>>;
 
 /// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF, &pmc_hi::DEF, &envmap_smc::DEF];
+pub static EXPERIMENTS: &[&ExperimentDef] =
+    &[&surface_smc::DEF, &transmittance::DEF, &particle_sweep::DEF, &pmc_hi::DEF, &envmap_smc::DEF];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {

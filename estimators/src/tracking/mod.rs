@@ -1,0 +1,158 @@
+//! Null-collision and particle-model estimators of paper 002 (SPEC §4.2): transmittance trackers
+//! (ray marching, delta, ratio, residual ratio, double and single particle models) and particle
+//! tracing of multiple scattering (`spm_*`).
+//!
+//! Every medium access goes through the counted [`MediumProbe`]: one extinction evaluation is one
+//! fetch, one ray or path is one sample.
+
+pub mod delta_tracking;
+pub mod double_particle;
+pub mod ratio_tracking;
+pub mod ray_marching;
+pub mod residual_ratio_tracking;
+pub mod single_particle;
+pub mod spm;
+
+use crate::accumulate::RgbMean;
+use crate::error::{ConfigError, EstimateError};
+use crate::math::Rgb;
+use crate::params::Params;
+use crate::rng::StreamRng;
+use crate::samplers::free_flight::SamplingDensity;
+use crate::task::{MediumProbe, Task};
+use crate::testbed::{MediumQuantity, MediumRay, TestBed};
+use rand::Rng;
+
+/// How the weight of the transmitted particle changes at an interaction with
+/// `r = sigma_diff / sigma_samp` (paper 002 §3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Rule {
+    /// Double particle model, Eq. 8 (ratio tracking when sigma_samp is a constant majorant):
+    /// `E *= 1 - r`, any sign of `r`.
+    Double,
+    /// Woodcock / delta tracking: terminate with probability `r` (needs `0 <= r <= 1`).
+    Delta,
+    /// Single particle model, terminating (Eq. 9 with `q_scat = a r`, `q_tran = |1 - r|`); a
+    /// scattered or absorbed particle leaves the ray (weight 0). Valid for `0 <= r <= 2/(a+1)`.
+    Terminating {
+        /// Albedo.
+        a: f64,
+    },
+    /// Single particle model, non-terminating (Eq. 12 probabilities), any `r`.
+    NonTerminating {
+        /// Albedo.
+        a: f64,
+    },
+}
+
+/// Applies `rule` once: the factor the transmitted weight is multiplied by (0 = the particle left).
+pub fn interact(rule: Rule, r: f64, xi: f64) -> Result<f64, EstimateError> {
+    match rule {
+        Rule::Double => Ok(1.0 - r),
+        Rule::Delta => {
+            if !(0.0..=1.0).contains(&r) {
+                return Err(EstimateError::Refused(format!(
+                    "delta tracking needs a majorant, but sigma_t / sigma_samp = {r}"
+                )));
+            }
+            Ok(if xi < r { 0.0 } else { 1.0 })
+        }
+        Rule::Terminating { a } => {
+            if r < 0.0 || r > 2.0 / (a + 1.0) {
+                return Err(EstimateError::Refused(format!(
+                    "terminating single-particle model invalid at r = {r} (needs 0 <= r <= 2/(a+1) = {})",
+                    2.0 / (a + 1.0)
+                )));
+            }
+            let q_tran = (1.0 - r).abs();
+            Ok(if xi < q_tran { (1.0 - r) / q_tran } else { 0.0 })
+        }
+        Rule::NonTerminating { a } => {
+            let q_tran = (1.0 - r).abs() / (a * r.abs() + (1.0 - r).abs());
+            Ok(if q_tran > 0.0 && xi < q_tran { (1.0 - r) / q_tran } else { 0.0 })
+        }
+    }
+}
+
+/// The paper's `Transmittance` algorithm (§4.2) on `[t0, t1]` of `ray` for the difference
+/// extinction `sigma_t - main(t)`: free flights from `samp` (Eq. 4), `rule` at each interaction.
+/// Returns the weight of the transmitted particle (multiply by the main part's transmittance).
+#[allow(clippy::too_many_arguments)] // the tracker loop of paper 002 Alg. 1: probe, ray, segment, densities, weights, callbacks
+pub fn track(
+    probe: &MediumProbe<'_>,
+    ray: &MediumRay,
+    (t0, t1): (f64, f64),
+    samp: &SamplingDensity,
+    main: Option<&SamplingDensity>,
+    rule: Rule,
+    rng: &mut StreamRng,
+    mut seen: impl FnMut(f64),
+) -> Result<f64, EstimateError> {
+    let (mut e, mut s) = (1.0, t0);
+    loop {
+        s = samp.sample(s, rng.gen::<f64>());
+        if s >= t1 {
+            return Ok(e);
+        }
+        let sigma_diff = probe.sigma_t(ray.origin + ray.dir * s) - main.map_or(0.0, |m| m.eval(s));
+        seen(sigma_diff);
+        e *= interact(rule, sigma_diff / samp.eval(s), rng.gen::<f64>())?;
+        if e == 0.0 {
+            return Ok(0.0);
+        }
+    }
+}
+
+/// The medium segment `[t0, t1]` of a transmittance integral (None: the ray misses it).
+pub fn segment(probe: &MediumProbe<'_>) -> Option<(f64, f64)> {
+    let ray = probe.ray();
+    probe.clip(ray.origin, ray.dir).map(|(a, b)| (a, b.min(ray.length))).filter(|(a, b)| b > a)
+}
+
+/// Runs a transmittance estimator: averages `one()` over rays while the budget lasts and
+/// multiplies by the integral's weight. A ray that misses the medium is exact (T = 1) and costs
+/// one sample, so no estimator can loop on it. Refuses radiance integrals.
+pub fn transmittance(
+    task: &Task<'_>,
+    rng: &mut StreamRng,
+    mut one: impl FnMut(&MediumProbe<'_>, (f64, f64), &mut StreamRng) -> Result<f64, EstimateError>,
+) -> Result<Rgb, EstimateError> {
+    let probe = task.medium().ok_or_else(|| EstimateError::Refused("the test bed has no medium".into()))?;
+    let MediumQuantity::Transmittance { weight } = probe.ray().quantity else {
+        return Err(EstimateError::Refused("a transmittance estimator cannot estimate scattered radiance".into()));
+    };
+    let Some(seg) = segment(&probe) else {
+        probe.start_sample();
+        return Ok(weight);
+    };
+    let mut mean = RgbMean::new();
+    while task.more() {
+        probe.start_sample();
+        mean.push(Rgb::splat(one(&probe, seg, rng)?));
+    }
+    Ok(weight * mean.mean().0[0])
+}
+
+/// A positive finite `sigma_samp` parameter (`None` when absent).
+pub fn sigma_samp_param(p: &Params, owner: &str) -> Result<Option<f64>, ConfigError> {
+    if !p.0.contains_key("sigma_samp") {
+        return Ok(None);
+    }
+    let v = p.f64("sigma_samp", 1.0)?;
+    if v <= 0.0 {
+        return Err(ConfigError::invalid(format!("{owner}.sigma_samp"), v, "must be > 0"));
+    }
+    Ok(Some(v))
+}
+
+/// Refuses (as a skipped pair) test beds whose integrals are not transmittances.
+pub fn supports_transmittance(bed: &dyn TestBed) -> Result<(), String> {
+    match bed.medium() {
+        Some(m) if matches!(m.ray(0).quantity, MediumQuantity::Transmittance { .. }) => Ok(()),
+        Some(_) => Err("a transmittance estimator; this variant asks for scattered radiance".into()),
+        None => Err("needs a medium".into()),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,61 @@
+//! `ray_marching`: the biased control (paper 002 §2): `T = exp(-h sum sigma_t(t_j))` with a fixed
+//! step `h` (parameter `step`, default 0.9 as in paper 002 Fig. 9) and one random offset per ray.
+//! Under a fetch budget, one ray spends the whole budget: `N = budget` equal steps. Biased by
+//! construction (Jensen: E[exp(-X)] > exp(-E[X])).
+
+use super::{supports_transmittance, transmittance};
+use crate::budget::BudgetKind;
+use crate::error::{ConfigError, EstimateError};
+use crate::estimator::{Bias, Estimator};
+use crate::math::Rgb;
+use crate::registry::EstimatorEntry;
+use crate::rng::StreamRng;
+use crate::task::Task;
+use crate::testbed::{Needs, TestBed};
+use rand::Rng;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "ray_marching",
+    paper: "002",
+    label: "ray marching (biased control)",
+    bias: Bias::Biased,
+    needs: Needs::MEDIUM,
+    summary: "biased control: fixed-step ray marching of the optical depth (step 0.9; one ray = the fetch budget)",
+    build: |p| {
+        p.reject_unknown("ray_marching", &["step"])?;
+        let step = p.f64("step", 0.9)?;
+        if step <= 0.0 {
+            return Err(ConfigError::invalid("ray_marching.step", step, "must be > 0"));
+        }
+        Ok(Box::new(RayMarching { step }))
+    },
+};
+
+/// The estimator.
+pub struct RayMarching {
+    /// Step length under a sample budget.
+    pub step: f64,
+}
+
+impl Estimator for RayMarching {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let budget = task.budget();
+        transmittance(task, rng, |probe, (t0, t1), rng| {
+            let len = t1 - t0;
+            let n = match budget.kind {
+                BudgetKind::Fetches => budget.amount.max(1) as f64,
+                _ => (len / self.step).ceil().max(1.0),
+            };
+            let h = len / n;
+            let u: f64 = rng.gen();
+            let ray = *probe.ray();
+            let tau: f64 =
+                (0..n as u64).map(|j| probe.sigma_t(ray.origin + ray.dir * (t0 + (j as f64 + u) * h))).sum::<f64>() * h;
+            Ok((-tau).exp())
+        })
+    }
+    fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
+        supports_transmittance(bed)
+    }
+}

@@ -1,0 +1,91 @@
+//! Transmittance by the Single Particle Model of paper 002 (Eq. 9, §3.3) with a constant
+//! `sigma_samp` (parameter, default 1): the particle keeps only one offspring; on the ray's
+//! transmittance only the transmitted one counts (a scattered or absorbed particle scores 0).
+//! - `single_particle_terminating`: `q_scat = a r`, `q_tran = |1 - r|`; valid only for
+//!   `0 <= r <= 2/(a+1)`: configurations whose declared majorant allows a larger `r` are refused
+//!   before the run (`ConfigError`, exit 2), and an `r` out of range met at run time is refused.
+//! - `single_particle_nonterminating`: Eq. 12 probabilities, any `r`.
+
+use super::{sigma_samp_param, supports_transmittance, track, transmittance, Rule};
+use crate::error::{ConfigError, EstimateError};
+use crate::estimator::{Bias, Estimator};
+use crate::math::Rgb;
+use crate::registry::EstimatorEntry;
+use crate::rng::StreamRng;
+use crate::samplers::free_flight::SamplingDensity;
+use crate::task::Task;
+use crate::testbed::{Needs, TestBed};
+
+/// `single_particle_terminating` registry entry.
+pub static TERMINATING: EstimatorEntry = EstimatorEntry {
+    id: "single_particle_terminating",
+    paper: "002",
+    label: "single particle, terminating",
+    bias: Bias::Unbiased,
+    needs: Needs::MEDIUM,
+    summary: "single particle model, terminating (Eq. 9, 19): refuses r > 2/(a+1) or r < 0",
+    build: |p| build(p, "single_particle_terminating", true),
+};
+
+/// `single_particle_nonterminating` registry entry.
+pub static NONTERMINATING: EstimatorEntry = EstimatorEntry {
+    id: "single_particle_nonterminating",
+    paper: "002",
+    label: "single particle, non-terminating",
+    bias: Bias::Unbiased,
+    needs: Needs::MEDIUM,
+    summary: "single particle model, non-terminating (Eq. 12, 20), any r",
+    build: |p| build(p, "single_particle_nonterminating", false),
+};
+
+fn build(p: &crate::params::Params, id: &str, terminating: bool) -> Result<Box<dyn Estimator>, ConfigError> {
+    p.reject_unknown(id, &["sigma_samp"])?;
+    Ok(Box::new(SingleParticle { sigma_samp: sigma_samp_param(p, id)?.unwrap_or(1.0), terminating }))
+}
+
+/// The estimator.
+pub struct SingleParticle {
+    /// Constant sampling extinction.
+    pub sigma_samp: f64,
+    /// Terminating (true) or non-terminating.
+    pub terminating: bool,
+}
+
+/// Refuses a terminating model whose `r` can exceed `2/(a+1)` (paper 002 §3.3).
+pub fn check_terminating(id: &str, sigma_samp: f64, bed: &dyn TestBed) -> Result<(), ConfigError> {
+    let Some(m) = bed.medium() else { return Ok(()) };
+    let (r_max, a) = (m.majorant() / sigma_samp, m.albedo());
+    if r_max > 2.0 / (a + 1.0) {
+        return Err(ConfigError::invalid(
+            format!("{id}.sigma_samp"),
+            sigma_samp,
+            format!(
+                "the terminating model is invalid on {}/{}: r = sigma_t/sigma_samp reaches {r_max:.4} > 2/(a+1) = {:.4} (albedo {a}); use sigma_samp >= {:.4} or the non-terminating model",
+                bed.id(),
+                bed.variant(),
+                2.0 / (a + 1.0),
+                m.majorant() * (a + 1.0) / 2.0
+            ),
+        ));
+    }
+    Ok(())
+}
+
+impl Estimator for SingleParticle {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        transmittance(task, rng, |probe, seg, rng| {
+            let a = probe.albedo();
+            let rule = if self.terminating { Rule::Terminating { a } } else { Rule::NonTerminating { a } };
+            track(probe, probe.ray(), seg, &SamplingDensity::constant(self.sigma_samp), None, rule, rng, |_| ())
+        })
+    }
+    fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
+        supports_transmittance(bed)
+    }
+    fn validate(&self, bed: &dyn TestBed) -> Result<(), ConfigError> {
+        if self.terminating {
+            check_terminating("single_particle_terminating", self.sigma_samp, bed)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,153 @@
+//! Particle tracing of multiple scattering under the environment light with the Single Particle
+//! Model (paper 002 §4.1, `SimulateParticle`): camera importons, constant `sigma_samp`
+//! (parameter, default 1), Rayleigh scattering, environment radiance collected on exit.
+//! `spm_terminating` (Eq. 9, `q_scat = a r`, `q_tran = |1 - r|`; refuses `r > 2/(a+1)`),
+//! `spm_nonterminating` (Eq. 12), `spm_adaptive` (non-terminating when `r < 1` or
+//! `q_scat + q_tran > 1`, terminating otherwise).
+
+use super::sigma_samp_param;
+use super::single_particle::check_terminating;
+use crate::accumulate::RgbMean;
+use crate::error::{ConfigError, EstimateError};
+use crate::estimator::{Bias, Estimator};
+use crate::math::Rgb;
+use crate::registry::EstimatorEntry;
+use crate::rng::StreamRng;
+use crate::samplers::rayleigh;
+use crate::task::{MediumProbe, Task};
+use crate::testbed::{MediumQuantity, Needs, TestBed};
+use rand::Rng;
+
+/// The collision rule of a particle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpmMode {
+    /// Eq. 9 with `q_scat = a r`, `q_tran = |1 - r|`.
+    Terminating,
+    /// Eq. 12 (normalised).
+    NonTerminating,
+    /// The paper's adaptive choice.
+    Adaptive,
+}
+
+/// One importon path from the integral's ray (`SimulateParticle`): its radiance estimate.
+pub fn trace(
+    probe: &MediumProbe<'_>,
+    sigma_samp: f64,
+    mode: SpmMode,
+    rng: &mut StreamRng,
+) -> Result<Rgb, EstimateError> {
+    let ray = *probe.ray();
+    let (mut pos, mut dir, mut e) = (ray.origin, ray.dir, 1.0f64);
+    let a = probe.albedo();
+    loop {
+        let Some((t0, t1)) = probe.clip(pos, dir) else { return Ok(probe.environment(dir) * e) };
+        let mut s = t0;
+        loop {
+            s += -(-rng.gen::<f64>()).ln_1p() / sigma_samp;
+            if s >= t1 {
+                return Ok(probe.environment(dir) * e);
+            }
+            let p = pos + dir * s;
+            let r = probe.sigma_t(p) / sigma_samp;
+            let (mut q_scat, mut q_tran) = (a * r, (1.0 - r).abs());
+            let q_sum = q_scat + q_tran;
+            let normalise = match mode {
+                SpmMode::Terminating => {
+                    if r < 0.0 || r > 2.0 / (a + 1.0) {
+                        return Err(EstimateError::Refused(format!("terminating model invalid at r = {r} > 2/(a+1)")));
+                    }
+                    false
+                }
+                SpmMode::NonTerminating => true,
+                SpmMode::Adaptive => r < 1.0 || q_sum > 1.0,
+            };
+            if normalise && q_sum > 0.0 {
+                q_scat /= q_sum;
+                q_tran /= q_sum;
+            }
+            let xi: f64 = rng.gen();
+            if xi < q_scat {
+                e *= a * r / q_scat;
+                pos = p;
+                dir = rayleigh::sample(dir, rng);
+                break;
+            } else if xi < q_scat + q_tran {
+                e *= (1.0 - r) / q_tran;
+            } else {
+                return Ok(Rgb::ZERO);
+            }
+        }
+    }
+}
+
+macro_rules! spm_entry {
+    ($name:ident, $id:literal, $label:literal, $mode:expr, $summary:literal) => {
+        #[doc = concat!("`", $id, "` registry entry.")]
+        pub static $name: EstimatorEntry = EstimatorEntry {
+            id: $id,
+            paper: "002",
+            label: $label,
+            bias: Bias::Unbiased,
+            needs: Needs::MEDIUM,
+            summary: $summary,
+            build: |p| {
+                p.reject_unknown($id, &["sigma_samp"])?;
+                Ok(Box::new(Spm { sigma_samp: sigma_samp_param(p, $id)?.unwrap_or(1.0), mode: $mode }))
+            },
+        };
+    };
+}
+
+spm_entry!(
+    TERMINATING,
+    "spm_terminating",
+    "SPM terminating",
+    SpmMode::Terminating,
+    "particle tracing, terminating single particle model (Eq. 9)"
+);
+spm_entry!(
+    NONTERMINATING,
+    "spm_nonterminating",
+    "SPM non-terminating",
+    SpmMode::NonTerminating,
+    "particle tracing, non-terminating single particle model (Eq. 12)"
+);
+spm_entry!(
+    ADAPTIVE,
+    "spm_adaptive",
+    "SPM adaptive (SimulateParticle)",
+    SpmMode::Adaptive,
+    "particle tracing, the paper's adaptive SimulateParticle"
+);
+
+/// A particle tracer.
+pub struct Spm {
+    /// Constant sampling extinction.
+    pub sigma_samp: f64,
+    /// Collision rule.
+    pub mode: SpmMode,
+}
+
+impl Estimator for Spm {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let probe = task.medium().ok_or_else(|| EstimateError::Refused("the test bed has no medium".into()))?;
+        let mut mean = RgbMean::new();
+        while task.more() {
+            probe.start_sample();
+            mean.push(trace(&probe, self.sigma_samp, self.mode, rng)?);
+        }
+        Ok(mean.mean())
+    }
+    fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
+        match bed.medium().map(|m| m.ray(0).quantity) {
+            Some(MediumQuantity::Radiance) => Ok(()),
+            _ => Err("particle tracing estimates scattered radiance; this variant is a transmittance".into()),
+        }
+    }
+    fn validate(&self, bed: &dyn TestBed) -> Result<(), ConfigError> {
+        if self.mode == SpmMode::Terminating {
+            check_terminating("spm_terminating", self.sigma_samp, bed)?;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,150 @@
+//! Unbiasedness (SPEC §6), refusal and stability (SPEC §10) tests of the trackers.
+
+use crate::budget::{Budget, BudgetKind};
+use crate::error::EstimateError;
+use crate::estimator::Estimator;
+use crate::media::{Field, MediumBed};
+use crate::params::Params;
+use crate::registry;
+use crate::rng::stream;
+use crate::stats::{holm_bonferroni, one_sample_t, welch, Moments};
+use crate::task::Task;
+use crate::testbed::TestBed;
+
+fn build(id: &str, p: Params) -> Box<dyn Estimator> {
+    (registry::estimator(id).unwrap().build)(&p).unwrap()
+}
+
+/// Smallest Holm-adjusted p-value of per-integral t-tests (reps estimates of `spp` rays each).
+fn holm_p(bed: &MediumBed, est: &dyn Estimator, reps: usize, spp: u64, seed: u64) -> f64 {
+    let mut ps = Vec::new();
+    for i in 0..bed.integrals() {
+        let mut m = Moments::default();
+        let mut rng = stream(seed + i as u64, "unbiased");
+        for _ in 0..reps {
+            let task = Task::new(bed, i, Budget::samples(spp).unwrap());
+            m.push(est.estimate(&task, &mut rng).unwrap()[0]);
+        }
+        let r = bed.reference().value[i][0];
+        if m.std_err() > 0.0 {
+            ps.push(one_sample_t(m.mean(), m.std_err(), m.count(), r).p_value);
+        } else {
+            assert!((m.mean() - r).abs() < 1e-12 * r.abs().max(1.0));
+        }
+    }
+    holm_bonferroni(&ps).into_iter().fold(1.0, f64::min)
+}
+
+/// Every unbiased transmittance estimator passes (Holm over the central ray's points, family-wise
+/// alpha 1e-3), including sigma_samp below the maximum extinction (not a majorant) and control
+/// variates with negative difference extinction; the coarse ray-marching control is flagged.
+#[test]
+fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
+    let eq21 = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 8.0)).unwrap();
+    let perlin = MediumBed::new(Field::Perlin, "central-ray", &Params::new().with("points", 4.0)).unwrap();
+    let s = |v: f64| Params::new().with("sigma_samp", v);
+    let cases: Vec<(&MediumBed, &str, Params)> = vec![
+        (&eq21, "delta_tracking", Params::new()),
+        (&eq21, "ratio_tracking", Params::new()),
+        (&eq21, "residual_ratio_tracking", Params::new()),
+        (&eq21, "double_particle", s(0.4)),
+        (&eq21, "double_particle", s(0.4).with("control", 1.0)),
+        (&eq21, "double_particle", s(3.0)),
+        (&eq21, "single_particle_nonterminating", s(0.5)),
+        (&eq21, "single_particle_terminating", s(0.9)),
+        (&perlin, "residual_ratio_tracking", Params::new()),
+        (&perlin, "double_particle", s(0.3).with("control", 1.0)),
+    ];
+    for (k, (bed, id, p)) in cases.into_iter().enumerate() {
+        let est = build(id, p.clone());
+        est.validate(bed).unwrap();
+        let p_value = holm_p(bed, est.as_ref(), 300, 8, 100 * k as u64);
+        assert!(p_value > 1e-3, "{id} {p:?} on {}: Holm p = {p_value:e}", bed.id());
+    }
+    let marching = build("ray_marching", Params::new().with("step", 2.5));
+    let p_value = holm_p(&eq21, marching.as_ref(), 300, 8, 7);
+    assert!(p_value < 1e-3, "ray marching not flagged: p = {p_value}");
+}
+
+/// The terminating model refuses r > 2/(a+1) (and delta tracking a non-majorant) before any
+/// run, naming the field; at run time an out-of-range r is refused, never silently used.
+#[test]
+fn invalid_terminating_configurations_are_refused() {
+    let bed = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 4.0)).unwrap();
+    for id in ["single_particle_terminating", "delta_tracking"] {
+        let err = build(id, Params::new().with("sigma_samp", 0.4)).validate(&bed).unwrap_err().to_string();
+        assert!(err.contains(&format!("{id}.sigma_samp")), "{err}");
+    }
+    let multiple =
+        MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("resolution", 4.0)).unwrap();
+    let err =
+        build("spm_terminating", Params::new().with("sigma_samp", 0.8)).validate(&multiple).unwrap_err().to_string();
+    assert!(err.contains("2/(a+1)"), "{err}");
+    assert!(build("spm_terminating", Params::new().with("sigma_samp", 1.0)).validate(&multiple).is_ok());
+    assert!(matches!(super::interact(super::Rule::Terminating { a: 0.7 }, -0.1, 0.5), Err(EstimateError::Refused(_))));
+    assert!(registry::estimator("double_particle")
+        .map(|e| (e.build)(&Params::new().with("sigma_samp", 0.0)).is_err())
+        .unwrap());
+}
+
+/// The particle models agree with delta tracking on a multiple-scattering pixel (Welch).
+#[test]
+fn particle_models_agree_with_delta_tracking() {
+    let bed = MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("resolution", 4.0)).unwrap();
+    let run = |id: &str, sigma: f64| {
+        let est = build(id, Params::new().with("sigma_samp", sigma));
+        let mut m = Moments::default();
+        let mut rng = stream(3, id);
+        for _ in 0..400 {
+            let task = Task::new(&bed, 5, Budget::samples(10).unwrap());
+            m.push(est.estimate(&task, &mut rng).unwrap()[1]);
+        }
+        m
+    };
+    let base = run("delta_tracking", 1.0);
+    for (id, sigma) in
+        [("spm_terminating", 1.5), ("spm_nonterminating", 0.5), ("spm_adaptive", 0.6), ("spm_adaptive", 2.0)]
+    {
+        let m = run(id, sigma);
+        let p = welch(m.mean(), m.std_err(), m.count(), base.mean(), base.std_err(), base.count()).p_value;
+        assert!(p > 1e-3, "{id} {sigma}: {} vs {} (p {p:e})", m.mean(), base.mean());
+    }
+}
+
+/// SPEC §10: extreme sampling densities, optical depth 1e4, rays that miss the medium, albedo 1
+/// with non-terminating weights: finite results (or a refusal), and no endless loop.
+#[test]
+fn stability_cases_are_finite() {
+    let short = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 200.0)).unwrap();
+    for sigma in [1e-6, 1e6] {
+        let est = build("double_particle", Params::new().with("sigma_samp", sigma));
+        let task = Task::new(&short, 0, Budget::samples(4).unwrap());
+        assert!(est.estimate(&task, &mut stream(1, "stab")).unwrap().is_finite());
+    }
+    let thick =
+        MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 2.0).with("scale", 1500.0)).unwrap();
+    assert!(thick.reference().value[1][0] == 0.0 || thick.reference().value[1][0] < 1e-300);
+    for id in ["ratio_tracking", "delta_tracking", "residual_ratio_tracking", "ray_marching"] {
+        let task = Task::new(&thick, 1, Budget::samples(2).unwrap());
+        assert!(build(id, Params::new()).estimate(&task, &mut stream(2, id)).unwrap().is_finite(), "{id}");
+    }
+    // The corner pixel's ray misses the sphere: exact, one sample, even under a fetch budget.
+    let image = MediumBed::new(Field::Eq21, "transmittance", &Params::new().with("resolution", 4.0)).unwrap();
+    for id in ["ratio_tracking", "residual_ratio_tracking", "ray_marching", "delta_tracking"] {
+        let task = Task::new(&image, 0, Budget::new(BudgetKind::Fetches, 10).unwrap());
+        let v = build(id, Params::new()).estimate(&task, &mut stream(4, id)).unwrap();
+        assert_eq!(v, image.reference().value[0], "{id}");
+        assert_eq!(task.costs().samples, 1);
+    }
+    let white = MediumBed::without_reference(
+        Field::Eq21,
+        "multiple",
+        &Params::new().with("resolution", 4.0).with("albedo", 1.0),
+    )
+    .unwrap();
+    let task = Task::new(&white, 5, Budget::samples(50).unwrap());
+    assert!(build("spm_nonterminating", Params::new().with("sigma_samp", 0.5))
+        .estimate(&task, &mut stream(5, "w"))
+        .unwrap()
+        .is_finite());
+}
