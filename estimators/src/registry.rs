@@ -42,7 +42,15 @@ pub struct TestBedEntry {
     pub summary: &'static str,
     /// Builds a variant (computes or loads its reference).
     pub build: BuildTestBed,
+    /// Computes a stored long-run reference for a variant (`mcbench reference`), for variants
+    /// without a closed form; `None` when every variant is exact.
+    pub compute_reference: Option<ComputeReference>,
 }
+
+/// Computes a stored reference: `(variant, params, worker threads)` to a reference whose kind is
+/// [`crate::testbed::ReferenceKind::Stored`], plus the resolution it was computed at.
+pub type ComputeReference =
+    fn(&str, &Params, usize) -> Result<(crate::testbed::Reference, (usize, usize)), ConfigError>;
 
 /// Every registered estimator.
 pub static ESTIMATORS: &[&EstimatorEntry] = &[

@@ -7,7 +7,7 @@ use crate::brdf::DirectionSample;
 use crate::budget::{Budget, BudgetKind};
 use crate::envmap::EnvFrame;
 use crate::math::{Rgb, Vec3};
-use crate::testbed::{EnvQuantity, EnvSequenceScene, HemisphereScene, ShadingPoint, TestBed};
+use crate::testbed::{EnvQuantity, EnvSequenceScene, HemisphereScene, MediumRay, MediumScene, ShadingPoint, TestBed};
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use std::cell::{Cell, RefCell};
@@ -25,6 +25,10 @@ pub struct Costs {
     /// Rays traced (incident-radiance queries, shadow rays, ...).
     pub rays: u64,
 }
+
+/// Under a fetch budget, an estimate also stops after `budget x FETCH_BUDGET_SAMPLE_CAP` samples
+/// (rays that fetch nothing cannot spend a fetch budget).
+pub const FETCH_BUDGET_SAMPLE_CAP: u64 = 64;
 
 /// One estimate of one integral under one budget.
 pub struct Task<'a> {
@@ -65,7 +69,11 @@ impl<'a> Task<'a> {
         let c = self.costs.get();
         match self.budget.kind {
             BudgetKind::Samples => c.samples < self.budget.amount,
-            BudgetKind::Fetches => c.fetches < self.budget.amount,
+            // A sample cap keeps a ray that fetches nothing (it misses the medium, or its free
+            // flights all leave it) from looping forever under a fetch budget.
+            BudgetKind::Fetches => {
+                c.fetches < self.budget.amount && c.samples < self.budget.amount.saturating_mul(FETCH_BUDGET_SAMPLE_CAP)
+            }
             BudgetKind::Micros => (self.started.elapsed().as_micros() as u64) < self.budget.amount,
         }
     }
@@ -86,6 +94,11 @@ impl<'a> Task<'a> {
     pub fn hemisphere(&self) -> Option<HemisphereProbe<'_>> {
         let scene = self.bed.hemisphere()?;
         Some(HemisphereProbe { point: scene.shading(self.integral), scene, task: self })
+    }
+    /// The counted medium probe of this integral, when the scene has a medium.
+    pub fn medium(&self) -> Option<MediumProbe<'_>> {
+        let scene = self.bed.medium()?;
+        Some(MediumProbe { ray: scene.ray(self.integral), scene, task: self })
     }
     /// The environment-sequence probe of this integral (frame `i % F` of pixel `i / F`), when the
     /// scene has one.
@@ -200,5 +213,61 @@ impl EnvProbe<'_> {
     /// The environment-map density of another frame.
     pub fn environment_pdf_in_frame(&self, frame: usize, wi: Vec3) -> f64 {
         self.scene.environment(frame).pdf(wi)
+    }
+}
+
+/// Counted access to a participating medium (paper 002): every extinction evaluation is one fetch,
+/// every approximate (cheap) evaluation one cheap fetch, every path or transmittance ray started
+/// one sample and one ray. Albedo, bounds and environment radiance come with the fetch or are
+/// scene constants and cost nothing extra.
+pub struct MediumProbe<'a> {
+    scene: &'a dyn MediumScene,
+    task: &'a Task<'a>,
+    ray: MediumRay,
+}
+
+impl MediumProbe<'_> {
+    /// The ray of this integral.
+    pub fn ray(&self) -> &MediumRay {
+        &self.ray
+    }
+    /// Starts one sample (a transmittance ray or a particle path): one sample and one ray.
+    pub fn start_sample(&self) {
+        self.task.count(|c| {
+            c.samples += 1;
+            c.rays += 1;
+        });
+    }
+    /// Real extinction at `p`: one fetch.
+    pub fn sigma_t(&self, p: Vec3) -> f64 {
+        self.task.count(|c| c.fetches += 1);
+        self.scene.sigma_t(p)
+    }
+    /// The approximate extinction at `p`: one cheap fetch when the scene has one, else one full
+    /// fetch of the real extinction.
+    pub fn sigma_approx(&self, p: Vec3) -> f64 {
+        match self.scene.sigma_approx(p) {
+            Some(v) => {
+                self.task.count(|c| c.cheap_fetches += 1);
+                v
+            }
+            None => self.sigma_t(p),
+        }
+    }
+    /// The majorant the scene declares.
+    pub fn majorant(&self) -> f64 {
+        self.scene.majorant()
+    }
+    /// The albedo.
+    pub fn albedo(&self) -> f64 {
+        self.scene.albedo()
+    }
+    /// Clips a ray to the medium's bounding volume (geometry only: free).
+    pub fn clip(&self, origin: Vec3, dir: Vec3) -> Option<(f64, f64)> {
+        self.scene.clip(origin, dir)
+    }
+    /// Environment radiance from direction `w` leaving the scene (free: analytic lighting).
+    pub fn environment(&self, w: Vec3) -> Rgb {
+        self.scene.environment(w)
     }
 }

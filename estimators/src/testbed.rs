@@ -88,6 +88,14 @@ pub struct Reference {
 }
 
 impl Reference {
+    /// A placeholder with no values (filled in by the test bed's constructor).
+    pub fn empty() -> Self {
+        Reference {
+            kind: ReferenceKind::Exact { method: String::new(), bound: 0.0 },
+            value: Vec::new(),
+            std_err: Vec::new(),
+        }
+    }
     /// True for closed-form or quadrature references.
     pub fn is_exact(&self) -> bool {
         matches!(self.kind, ReferenceKind::Exact { .. })
@@ -114,6 +122,56 @@ pub trait HemisphereScene: Send + Sync {
     fn shading(&self, i: usize) -> ShadingPoint;
     /// Radiance arriving at the shading point of integral `i` from direction `wi` (one ray).
     fn incident(&self, i: usize, wi: Vec3) -> Rgb;
+}
+
+/// What integral `i` of a medium scene asks for (SPEC §3.3-3.4).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MediumQuantity {
+    /// `weight * T(length)`: the transmittance from `origin` along `dir` over `[0, length]`, times
+    /// a known radiance (the environment behind the medium, or one for the central ray's T(s)).
+    Transmittance {
+        /// The factor multiplying the transmittance (per channel).
+        weight: Rgb,
+    },
+    /// The radiance arriving at `origin` from `-dir` (multiple scattering under the environment).
+    Radiance,
+}
+
+/// The ray of one medium integral: origin, unit direction, length and what is estimated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MediumRay {
+    /// Ray origin.
+    pub origin: Vec3,
+    /// Unit direction.
+    pub dir: Vec3,
+    /// Length of the segment `[0, length]` (transmittance integrals).
+    pub length: f64,
+    /// What is estimated.
+    pub quantity: MediumQuantity,
+}
+
+/// A participating-medium scene (paper 002): extinction, the bound it declares, albedo,
+/// environment radiance, and the ray of each integral. Estimators reach it only through the
+/// counted [`crate::task::MediumProbe`]: every `sigma_t` counts one fetch.
+pub trait MediumScene: Send + Sync {
+    /// Real extinction at `p` (the whole parameter stack: one fetch).
+    fn sigma_t(&self, p: Vec3) -> f64;
+    /// A cheap approximate extinction for control variates (counted as a cheap fetch), or `None`
+    /// when the scene has none (then explorers must pay full fetches).
+    fn sigma_approx(&self, _p: Vec3) -> Option<f64> {
+        None
+    }
+    /// The majorant the scene declares: `sigma_t <= majorant` everywhere.
+    fn majorant(&self) -> f64;
+    /// Single-scattering albedo (constant in these scenes).
+    fn albedo(&self) -> f64;
+    /// The ray parameters `[t0, t1]` where `origin + t dir` (unit `dir`, `t >= 0`) is inside the
+    /// medium's bounding volume, or `None` when the ray misses it.
+    fn clip(&self, origin: Vec3, dir: Vec3) -> Option<(f64, f64)>;
+    /// Environment radiance arriving from direction `w` (a unit vector leaving the scene).
+    fn environment(&self, w: Vec3) -> Rgb;
+    /// The ray of integral `i`.
+    fn ray(&self, i: usize) -> MediumRay;
 }
 
 /// A test bed (SPEC §2). Integrals are pixels in row-major order, `i = py * width + px`.
@@ -144,6 +202,10 @@ pub trait TestBed: Send + Sync {
     }
     /// The hemispherical-integral view of the scene, when it has one.
     fn hemisphere(&self) -> Option<&dyn HemisphereScene> {
+        None
+    }
+    /// The participating-medium view of the scene, when it has one.
+    fn medium(&self) -> Option<&dyn MediumScene> {
         None
     }
     /// The environment-sequence view of the scene (paper 004), when it has one.

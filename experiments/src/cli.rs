@@ -46,6 +46,9 @@ enum Command {
         /// Variant (the first when omitted).
         #[arg(long)]
         variant: Option<String>,
+        /// Paths per integral for stored Monte Carlo references (the test bed's default when omitted).
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        samples: Option<u64>,
         /// Results root.
         #[arg(long, default_value = "results")]
         results: PathBuf,
@@ -147,7 +150,9 @@ fn dispatch(cli: Cli) -> Result<()> {
             list(what);
             Ok(())
         }
-        Some(Command::Reference { testbed, variant, results }) => reference(&testbed, variant, &results),
+        Some(Command::Reference { testbed, variant, samples, results }) => {
+            reference(&testbed, variant, samples, &results)
+        }
         Some(Command::Plot { results_dir, plots }) => {
             let report = crate::output::read_results(&results_dir)?;
             let dir = plots.join(&report.meta.experiment);
@@ -305,19 +310,38 @@ fn list(what: Option<ListWhat>) {
     }
 }
 
-fn reference(testbed: &str, variant: Option<String>, results: &std::path::Path) -> Result<()> {
+fn reference(testbed: &str, variant: Option<String>, samples: Option<u64>, results: &std::path::Path) -> Result<()> {
     let entry = estimators::registry::testbed(testbed)?;
     let variant = variant.unwrap_or_else(|| entry.variants[0].to_string());
     entry.check_variant(&variant)?;
     let t0 = Instant::now();
-    let bed = (entry.build)(&variant, &Params::new())?;
-    let r = bed.reference();
+    // Exact variants compute their reference when built; stored ones run the test bed's hook.
+    let built = (entry.build)(&variant, &Params::new());
+    let (r, resolution) = match (built, entry.compute_reference) {
+        (Ok(bed), _) if bed.reference().is_exact() || entry.compute_reference.is_none() => {
+            (bed.reference().clone(), bed.resolution())
+        }
+        (_, Some(compute)) => {
+            let mut params = Params::new();
+            if let Some(n) = samples {
+                params = params.with("samples", n as f64);
+            }
+            let threads = std::thread::available_parallelism().map(|t| t.get()).unwrap_or(1);
+            compute(&variant, &params, threads)?
+        }
+        (Ok(bed), None) => (bed.reference().clone(), bed.resolution()),
+        (Err(e), None) => return Err(e.into()),
+    };
     let path = results.join("references").join(format!("{testbed}_{variant}.json"));
+    let command = match &r.kind {
+        estimators::testbed::ReferenceKind::Stored { command, .. } => command.clone(),
+        _ => format!("mcbench reference {testbed} --variant {variant}"),
+    };
     let doc = serde_json::json!({
         "testbed": testbed,
         "variant": variant,
-        "command": format!("mcbench reference {testbed} --variant {variant}"),
-        "resolution": bed.resolution(),
+        "command": command,
+        "resolution": resolution,
         "reference": r,
     });
     let text = serde_json::to_string(&doc).map_err(|e| HarnessError::write(&path, e))?;

@@ -32,6 +32,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     summary:
         "Phong sphere under a rotating HDR sky, L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
     build: |variant, params| Ok(Box::new(EnvmapSequence::new(variant, params)?)),
+    compute_reference: None,
 };
 
 /// Half-width of the orthographic image (inside the unit disc's inscribed square).

@@ -23,6 +23,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     provides: Needs::SURFACE,
     summary: "Phong plane under a gradient sky, pinhole 32x32, exact reference (paper 001 §5)",
     build: |variant, params| Ok(Box::new(GradientPlane::new(variant, params)?)),
+    compute_reference: None,
 };
 
 /// Relative tolerance of the glossy quadrature (the test bed promises 1e-9).
