@@ -19,6 +19,7 @@ pub mod independent;
 pub mod lighting;
 pub mod math;
 pub mod params;
+pub mod phase;
 pub mod quadrature;
 pub mod registry;
 pub mod rng;

@@ -270,4 +270,16 @@ impl MediumProbe<'_> {
     pub fn environment(&self, w: Vec3) -> Rgb {
         self.scene.environment(w)
     }
+    /// The phase function (a scene constant: free).
+    pub fn phase(&self) -> crate::phase::Phase {
+        self.scene.phase()
+    }
+    /// Records a diagnostic on this integral's task ([`Task::note`]).
+    pub fn note(&self, name: &'static str, value: f64) {
+        self.task.note(name, value);
+    }
+    /// True while this integral's budget is not spent ([`Task::more`]).
+    pub fn more(&self) -> bool {
+        self.task.more()
+    }
 }
