@@ -18,6 +18,7 @@ pub mod estimator;
 pub mod independent;
 pub mod lighting;
 pub mod math;
+pub mod media_smc;
 pub mod params;
 pub mod phase;
 pub mod quadrature;

@@ -63,6 +63,7 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::smc_surface::is1_cv1::ENTRY,
     &crate::smc_surface::is1_cv2::ENTRY,
     &crate::smc_surface::brdf_is1_cv2::ENTRY,
+    &crate::media_smc::rm_is1_cv2::ENTRY,
     &crate::smc::bidirectional_is::ENTRY,
     &crate::smc::bidirectional_is_sn::ENTRY,
     &crate::smc::smc::ENTRY,
@@ -72,8 +73,11 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
 ];
 
 /// Every registered test bed.
-pub static TESTBEDS: &[&TestBedEntry] =
-    &[&crate::testbeds::gradient_plane::ENTRY, &crate::testbeds::envmap_sequence::ENTRY];
+pub static TESTBEDS: &[&TestBedEntry] = &[
+    &crate::testbeds::gradient_plane::ENTRY,
+    &crate::testbeds::envmap_sequence::ENTRY,
+    &crate::testbeds::gradient_box::ENTRY,
+];
 
 /// Looks an estimator up by id.
 pub fn estimator(id: &str) -> Result<&'static EstimatorEntry, ConfigError> {
