@@ -5,6 +5,8 @@ pub mod claims;
 pub mod envmap_smc;
 pub mod envmap_smc_post;
 pub mod envmap_unbiasedness;
+pub mod media_smc;
+pub mod media_smc_post;
 pub mod surface_smc;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};
@@ -39,7 +41,7 @@ pub struct ExperimentDef {
 pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &Path, Option<&Path>) -> crate::error::Result<Vec<PathBuf>>;
 
 /// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF, &envmap_smc::DEF];
+pub static EXPERIMENTS: &[&ExperimentDef] = &[&surface_smc::DEF, &envmap_smc::DEF, &media_smc::DEF];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {
