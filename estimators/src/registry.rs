@@ -63,6 +63,7 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::smc_surface::is1_cv1::ENTRY,
     &crate::smc_surface::is1_cv2::ENTRY,
     &crate::smc_surface::brdf_is1_cv2::ENTRY,
+    &crate::media_smc::rm_is1_cv2::ENTRY,
     &crate::smc::bidirectional_is::ENTRY,
     &crate::smc::bidirectional_is_sn::ENTRY,
     &crate::smc::smc::ENTRY,
@@ -91,6 +92,7 @@ pub static TESTBEDS: &[&TestBedEntry] = &[
     &crate::testbeds::checker::ENTRY,
     &crate::media::EQ21,
     &crate::media::PERLIN,
+    &crate::testbeds::gradient_box::ENTRY,
 ];
 
 /// Looks an estimator up by id.

@@ -95,6 +95,11 @@ impl<'a> Task<'a> {
         let scene = self.bed.hemisphere()?;
         Some(HemisphereProbe { point: scene.shading(self.integral), scene, task: self })
     }
+    /// The counted medium probe of this integral, when the scene has a medium.
+    pub fn medium(&self) -> Option<MediumProbe<'_>> {
+        let scene = self.bed.medium()?;
+        Some(MediumProbe { ray: scene.ray(self.integral), scene, task: self })
+    }
     /// The environment-sequence probe of this integral (frame `i % F` of pixel `i / F`), when the
     /// scene has one.
     pub fn env_sequence(&self) -> Option<EnvProbe<'_>> {
@@ -102,11 +107,6 @@ impl<'a> Task<'a> {
         let frames = scene.frames().max(1);
         let (pixel, frame) = (self.integral / frames, self.integral % frames);
         Some(EnvProbe { scene, task: self, pixel, frame, point: scene.shading(pixel), env: scene.environment(frame) })
-    }
-    /// The counted medium probe of this integral, when the scene has a medium.
-    pub fn medium(&self) -> Option<MediumProbe<'_>> {
-        let scene = self.bed.medium()?;
-        Some(MediumProbe { ray: scene.ray(self.integral), scene, task: self })
     }
     fn count(&self, f: impl FnOnce(&mut Costs)) {
         let mut c = self.costs.get();
@@ -274,5 +274,17 @@ impl MediumProbe<'_> {
     /// Environment radiance from direction `w` leaving the scene (free: analytic lighting).
     pub fn environment(&self, w: Vec3) -> Rgb {
         self.scene.environment(w)
+    }
+    /// The phase function (a scene constant: free).
+    pub fn phase(&self) -> crate::phase::Phase {
+        self.scene.phase()
+    }
+    /// Records a diagnostic on this integral's task ([`Task::note`]).
+    pub fn note(&self, name: &'static str, value: f64) {
+        self.task.note(name, value);
+    }
+    /// True while this integral's budget is not spent ([`Task::more`]).
+    pub fn more(&self) -> bool {
+        self.task.more()
     }
 }

@@ -179,6 +179,10 @@ pub trait MediumScene: Send + Sync {
     fn environment(&self, w: Vec3) -> Rgb;
     /// The ray of integral `i`.
     fn ray(&self, i: usize) -> MediumRay;
+    /// The phase function (paper 000 Eq. 5); isotropic unless the scene says otherwise.
+    fn phase(&self) -> crate::phase::Phase {
+        crate::phase::Phase::Isotropic
+    }
 }
 
 /// A test bed (SPEC §2). Integrals are pixels in row-major order, `i = py * width + px`.

@@ -318,8 +318,9 @@ fn reference(testbed: &str, variant: Option<String>, samples: Option<u64>, resul
     // Exact variants compute their reference when built; stored ones run the test bed's hook.
     let built = (entry.build)(&variant, &Params::new());
     let (r, resolution) = match (built, entry.compute_reference) {
-        (Ok(bed), None) => (bed.reference().clone(), bed.resolution()),
-        (Ok(bed), Some(_)) if bed.reference().is_exact() => (bed.reference().clone(), bed.resolution()),
+        (Ok(bed), _) if bed.reference().is_exact() || entry.compute_reference.is_none() => {
+            (bed.reference().clone(), bed.resolution())
+        }
         (_, Some(compute)) => {
             let mut params = Params::new();
             if let Some(n) = samples {
@@ -328,6 +329,7 @@ fn reference(testbed: &str, variant: Option<String>, samples: Option<u64>, resul
             let threads = std::thread::available_parallelism().map(|t| t.get()).unwrap_or(1);
             compute(&variant, &params, threads)?
         }
+        (Ok(bed), None) => (bed.reference().clone(), bed.resolution()),
         (Err(e), None) => return Err(e.into()),
     };
     let path = results.join("references").join(format!("{testbed}_{variant}.json"));

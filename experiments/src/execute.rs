@@ -145,8 +145,9 @@ pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path) -> Result<
 }
 
 fn integral_rows(cell: &CellResult, bed: &dyn estimators::testbed::TestBed) -> Vec<IntegralRow> {
-    let (w, _) = bed.resolution();
-    let frames = bed.sequence_length().max(1);
+    let (w, h) = bed.resolution();
+    // Integrals per pixel (frames of paper 004); 1 when a sequence spans pixels (gradient-box).
+    let frames = (bed.integrals() / (w * h).max(1)).max(1);
     let reference = bed.reference();
     let mut out = Vec::with_capacity(cell.moments.len() * 3);
     for (i, m) in cell.moments.iter().enumerate() {

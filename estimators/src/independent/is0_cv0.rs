@@ -16,11 +16,14 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     paper: "001",
     label: "MCMC (independent MC)",
     bias: Bias::Unbiased,
-    needs: Needs::SURFACE,
-    summary: "uniform hemisphere sampling, no control variate (independent MC baseline)",
+    needs: Needs::NONE,
+    summary: "independent MC baseline: uniform hemisphere sampling; on a medium, the path tracer (free flights, phase sampling)",
     build: |p| {
         p.reject_unknown("is0_cv0", &[])?;
-        Ok(Box::new(Is0Cv0))
+        Ok(Box::new(crate::media_smc::SurfaceOrMedium {
+            surface: Box::new(Is0Cv0),
+            medium: Box::new(crate::media_smc::PathTracer),
+        }))
     },
 };
 

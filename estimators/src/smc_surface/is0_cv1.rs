@@ -4,6 +4,7 @@
 use super::{Sampling, SmcSurface};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
+use crate::media_smc::{MediaSmc, Sampling as MediaSampling};
 use crate::registry::EstimatorEntry;
 use crate::testbed::Needs;
 
@@ -13,7 +14,13 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     paper: "001",
     label: "is0_cv1",
     bias: Bias::Unbiased,
-    needs: Needs::SURFACE,
-    summary: "SMC surface cache: uniform sampling, piecewise-constant control variate (cv1)",
-    build: |p| SmcSurface::build("is0_cv1", Sampling::Uniform, ControlVariate::Constant, p),
+    needs: Needs::NONE,
+    summary: "SMC cache: uniform sampling, piecewise-constant control variate (cv1); on a medium, the octree of spherical caches (paper 000)",
+    build: |p| {
+        crate::media_smc::SurfaceOrMedium::build(
+            |p| SmcSurface::build("is0_cv1", Sampling::Uniform, ControlVariate::Constant, p),
+            |p| Ok(Box::new(MediaSmc::from_params("is0_cv1", MediaSampling::Uniform, ControlVariate::Constant, p)?)),
+            p,
+        )
+    },
 };

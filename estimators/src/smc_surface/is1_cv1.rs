@@ -4,6 +4,7 @@
 use super::{Sampling, SmcSurface};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
+use crate::media_smc::{MediaSmc, Sampling as MediaSampling};
 use crate::registry::EstimatorEntry;
 use crate::testbed::Needs;
 
@@ -13,7 +14,13 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     paper: "001",
     label: "is1_cv1",
     bias: Bias::Unbiased,
-    needs: Needs::SURFACE,
-    summary: "SMC surface cache: cache-PDF importance sampling, piecewise-constant control variate",
-    build: |p| SmcSurface::build("is1_cv1", Sampling::Cache, ControlVariate::Constant, p),
+    needs: Needs::NONE,
+    summary: "SMC cache: cache-PDF importance sampling, piecewise-constant control variate; on a medium, the octree of spherical caches (paper 000)",
+    build: |p| {
+        crate::media_smc::SurfaceOrMedium::build(
+            |p| SmcSurface::build("is1_cv1", Sampling::Cache, ControlVariate::Constant, p),
+            |p| Ok(Box::new(MediaSmc::from_params("is1_cv1", MediaSampling::Cache, ControlVariate::Constant, p)?)),
+            p,
+        )
+    },
 };

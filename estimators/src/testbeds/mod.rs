@@ -4,6 +4,8 @@ pub mod checker;
 pub mod checker_reference;
 pub mod envmap_reference;
 pub mod envmap_sequence;
+pub mod gradient_box;
+pub mod gradient_box_reference;
 pub mod gradient_plane;
 pub mod phong_lobe;
 pub mod pinhole;

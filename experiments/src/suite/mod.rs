@@ -5,6 +5,8 @@ pub mod claims;
 pub mod envmap_smc;
 pub mod envmap_smc_post;
 pub mod envmap_unbiasedness;
+pub mod media_smc;
+pub mod media_smc_post;
 pub mod particle_sweep;
 pub mod pmc_hi;
 pub mod surface_smc;
@@ -44,7 +46,7 @@ pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &Path, Option<&Path>) -
 
 /// Every experiment, in the order the default suite runs them.
 pub static EXPERIMENTS: &[&ExperimentDef] =
-    &[&surface_smc::DEF, &transmittance::DEF, &particle_sweep::DEF, &pmc_hi::DEF, &envmap_smc::DEF];
+    &[&surface_smc::DEF, &media_smc::DEF, &transmittance::DEF, &particle_sweep::DEF, &pmc_hi::DEF, &envmap_smc::DEF];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {

@@ -1,0 +1,59 @@
+//! Criterion benches of the medium SMC hot paths (SPEC §11, issue 4): one independent path in the
+//! gradient box (free flights + phase sampling), one octree leaf lookup at depth 3, and one
+//! `is1_cv2` estimate of a 16 x 16 gradient-box image at 4 spp (shared octree, 1024 paths).
+//! Run with `cargo bench -p estimators --bench media`.
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
+use estimators::budget::Budget;
+use estimators::cache::{CacheConfig, Domain};
+use estimators::estimator::Estimator;
+use estimators::math::{Rgb, Vec3};
+use estimators::media_smc::octree::Octree;
+use estimators::media_smc::{walk, MediaSmc, Sampling};
+use estimators::params::Params;
+use estimators::rng::stream;
+use estimators::task::Task;
+use estimators::testbeds::gradient_box::GradientBox;
+use rand::Rng;
+
+fn media(c: &mut Criterion) {
+    let bed = GradientBox::without_reference("albedo-0.8", &Params::new()).expect("builds");
+    let mut group = c.benchmark_group("media");
+    let task = Task::new(&bed, 136, Budget::samples(u64::MAX).expect("budget"));
+    let probe = task.medium().expect("medium");
+    let mut rng = stream(1, "bench path");
+    group.bench_function("independent_path", |b| b.iter(|| black_box(walk::independent_path(&probe, &mut rng))));
+
+    let config =
+        CacheConfig { domain: Domain::Sphere, criterion: 1.0, max_depth: 3, counter_divisor: 32, importance: true };
+    let mut tree = Octree::<f64>::new(Vec3::default(), 0.5, config);
+    let mut r = stream(2, "bench octree");
+    while tree.stats().depth < 3 || tree.stats().leaves < 512 {
+        let p = Vec3::new(r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5);
+        let st = estimators::cache::St { s: r.gen(), t: r.gen() };
+        tree.add_record(p, st, Rgb::splat(1.0 + st.t), Rgb::ZERO);
+    }
+    group.bench_function("octree_lookup_depth3", |b| {
+        b.iter(|| {
+            let p = Vec3::new(r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5);
+            black_box(tree.leaf_of(p))
+        })
+    });
+
+    let est =
+        MediaSmc::from_params("is1_cv2", Sampling::Cache, estimators::cache::ControlVariate::Bilinear, &Params::new())
+            .expect("params");
+    group.throughput(Throughput::Elements(256 * 4));
+    group.sample_size(20);
+    let mut rng = stream(3, "bench is1_cv2");
+    group.bench_function("is1_cv2_image_16x16_4spp", |b| {
+        b.iter(|| {
+            let tasks: Vec<Task<'_>> = (0..256).map(|i| Task::new(&bed, i, Budget::samples(4).expect("4"))).collect();
+            black_box(est.estimate_sequence(&tasks, &mut rng).expect("finite"))
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, media);
+criterion_main!(benches);

@@ -1,0 +1,35 @@
+//! `rm_is1_cv2`: the ray-marching variant of paper 000 (Eq. 8-9, §4.5) with the octree's
+//! `is1_cv2` estimate of the in-scattered radiance at each scattering event; biased by
+//! construction (the source term is taken at the far end of each step). Parameter `step`
+//! (default 0.5, i.e. one optical depth in `gradient-box`) plus the SMC parameters.
+//!
+//! Deviation from §4.5, stated: the choice between transmission (`Omega_t`) and scattering
+//! (`Omega_s`) is made with probabilities proportional to `kappa_t` and `kappa_s` instead of being
+//! merged into the cache's partial-sum tree, and the transmission term carries no control variate;
+//! the id exists as the biased control the unbiasedness tests must flag. The id is not
+//! `ray_marching`, which feat/media uses for the transmittance tracker.
+
+use super::{MediaSmc, Sampling, PARAMS};
+use crate::cache::ControlVariate;
+use crate::estimator::Bias;
+use crate::registry::EstimatorEntry;
+use crate::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "rm_is1_cv2",
+    paper: "000",
+    label: "ray marching is1_cv2 (biased)",
+    bias: Bias::Biased,
+    needs: Needs::MEDIUM,
+    summary: "ray marching over the 4 pi + 1 domain (paper 000 Eq. 8-9) with the SMC octree; biased control",
+    build: |p| {
+        let known: Vec<&str> = PARAMS.iter().copied().chain(["step"]).collect();
+        p.reject_unknown("rm_is1_cv2", &known)?;
+        let step = p.f64_in("step", 0.5, 1e-6, 10.0)?;
+        let mut rest = p.clone();
+        rest.0.remove("step");
+        let est = MediaSmc::from_params("rm_is1_cv2", Sampling::Cache, ControlVariate::Bilinear, &rest)?;
+        Ok(Box::new(est.ray_marching(step)))
+    },
+};
