@@ -260,6 +260,10 @@ impl MediumScene for MediumBed {
     fn albedo(&self) -> f64 {
         self.albedo
     }
+    /// Both media scatter with the Rayleigh phase function (SPEC §3.3-3.4).
+    fn phase(&self) -> crate::phase::Phase {
+        crate::phase::Phase::Rayleigh
+    }
     fn clip(&self, origin: Vec3, dir: Vec3) -> Option<(f64, f64)> {
         clip_sphere(origin, dir)
     }
