@@ -28,7 +28,7 @@ pub struct BrdfIs0Cv0;
 
 impl Estimator for BrdfIs0Cv0 {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
-        super::average(task, rng, |probe, rng| {
+        super::average(task, rng, |probe, _frame, rng| {
             let p = probe.point();
             let s = p.brdf.sample(p.wo, p.normal, rng);
             // The mixture pdf is positive wherever the integrand is non-zero (the cosine lobe

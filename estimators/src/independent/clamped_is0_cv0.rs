@@ -4,7 +4,7 @@
 
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
-use crate::math::{Frame, Rgb};
+use crate::math::Rgb;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::uniform_hemisphere;
@@ -37,8 +37,7 @@ pub struct ClampedIs0Cv0 {
 
 impl Estimator for ClampedIs0Cv0 {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
-        super::average(task, rng, |probe, rng| {
-            let frame = Frame::around(probe.point().normal);
+        super::average(task, rng, |probe, frame, rng| {
             let local = uniform_hemisphere::sample_local(rng);
             (probe.integrand(frame.to_world(local)) / uniform_hemisphere::pdf(local.z)).map(|c| c.min(self.clamp))
         })

@@ -3,7 +3,7 @@
 
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
-use crate::math::{Frame, Rgb};
+use crate::math::Rgb;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::uniform_hemisphere;
@@ -32,8 +32,7 @@ pub struct Is0Cv0;
 
 impl Estimator for Is0Cv0 {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
-        super::average(task, rng, |probe, rng| {
-            let frame = Frame::around(probe.point().normal);
+        super::average(task, rng, |probe, frame, rng| {
             let local = uniform_hemisphere::sample_local(rng);
             probe.integrand(frame.to_world(local)) / uniform_hemisphere::pdf(local.z)
         })

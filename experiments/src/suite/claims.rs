@@ -30,54 +30,65 @@ pub fn last_segment_slope(report: &RunReport, testbed: &str, variant: &str, esti
     Some((b.rmse / a.rmse).ln() / (b.budget as f64 / a.budget as f64).ln())
 }
 
+/// A claim judged on an estimator's fit: `judge` gives (held, note); not measured without a fit.
+fn slope_claim(
+    report: &RunReport,
+    tb: (&str, &str),
+    estimator: &str,
+    paper: f64,
+    claim: &str,
+    judge: impl Fn(&Fit) -> (bool, String),
+) -> Claim {
+    match fit(report, tb.0, tb.1, estimator) {
+        None => not_measured(tb.0, claim, paper, format!("{estimator} did not run (not available or skipped)")),
+        Some(f) => {
+            let (held, note) = judge(f);
+            Claim {
+                testbed: format!("{}/{}", tb.0, tb.1),
+                claim: claim.into(),
+                paper_value: Some(paper),
+                our_value: Some(f.slope),
+                held: Some(held),
+                note,
+            }
+        }
+    }
+}
+
 /// "Estimator X converges with slope `paper`": held when our 95% CI contains the paper's slope
 /// (the local slope over the last two budgets is given in the note).
 pub fn slope_matches(report: &RunReport, tb: (&str, &str), estimator: &str, paper: f64, claim: &str) -> Claim {
-    match fit(report, tb.0, tb.1, estimator) {
-        None => not_measured(tb.0, claim, paper, format!("{estimator} did not run (not available or skipped)")),
-        Some(f) => Claim {
-            testbed: format!("{}/{}", tb.0, tb.1),
-            claim: claim.into(),
-            paper_value: Some(paper),
-            our_value: Some(f.slope),
-            held: Some(f.slope_ci_low <= paper && paper <= f.slope_ci_high),
-            note: format!(
-                "held if the 95% CI [{:.3}, {:.3}] over budgets {}..{} contains {paper}; slope over the last two budgets {}",
-                f.slope_ci_low,
-                f.slope_ci_high,
-                f.budgets.first().copied().unwrap_or(0),
-                f.budgets.last().copied().unwrap_or(0),
-                last_segment_slope(report, tb.0, tb.1, estimator).map(|s| format!("{s:.3}")).unwrap_or_else(|| "-".into())
-            ),
-        },
-    }
+    let last =
+        last_segment_slope(report, tb.0, tb.1, estimator).map(|s| format!("{s:.3}")).unwrap_or_else(|| "-".into());
+    slope_claim(report, tb, estimator, paper, claim, |f| {
+        let note = format!(
+            "held if the 95% CI [{:.3}, {:.3}] over budgets {}..{} contains {paper}; slope over the last two budgets {last}",
+            f.slope_ci_low,
+            f.slope_ci_high,
+            f.budgets.first().copied().unwrap_or(0),
+            f.budgets.last().copied().unwrap_or(0),
+        );
+        (f.slope_ci_low <= paper && paper <= f.slope_ci_high, note)
+    })
 }
 
 /// "Estimator X converges faster than independent MC": held when our CI lies below -0.5; the
 /// paper's slope `paper` is compared in the note (and judged by [`slope_matches`]).
 pub fn slope_steeper(report: &RunReport, tb: (&str, &str), estimator: &str, paper: f64, claim: &str) -> Claim {
-    match fit(report, tb.0, tb.1, estimator) {
-        None => not_measured(tb.0, claim, paper, format!("{estimator} did not run (not available or skipped)")),
-        Some(f) => Claim {
-            testbed: format!("{}/{}", tb.0, tb.1),
-            claim: claim.into(),
-            paper_value: Some(paper),
-            our_value: Some(f.slope),
-            held: Some(f.slope_ci_high < -0.5),
-            note: format!(
-                "held if the 95% CI [{:.3}, {:.3}] lies below -0.5; the paper's {paper} is {} our CI",
-                f.slope_ci_low,
-                f.slope_ci_high,
-                if paper < f.slope_ci_low {
-                    "steeper than"
-                } else if paper > f.slope_ci_high {
-                    "shallower than"
-                } else {
-                    "inside"
-                }
-            ),
-        },
-    }
+    slope_claim(report, tb, estimator, paper, claim, |f| {
+        let place = if paper < f.slope_ci_low {
+            "steeper than"
+        } else if paper > f.slope_ci_high {
+            "shallower than"
+        } else {
+            "inside"
+        };
+        let note = format!(
+            "held if the 95% CI [{:.3}, {:.3}] lies below -0.5; the paper's {paper} is {place} our CI",
+            f.slope_ci_low, f.slope_ci_high
+        );
+        (f.slope_ci_high < -0.5, note)
+    })
 }
 
 /// "X beats the baseline by `paper` x at equal time": held when our speed-up is at least half the
