@@ -1,5 +1,6 @@
 //! Criterion benches of the null-collision hot paths (paper 002; SPEC §11; issue 5 item 10):
-//! one fetch of each medium (the floor: a tight loop of extinction evaluations), and one
+//! one fetch of each medium (the floor: a tight loop of extinction evaluations along the central
+//! ray), and one
 //! transmittance estimate (16 rays) of each tracker on the full central ray s = 20 of each medium.
 //!
 //! Every bench times itself through `iter_custom` and counts the fetches its estimates made, so
@@ -57,13 +58,12 @@ fn bed(id: &str, variant: &str) -> Box<dyn TestBed> {
     (entry.build)(variant, &Params::new()).expect("builds")
 }
 
-/// Bare fetches: `sigma_t` at 1024 fixed points inside the sphere, in a tight loop.
+/// Bare fetches: `sigma_t` at 1024 random points along the central ray (where the trackers step,
+/// so both see the same noise-table and branch behaviour), in a tight loop.
 fn bare_fetch(c: &mut Criterion, medium: &str, bed: &dyn TestBed, tally: &mut Tally) {
     let scene = bed.medium().expect("medium");
     let mut rng = stream(7, "bench fetch points");
-    let points: Vec<Vec3> = (0..1024)
-        .map(|_| Vec3::new(rng.gen_range(-7.0..7.0), rng.gen_range(-7.0..7.0), rng.gen_range(3.0..17.0)))
-        .collect();
+    let points: Vec<Vec3> = (0..1024).map(|_| Vec3::new(0.0, 0.0, rng.gen_range(0.0..20.0))).collect();
     let mut group = c.benchmark_group(format!("fetch/{medium}"));
     group.throughput(Throughput::Elements(points.len() as u64));
     group.bench_function("sigma_t_x1024", |b| {
