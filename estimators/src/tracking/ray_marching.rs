@@ -1,7 +1,8 @@
 //! `ray_marching`: the biased control (paper 002 §2): `T = exp(-h sum sigma_t(t_j))` with a fixed
 //! step `h` (parameter `step`, default 0.9 as in paper 002 Fig. 9) and one random offset per ray.
 //! Under a fetch budget, one ray spends the whole budget: `N = budget` equal steps. Biased by
-//! construction (Jensen: E[exp(-X)] > exp(-E[X])).
+//! construction (Jensen: E[exp(-X)] > exp(-E[X])). On point-light single-scatter integrals the
+//! same id marches the primary and shadow rays ([`crate::single_scatter::ray_marching`]).
 
 use super::{supports_transmittance, transmittance};
 use crate::budget::BudgetKind;
@@ -21,16 +22,25 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "ray marching (biased control)",
     bias: Bias::Biased,
     needs: Needs::MEDIUM,
-    summary: "biased control: fixed-step ray marching of the optical depth (step 0.9; one ray = the fetch budget)",
+    summary: "biased control: fixed-step ray marching of the optical depth (step 0.9; one ray = the fetch budget); on single scattering, of the primary and shadow rays",
     build: |p| {
-        p.reject_unknown("ray_marching", &["step"])?;
-        let step = p.f64("step", 0.9)?;
-        if step <= 0.0 {
-            return Err(ConfigError::invalid("ray_marching.step", step, "must be > 0"));
-        }
-        Ok(Box::new(RayMarching { step }))
+        crate::single_scatter::SingleScatterOr::build(
+            "ray_marching",
+            p,
+            (&["step"], |p| Ok(Box::new(RayMarching { step: step(p)? }))),
+            (&["step"], |p| Ok(Box::new(crate::single_scatter::ray_marching::RayMarchingScatter { step: step(p)? }))),
+        )
     },
 };
+
+/// The `step` parameter (> 0, default 0.9).
+fn step(p: &crate::params::Params) -> Result<f64, ConfigError> {
+    let step = p.f64("step", 0.9)?;
+    if step <= 0.0 {
+        return Err(ConfigError::invalid("ray_marching.step", step, "must be > 0"));
+    }
+    Ok(step)
+}
 
 /// The estimator.
 pub struct RayMarching {
