@@ -1,5 +1,5 @@
 //! Equiangular (Cauchy) sampling of a ray parameter (paper 002 §4.3 "source-driven sampling",
-//! [KF12]): the density `D / ((theta1 - theta0) (D^2 + (t - t_l)^2))` on `[t0, t1]`, which
+//! \[KF12\]): the density `D / ((theta1 - theta0) (D^2 + (t - t_l)^2))` on `[t0, t1]`, which
 //! mimics the `1 / r^2` fall-off of a point light at distance `D` from the ray, closest at `t_l`.
 //! Sampled exactly by `t = t_l + D tan(theta)`, `theta` uniform in `[theta0, theta1]`.
 

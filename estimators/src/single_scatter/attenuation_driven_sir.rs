@@ -1,4 +1,4 @@
-//! `attenuation_driven_sir` (paper 002 §4.3, sampling importance resampling [TCE05]): the
+//! `attenuation_driven_sir` (paper 002 §4.3, sampling importance resampling \[TCE05\]): the
 //! candidates are the attenuation-driven scattering points with weights
 //! `w_k = T^(s_k-) a sigma_t rho I / (r^2 sigma_samp)` (everything but the shadow transmittance);
 //! `shadow_rays` of them (default 1) are resampled with probability `|w_k| / W`, `W = sum |w_k|`,

@@ -39,6 +39,7 @@ use crate::lighting::PointLight;
 use crate::math::{Rgb, Vec3};
 use crate::params::Params;
 use crate::phase::Phase;
+use crate::registry::BuildEstimator;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::{MediumProbe, Task};
@@ -201,8 +202,8 @@ impl SingleScatterOr {
     pub fn build(
         id: &str,
         params: &Params,
-        (other_keys, other): (&[&str], fn(&Params) -> Result<Box<dyn Estimator>, ConfigError>),
-        (scatter_keys, single_scatter): (&[&str], fn(&Params) -> Result<Box<dyn Estimator>, ConfigError>),
+        (other_keys, other): (&[&str], BuildEstimator),
+        (scatter_keys, single_scatter): (&[&str], BuildEstimator),
     ) -> Result<Box<dyn Estimator>, ConfigError> {
         let known: Vec<&str> = other_keys.iter().chain(scatter_keys).copied().collect();
         params.reject_unknown(id, &known)?;

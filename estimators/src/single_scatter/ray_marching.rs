@@ -4,8 +4,10 @@
 //! (its own offset): `L = h sum_j T(t_j) a sigma_j rho I T_l(t_j) / r_j^2`. Biased by construction
 //! (Jensen: `E[exp(-X)] != exp(-E[X])`).
 //!
-//! Step: parameter `step` (default 0.9, as paper 002 Fig. 9) under a sample budget; under a fetch
-//! budget `B` one primary ray spends about the budget (the paper's "single ray per pixel"): with
+//! Step: parameter `step` (default 0.9, as paper 002 Fig. 9) under a sample budget, and under a
+//! fetch budget when `step` is given (the rays keep it and the budget buys more of them: a coarse
+//! `step` makes the harness's detectably biased control). Under a fetch budget `B` without `step`,
+//! one primary ray spends about the budget (the paper's "single ray per pixel" of Fig. 12): with
 //! `L` the primary segment and `R = int r_in(t) dt` the summed shadow lengths inside the sphere
 //! (geometry, no fetches), `L / h + R / h^2 = B` gives `h = (L + sqrt(L^2 + 4 B R)) / (2 B)`, and
 //! exactly one primary ray is marched.
@@ -23,8 +25,10 @@ use rand::Rng;
 
 /// The estimator.
 pub struct RayMarchingScatter {
-    /// Step length under a sample budget.
+    /// Step length under a sample budget (and under a fetch budget when `fixed_step`).
     pub step: f64,
+    /// The step was given explicitly: keep it under a fetch budget too.
+    pub fixed_step: bool,
 }
 
 /// The shadow segment from `p` to the light inside the medium (origin, direction, segment).
@@ -88,7 +92,7 @@ impl RayMarchingScatter {
 impl Estimator for RayMarchingScatter {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         let budget = task.budget();
-        if budget.kind != BudgetKind::Fetches {
+        if budget.kind != BudgetKind::Fetches || self.fixed_step {
             return run(task, rng, |probe, geo, rng| Ok(self.one(probe, geo, self.step, rng)));
         }
         // One primary ray spends the fetch budget (module doc).

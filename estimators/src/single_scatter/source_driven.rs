@@ -1,5 +1,5 @@
-//! `source_driven` (paper 002 §4.3, [KF12]): `points` scattering points per primary ray (default
-//! 1) from the equiangular (Cauchy) density mimicking `1 / (D^2 + (t - t_l)^2)`
+//! `source_driven` (paper 002 §4.3, \[KF12\]): per primary ray, `points` scattering points
+//! (default one) from the equiangular (Cauchy) density mimicking `1 / (D^2 + (t - t_l)^2)`
 //! ([`crate::samplers::equiangular`]), drawn before the primary ray is tracked; the integrand at
 //! each by the continuous transmittance and a residual-ratio-tracking shadow ray
 //! ([`super::points`]); estimate `(1/n) sum f(t_i) / p(t_i)`.

@@ -174,7 +174,7 @@ fn supports_accepts_the_single_scatter_ids_only() {
 
 /// Costs: one sample per primary ray, shadow rays counted as rays, a ray missing the medium is
 /// exact and costs one sample, and ray marching under a fetch budget marches exactly one primary
-/// ray spending about the budget.
+/// ray spending about the budget (or, with an explicit step, as many rays as the budget buys).
 #[test]
 fn costs_are_counted() {
     let bed = bed(Params::new().with("resolution", 4.0));
@@ -193,4 +193,8 @@ fn costs_are_counted() {
         assert_eq!(task.costs().samples, 1);
         assert!((0.6 * budget as f64..1.5 * budget as f64).contains(&f), "{budget}: {f}");
     }
+    // An explicit step keeps the step under a fetch budget: the budget buys more rays.
+    let task = Task::new(&bed, 5, Budget::new(BudgetKind::Fetches, 300).unwrap());
+    build("ray_marching", Params::new().with("step", 5.0)).estimate(&task, &mut stream(4, "rm5")).unwrap();
+    assert!(task.costs().samples > 5 && task.costs().fetches >= 300, "{:?}", task.costs());
 }

@@ -6,7 +6,7 @@
 //!
 //! is an unbiased estimate of `T(s)` (the interactions on `[t0, s]` are exactly a ratio-tracking
 //! run of that sub-segment). Between interaction points it is not constant but falls off
-//! exponentially with the control variate [JNT*11, NNDJ12], so any scattering point, however it
+//! exponentially with the control variate \[JNT*11, NNDJ12\], so any scattering point, however it
 //! was sampled, reuses the primary ray's interaction data: one tracking run per primary ray serves
 //! every scattering point at or before `end`.
 

@@ -28,7 +28,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             "ray_marching",
             p,
             (&["step"], |p| Ok(Box::new(RayMarching { step: step(p)? }))),
-            (&["step"], |p| Ok(Box::new(crate::single_scatter::ray_marching::RayMarchingScatter { step: step(p)? }))),
+            (&["step"], |p| {
+                let fixed_step = p.0.contains_key("step");
+                Ok(Box::new(crate::single_scatter::ray_marching::RayMarchingScatter { step: step(p)?, fixed_step }))
+            }),
         )
     },
 };
