@@ -4,6 +4,9 @@
 //! (its own offset): `L = h sum_j T(t_j) a sigma_j rho I T_l(t_j) / r_j^2`. Biased by construction
 //! (Jensen: `E[exp(-X)] != exp(-E[X])`).
 //!
+//! `jitter` (default 1) draws the offsets at random; `jitter = 0` fixes them at 1/2: the paper's
+//! "noise free but biased" marcher (a deterministic estimate per pixel).
+//!
 //! Step: parameter `step` (default 0.9, as paper 002 Fig. 9) under a sample budget, and under a
 //! fetch budget when `step` is given (the rays keep it and the budget buys more of them: a coarse
 //! `step` makes the harness's detectably biased control). Under a fetch budget `B` without `step`,
@@ -29,6 +32,19 @@ pub struct RayMarchingScatter {
     pub step: f64,
     /// The step was given explicitly: keep it under a fetch budget too.
     pub fixed_step: bool,
+    /// Random offsets (else 1/2).
+    pub jitter: bool,
+}
+
+impl RayMarchingScatter {
+    /// The offset of a marched ray.
+    fn offset(&self, rng: &mut StreamRng) -> f64 {
+        if self.jitter {
+            rng.gen()
+        } else {
+            0.5
+        }
+    }
 }
 
 /// The shadow segment from `p` to the light inside the medium (origin, direction, segment).
@@ -52,11 +68,10 @@ fn summed_shadow_length(probe: &MediumProbe<'_>, geo: &Geometry) -> f64 {
         * h
 }
 
-/// `exp(-h sum sigma)` over `n` steps of `[a, b]` of a line with one random offset.
-fn marched(probe: &MediumProbe<'_>, o: Vec3, w: Vec3, (a, b): (f64, f64), h: f64, rng: &mut StreamRng) -> f64 {
+/// `exp(-h sum sigma)` over `n` steps of `[a, b]` of a line with offset `u`.
+fn marched(probe: &MediumProbe<'_>, o: Vec3, w: Vec3, (a, b): (f64, f64), h: f64, u: f64) -> f64 {
     let n = ((b - a) / h).ceil().max(1.0);
     let hs = (b - a) / n;
-    let u: f64 = rng.gen();
     let tau: f64 = (0..n as u64).map(|k| probe.sigma_t(o + w * (a + (k as f64 + u) * hs))).sum::<f64>() * hs;
     (-tau).exp()
 }
@@ -67,7 +82,7 @@ impl RayMarchingScatter {
         let (t0, t1) = geo.seg;
         let n = ((t1 - t0) / h).ceil().max(1.0);
         let h = (t1 - t0) / n;
-        let u: f64 = rng.gen();
+        let u = self.offset(rng);
         let (mut tau, mut sum) = (0.0, 0.0);
         for j in 0..n as u64 {
             let t = t0 + (j as f64 + u) * h;
@@ -78,7 +93,7 @@ impl RayMarchingScatter {
                 let t_l = match shadow_segment(probe, geo.point(t), geo) {
                     Some((w, seg)) => {
                         probe.shadow_ray();
-                        marched(probe, geo.point(t), w, seg, h, rng)
+                        marched(probe, geo.point(t), w, seg, h, self.offset(rng))
                     }
                     None => 1.0,
                 };

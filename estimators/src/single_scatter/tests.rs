@@ -83,6 +83,28 @@ fn unbiased_ids_pass_and_ray_marching_is_flagged() {
     }
 }
 
+/// The same on the Perlin medium's stored 4x4 reference (default light): every unbiased id passes
+/// under sample budgets, and the pooled relative bias of all pixels is tested too (the harness's
+/// fetch budgets make the ray count a stopping time; these budgets do not).
+#[test]
+fn unbiased_ids_pass_on_the_perlin_medium() {
+    let bed = MediumBed::new(Field::Perlin, "single-scatter", &Params::new()).unwrap();
+    let pixels: Vec<usize> = (0..16).filter(|i| ![0, 3, 12, 15].contains(i)).collect();
+    for (k, id) in IDS.iter().enumerate().skip(1) {
+        let m = moments(&bed, build(id, Params::new()).as_ref(), &pixels, 300, 4, 500 + 50 * k as u64);
+        let p = holm_p(&bed, &m, &pixels);
+        assert!(p > 1e-3, "{id}: Holm p = {p:e}");
+        let (mut rel, mut var) = (0.0, 0.0);
+        for (m, &i) in m.iter().zip(&pixels) {
+            let r = bed.reference().value[i][0];
+            rel += (m.mean() - r) / r;
+            var += (m.std_err() / r).powi(2);
+        }
+        let z = rel / var.sqrt();
+        assert!(z.abs() < 3.29, "{id}: pooled relative bias z = {z:.2}");
+    }
+}
+
 /// SPEC §10 stability: the light on the sphere's boundary, inside the densest region (sigma_t = 1
 /// at z = pi, x + y + z = 4 pi / 3) and 1e-4 from a pixel ray: every id returns finite values,
 /// and the source-driven and MIS estimators (whose density follows the 1 / r^2 peak) still agree
@@ -136,6 +158,7 @@ fn bad_input_is_refused_naming_the_field() {
         ("attenuation_driven_sir", Params::new().with("shadow_rays", 0.0), "shadow_rays"),
         ("source_driven", Params::new().with("explorer_spacing", 0.0), "source_driven.explorer_spacing"),
         ("ray_marching", Params::new().with("step", 0.0), "ray_marching.step"),
+        ("ray_marching", Params::new().with("jitter", 0.5), "ray_marching.jitter"),
     ] {
         let err = (registry::estimator(id).unwrap().build)(&p).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(err.contains(field), "{id}: {err}");
@@ -193,6 +216,15 @@ fn costs_are_counted() {
         assert_eq!(task.costs().samples, 1);
         assert!((0.6 * budget as f64..1.5 * budget as f64).contains(&f), "{budget}: {f}");
     }
+    // Without jitter the marcher is deterministic (the paper's noise-free marcher).
+    let fixed = build("ray_marching", Params::new().with("jitter", 0.0));
+    let runs: Vec<f64> = (0..2)
+        .map(|k| {
+            let task = Task::new(&bed, 5, Budget::new(BudgetKind::Fetches, 100).unwrap());
+            fixed.estimate(&task, &mut stream(k, "rm0")).unwrap()[0]
+        })
+        .collect();
+    assert_eq!(runs[0], runs[1]);
     // An explicit step keeps the step under a fetch budget: the budget buys more rays.
     let task = Task::new(&bed, 5, Budget::new(BudgetKind::Fetches, 300).unwrap());
     build("ray_marching", Params::new().with("step", 5.0)).estimate(&task, &mut stream(4, "rm5")).unwrap();

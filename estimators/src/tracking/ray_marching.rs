@@ -28,9 +28,13 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             "ray_marching",
             p,
             (&["step"], |p| Ok(Box::new(RayMarching { step: step(p)? }))),
-            (&["step"], |p| {
+            (&["step", "jitter"], |p| {
                 let fixed_step = p.0.contains_key("step");
-                Ok(Box::new(crate::single_scatter::ray_marching::RayMarchingScatter { step: step(p)?, fixed_step }))
+                let jitter = match p.f64("jitter", 1.0)? {
+                    j if j == 0.0 || j == 1.0 => j == 1.0,
+                    j => return Err(ConfigError::invalid("ray_marching.jitter", j, "must be 0 or 1")),
+                };
+                Ok(Box::new(crate::single_scatter::ray_marching::RayMarchingScatter { step: step(p)?, fixed_step, jitter }))
             }),
         )
     },
