@@ -28,6 +28,7 @@ pub mod quadrature;
 pub mod registry;
 pub mod rng;
 pub mod samplers;
+pub mod single_scatter;
 pub mod smc;
 pub mod smc_surface;
 pub mod stats;

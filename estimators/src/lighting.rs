@@ -33,6 +33,28 @@ impl Gradient {
     }
 }
 
+/// An isotropic point light (paper 002 §4.3, SPEC §3.3): radiant intensity `intensity` (power
+/// `4 pi intensity`) at `position`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointLight {
+    /// Where the light is.
+    pub position: Vec3,
+    /// Radiant intensity (W/sr); the power is `4 pi intensity`.
+    pub intensity: f64,
+}
+
+impl PointLight {
+    /// The closest approach of the ray `origin + t dir` (unit `dir`) to the light: the ray
+    /// parameter `t_l` where it is closest and the distance `D` there (paper 002 Fig. 11), so the
+    /// squared distance at `t` is `D^2 + (t - t_l)^2`.
+    pub fn closest_approach(&self, origin: Vec3, dir: Vec3) -> (f64, f64) {
+        let to = self.position - origin;
+        let t_l = to.dot(dir);
+        let perp = to - dir * t_l;
+        (t_l, perp.length())
+    }
+}
+
 /// A rectangular area light facing down (emitting towards `-z`), axis-aligned in `x` and `y`:
 /// `[x0, x1] x [y0, y1]` at height `z` with constant radiance (paper 003 Fig. 6, SPEC §3.5).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

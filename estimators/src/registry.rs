@@ -83,6 +83,10 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::tracking::spm::TERMINATING,
     &crate::tracking::spm::NONTERMINATING,
     &crate::tracking::spm::ADAPTIVE,
+    &crate::single_scatter::attenuation_driven::ENTRY,
+    &crate::single_scatter::attenuation_driven_sir::ENTRY,
+    &crate::single_scatter::source_driven::ENTRY,
+    &crate::single_scatter::scattering_driven::ENTRY,
 ];
 
 /// Every registered test bed.

@@ -268,6 +268,10 @@ impl MediumProbe<'_> {
             c.rays += 1;
         });
     }
+    /// Counts one more ray within the current sample (a shadow ray towards a light).
+    pub fn shadow_ray(&self) {
+        self.task.count(|c| c.rays += 1);
+    }
     /// Real extinction at `p`: one fetch.
     pub fn sigma_t(&self, p: Vec3) -> f64 {
         self.task.count(|c| c.fetches += 1);

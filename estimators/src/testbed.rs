@@ -142,6 +142,14 @@ pub enum MediumQuantity {
     },
     /// The radiance arriving at `origin` from `-dir` (multiple scattering under the environment).
     Radiance,
+    /// The radiance arriving at `origin` from `-dir` scattered once from a point light (paper 002
+    /// Eq. 22 without the background term): `int T(s) sigma_s(s) rho(cos) I T_l(s) / r(s)^2 ds`
+    /// over the ray's medium segment, `r(s)` the distance to the light and `T_l` the
+    /// transmittance towards it.
+    SingleScatter {
+        /// The light.
+        light: crate::lighting::PointLight,
+    },
 }
 
 /// The ray of one medium integral: origin, unit direction, length and what is estimated.

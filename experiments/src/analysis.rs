@@ -95,7 +95,8 @@ pub struct TestRow {
     pub test: String,
     /// Budget the test ran at.
     pub budget: u64,
-    /// Test statistic (largest |t| for the Holm tests).
+    /// Test statistic (largest |t| for the Holm tests; infinite when an estimate has zero
+    /// variance and misses the reference, which JSON stores as `null` and reads back as NaN).
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub statistic: f64,
     /// Smallest Holm-adjusted p-value (or the pooled test's p-value); `NaN` when nothing was tested.
@@ -409,6 +410,20 @@ mod tests {
         assert!(t[0].detectable_rel_bias > 0.1 && t[0].detectable_rel_bias < 0.2, "{}", t[0].detectable_rel_bias);
         let ok = unbiasedness(&c, &exact(&[[1.0, 1.0, 1.0], [2.0, 2.0, 2.0]]), Bias::Unbiased);
         assert!(ok.iter().all(|t| t.verdict == "pass" && t.agrees));
+    }
+
+    /// A deterministic estimate that misses the reference has an infinite t statistic: the row
+    /// still round-trips through summary.json (`mcbench plot` reads it back).
+    #[test]
+    fn zero_variance_rows_round_trip_through_json() {
+        let mut c = cell(&[[1.0, 1.0, 1.0]], 8);
+        let mut same = Moments::default();
+        (0..8).for_each(|_| same.push(1.0));
+        c.moments = vec![[same.clone(), same.clone(), same]];
+        let t = &unbiasedness(&c, &exact(&[[3.0, 3.0, 3.0]]), Bias::Biased)[0];
+        assert!(t.statistic.is_infinite() && t.p_value == 0.0 && t.verdict == "biased");
+        let back: TestRow = serde_json::from_str(&serde_json::to_string(t).unwrap()).unwrap();
+        assert!(back.statistic.is_nan() && back.p_value == 0.0 && back.verdict == "biased");
     }
 
     #[test]

@@ -9,17 +9,24 @@
 //! - `transmittance` (camera b): orthographic along +y over x in [-10, 10], z in [0, 20]; pixel =
 //!   `T(chord) L_env(+y)` (scattering ignored, paper Fig. 9-10);
 //! - `multiple`: the same camera, pixel = radiance with multiple scattering (paper Fig. 6-7),
-//!   stored long-run reference made by `mcbench reference <id> --variant multiple`.
+//!   stored long-run reference made by `mcbench reference <id> --variant multiple`;
+//! - `single-scatter`: the same camera, pixel = radiance scattered once from the point light of
+//!   SPEC §3.3 (paper 002 §4.3, Eq. 22 without the background term, Fig. 12), reference by nested
+//!   adaptive quadrature ([`scatter_reference`]).
 //!
 //! Parameters: `resolution` (image side), `points` (central-ray grid), `scale` (multiplies the
-//! extinction and the declared majorant; SPEC §10 optical depth 1e4), `albedo` (default 0.7 / 0.9).
+//! extinction and the declared majorant; SPEC §10 optical depth 1e4), `albedo` (default 0.7 / 0.9),
+//! and for `single-scatter` the light: `light_x`, `light_y`, `light_z` (default the sphere's centre
+//! (0, 0, 10)) and `intensity` (default 100, power 400 pi).
 
 pub mod density;
 pub mod environment;
 pub mod reference;
+pub mod scatter_reference;
 pub mod variance;
 
 use crate::error::ConfigError;
+use crate::lighting::PointLight;
 use crate::math::{Rgb, Vec3};
 use crate::params::Params;
 use crate::registry::TestBedEntry;
@@ -30,7 +37,11 @@ pub const CENTRE: Vec3 = Vec3::new(0.0, 0.0, 10.0);
 /// Sphere radius.
 pub const RADIUS: f64 = 10.0;
 /// The variants of both media.
-pub const VARIANTS: &[&str] = &["central-ray", "transmittance", "multiple"];
+pub const VARIANTS: &[&str] = &["central-ray", "transmittance", "multiple", "single-scatter"];
+/// The point light of SPEC §3.3: intensity 100 (power 400 pi) at the sphere's centre.
+pub const LIGHT: PointLight = PointLight { position: CENTRE, intensity: 100.0 };
+/// Closest a pixel ray may pass the light: the single-scattered radiance grows like `1 / D`.
+pub const MIN_LIGHT_DISTANCE: f64 = 1e-9;
 
 /// Which extinction field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -62,8 +73,8 @@ impl Field {
 pub static EQ21: TestBedEntry = TestBedEntry {
     id: "eq21-medium",
     variants: VARIANTS,
-    provides: Needs::MEDIUM,
-    summary: "paper 002 Eq. 21 medium in a sphere, Rayleigh, albedo 0.7: central ray T(s), transmittance image, multiple scattering",
+    provides: Needs::MEDIUM.and(Needs::POINT_LIGHT),
+    summary: "paper 002 Eq. 21 medium in a sphere, Rayleigh, albedo 0.7: central ray T(s), transmittance image, multiple scattering, point-light single scattering",
     build: |v, p| Ok(Box::new(MediumBed::new(Field::Eq21, v, p)?)),
     compute_reference: Some(|v, p, t| reference::compute_stored(Field::Eq21, v, p, t)),
 };
@@ -72,8 +83,8 @@ pub static EQ21: TestBedEntry = TestBedEntry {
 pub static PERLIN: TestBedEntry = TestBedEntry {
     id: "perlin-medium",
     variants: VARIANTS,
-    provides: Needs::MEDIUM,
-    summary: "12-octave Perlin fbm medium (max 1, mostly < 0.6), Rayleigh, albedo 0.9; cheap = first 3 octaves",
+    provides: Needs::MEDIUM.and(Needs::POINT_LIGHT),
+    summary: "12-octave Perlin fbm medium (max 1, mostly < 0.6), Rayleigh, albedo 0.9; cheap = first 3 octaves; same variants",
     build: |v, p| Ok(Box::new(MediumBed::new(Field::Perlin, v, p)?)),
     compute_reference: Some(|v, p, t| reference::compute_stored(Field::Perlin, v, p, t)),
 };
@@ -86,7 +97,22 @@ pub struct MediumBed {
     albedo: f64,
     resolution: (usize, usize),
     rays: Vec<MediumRay>,
+    light: PointLight,
     reference: Reference,
+}
+
+/// The parameters of the point light (`single-scatter` only).
+const LIGHT_PARAMS: [&str; 4] = ["light_x", "light_y", "light_z", "intensity"];
+
+/// The point light from parameters (SPEC §3.3 defaults).
+fn light_param(field: Field, params: &Params) -> Result<PointLight, ConfigError> {
+    let p = LIGHT.position;
+    let position = Vec3::new(params.f64("light_x", p.x)?, params.f64("light_y", p.y)?, params.f64("light_z", p.z)?);
+    let intensity = params.f64("intensity", LIGHT.intensity)?;
+    if !(intensity > 0.0 && intensity <= 1e12) {
+        return Err(ConfigError::invalid(format!("{}.intensity", field.id()), intensity, "must lie in (0, 1e12]"));
+    }
+    Ok(PointLight { position, intensity })
 }
 
 /// Ray-sphere clip of the medium's sphere for unit `dir`, clamped to `t >= 0`.
@@ -106,7 +132,22 @@ pub fn clip_sphere(origin: Vec3, dir: Vec3) -> Option<(f64, f64)> {
 impl MediumBed {
     /// Builds a variant (validates parameters; computes exact or loads stored references).
     pub fn new(field: Field, variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown(field.id(), &["resolution", "points", "scale", "albedo"])?;
+        let mut bed = Self::without_reference(field, variant, params)?;
+        bed.reference = match variant {
+            "multiple" => reference::load_stored(field, bed.resolution.0, bed.scale, bed.albedo)?,
+            "single-scatter" => scatter_reference::reference(&bed)?,
+            _ => reference::transmittance_reference(&bed),
+        };
+        Ok(bed)
+    }
+
+    /// A variant without its reference (validates parameters; for computing a stored reference
+    /// and for tests that need no reference).
+    pub fn without_reference(field: Field, variant: &str, params: &Params) -> Result<Self, ConfigError> {
+        let light_params: &[&str] = if variant == "single-scatter" { &LIGHT_PARAMS } else { &[] };
+        let known: Vec<&str> =
+            ["resolution", "points", "scale", "albedo"].iter().chain(light_params).copied().collect();
+        params.reject_unknown(field.id(), &known)?;
         let albedo = params.f64_in("albedo", field.albedo(), 0.0, 1.0)?;
         if !VARIANTS.contains(&variant) {
             return Err(ConfigError::unknown(
@@ -119,7 +160,13 @@ impl MediumBed {
         if !(scale > 0.0 && scale <= 1e6) {
             return Err(ConfigError::invalid(format!("{}.scale", field.id()), scale, "must lie in (0, 1e6]"));
         }
-        let default_res = if variant == "multiple" || field == Field::Perlin { 16 } else { 32 };
+        let default_res = match (variant, field) {
+            ("single-scatter", Field::Perlin) => scatter_reference::PERLIN_RESOLUTION,
+            ("single-scatter", Field::Eq21) => scatter_reference::EQ21_RESOLUTION,
+            ("multiple", _) | (_, Field::Perlin) => 16,
+            _ => 32,
+        };
+        let light = light_param(field, params)?;
         let (resolution, rays) = match variant {
             "central-ray" => {
                 let k = params.count("points", 40, 10_000)?;
@@ -136,10 +183,10 @@ impl MediumBed {
             _ => {
                 let n = params.count("resolution", default_res, 512)?;
                 let dir = Vec3::new(0.0, 1.0, 0.0);
-                let quantity = if variant == "multiple" {
-                    MediumQuantity::Radiance
-                } else {
-                    MediumQuantity::Transmittance { weight: environment::radiance(dir) }
+                let quantity = match variant {
+                    "multiple" => MediumQuantity::Radiance,
+                    "single-scatter" => MediumQuantity::SingleScatter { light },
+                    _ => MediumQuantity::Transmittance { weight: environment::radiance(dir) },
                 };
                 let mut rays = Vec::with_capacity(n * n);
                 for py in 0..n {
@@ -153,39 +200,46 @@ impl MediumBed {
                 ((n, n), rays)
             }
         };
-        let mut bed = MediumBed {
+        let bed = MediumBed {
             field,
             variant: variant.to_string(),
             scale,
             albedo,
             resolution,
             rays,
+            light,
             reference: Reference::empty(),
         };
-        bed.reference = if variant == "multiple" {
-            reference::load_stored(field, resolution.0, scale, albedo)?
-        } else {
-            reference::transmittance_reference(&bed)
-        };
+        if variant == "single-scatter" {
+            bed.check_light_distance()?;
+        }
         Ok(bed)
     }
 
-    /// A bed without its reference (for computing a stored one).
-    pub(crate) fn without_reference(field: Field, variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        let res = params.count("resolution", 16, 512)?;
-        let rays = MediumBed::new(field, "transmittance", &Params::new().with("resolution", res as f64))?.rays;
-        let rays = rays.into_iter().map(|r| MediumRay { quantity: MediumQuantity::Radiance, ..r }).collect();
-        let scale = params.f64("scale", 1.0)?;
-        let albedo = params.f64_in("albedo", field.albedo(), 0.0, 1.0)?;
-        Ok(MediumBed {
-            field,
-            variant: variant.into(),
-            scale,
-            albedo,
-            resolution: (res, res),
-            rays,
-            reference: Reference::empty(),
-        })
+    /// Refuses a light closer than [`MIN_LIGHT_DISTANCE`] to a pixel ray that enters the medium
+    /// (the single-scattered radiance diverges like `1 / D` there).
+    fn check_light_distance(&self) -> Result<(), ConfigError> {
+        for (i, r) in self.rays.iter().enumerate() {
+            let (_, d) = self.light.closest_approach(r.origin, r.dir);
+            if d < MIN_LIGHT_DISTANCE && clip_sphere(r.origin, r.dir).is_some() {
+                return Err(ConfigError::invalid(
+                    format!("{}.light_x", self.field.id()),
+                    self.light.position.x,
+                    format!("the light is {d:e} from the ray of pixel {i} (at least {MIN_LIGHT_DISTANCE:e} needed: the radiance diverges like 1/D)"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The point light of the `single-scatter` variant.
+    pub fn light(&self) -> PointLight {
+        self.light
+    }
+
+    /// The extinction scale.
+    pub fn scale(&self) -> f64 {
+        self.scale
     }
 
     /// The field.
@@ -215,7 +269,11 @@ impl TestBed for MediumBed {
         &self.variant
     }
     fn provides(&self) -> Needs {
-        Needs::MEDIUM
+        if self.variant == "single-scatter" {
+            Needs::MEDIUM.and(Needs::POINT_LIGHT)
+        } else {
+            Needs::MEDIUM
+        }
     }
     fn resolution(&self) -> (usize, usize) {
         self.resolution
@@ -225,10 +283,13 @@ impl TestBed for MediumBed {
     }
     fn geometry(&self, i: usize) -> Vec<(&'static str, f64)> {
         let r = &self.rays[i];
-        if self.variant == "central-ray" {
-            vec![("s", r.length)]
-        } else {
-            vec![("ray_x", r.origin.x), ("ray_z", r.origin.z)]
+        match r.quantity {
+            _ if self.variant == "central-ray" => vec![("s", r.length)],
+            MediumQuantity::SingleScatter { light } => {
+                let (t_l, d) = light.closest_approach(r.origin, r.dir);
+                vec![("ray_x", r.origin.x), ("ray_z", r.origin.z), ("light_t", t_l), ("light_distance", d)]
+            }
+            _ => vec![("ray_x", r.origin.x), ("ray_z", r.origin.z)],
         }
     }
     fn medium(&self) -> Option<&dyn MediumScene> {

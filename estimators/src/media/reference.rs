@@ -22,21 +22,40 @@ use crate::testbed::{MediumQuantity, Reference, ReferenceKind, TestBed};
 /// Absolute tolerance on the optical depth (relative error of T <= 1e-12 with margin).
 pub const TAU_TOL: f64 = 1e-13;
 
+/// Initial quadrature panels per unit length for the transmittance references: one per unit for
+/// Eq. 21, one per 8 lattice cells of the finest Perlin octave (Perlin's optical depths then split
+/// at every lattice crossing and clamp kink anyway, see [`optical_depth_with`]).
+pub fn panels_per_unit(field: Field) -> f64 {
+    match field {
+        Field::Eq21 => 1.0,
+        Field::Perlin => density::perlin_constants::FREQ * 2f64.powi(density::perlin_constants::OCTAVES as i32 - 4),
+    }
+}
+
 /// The optical depth `int_a^b sigma_t(o + t d) dt` of `bed` by adaptive quadrature.
 pub fn optical_depth(bed: &MediumBed, o: Vec3, d: Vec3, a: f64, b: f64) -> Quadrature {
+    optical_depth_with(bed, o, d, (a, b), panels_per_unit(bed.field()), TAU_TOL)
+}
+
+/// [`optical_depth`] with `per_unit` initial panels per unit length and absolute tolerance `tol`.
+pub fn optical_depth_with(
+    bed: &MediumBed,
+    o: Vec3,
+    d: Vec3,
+    (a, b): (f64, f64),
+    per_unit: f64,
+    tol: f64,
+) -> Quadrature {
     if b <= a {
         return Quadrature { value: 0.0, error: 0.0, evaluations: 0 };
     }
-    let per_unit = match bed.field() {
-        Field::Eq21 => 1.0,
-        Field::Perlin => density::perlin_constants::FREQ * 2f64.powi(density::perlin_constants::OCTAVES as i32 - 4),
-    };
     let panels = ((b - a) * per_unit).ceil().max(1.0) as usize;
     let mut breaks: Vec<f64> = (0..=panels).map(|k| a + (b - a) * k as f64 / panels as f64).collect();
     if bed.field() == Field::Perlin {
+        // Every lattice crossing and clamp kink (then `per_unit` is irrelevant).
         breaks = with_clamp_kinks(&perlin_lattice_breaks(o, d, a, b), |t| perlin_unclamped(o + d * t));
     }
-    let q = gauss_kronrod_multi(|t| [bed.extinction(o + d * t)], &breaks, TAU_TOL, 0.0, 30);
+    let q = gauss_kronrod_multi(|t| [bed.extinction(o + d * t)], &breaks, tol, 0.0, 30);
     Quadrature { value: q.value[0], error: q.error[0], evaluations: q.evaluations }
 }
 

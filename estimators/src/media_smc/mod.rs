@@ -141,6 +141,18 @@ impl Estimator for MediaSmc {
             tasks.iter().map(|t| self.estimate(t, rng)).collect()
         }
     }
+    fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
+        supports_radiance(bed)
+    }
+}
+
+/// Refuses (as a skipped pair) media whose integrals are not the radiance under the environment
+/// (transmittances, point-light single scattering): these ids trace multiple scattering.
+pub fn supports_radiance(bed: &dyn TestBed) -> Result<(), String> {
+    match bed.medium().map(|m| m.ray(0).quantity) {
+        Some(crate::testbed::MediumQuantity::Radiance) => Ok(()),
+        _ => Err("traces multiple scattering under the environment; this test bed asks for another quantity".into()),
+    }
 }
 
 /// `is0_cv0` on a medium: the independent volumetric path tracer (free flights, phase sampling).
@@ -156,6 +168,9 @@ impl Estimator for PathTracer {
             mean.push(walk::independent_path(&probe, rng));
         }
         Ok(finite(std::slice::from_ref(task), vec![mean.mean()])?[0])
+    }
+    fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
+        supports_radiance(bed)
     }
 }
 

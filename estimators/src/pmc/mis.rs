@@ -2,7 +2,9 @@
 //! BRDF sample and one light sample per round (the light chosen with probability proportional to
 //! its power, a uniform point on it), combined with the balance heuristic (`power` = 2 selects the
 //! power heuristic). A round's estimate is `f(x_b) w_b(x_b) / p_b(x_b) + f(x_l) w_l(x_l) / p_l(x_l)`;
-//! an odd budget ends with a BRDF-only round `f / p_b`. The estimate averages the rounds.
+//! an odd budget ends with a BRDF-only round `f / p_b`. The estimate averages the rounds. On
+//! point-light single scattering in a medium the same id is paper 002's MIS
+//! ([`crate::single_scatter::mis`]).
 
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
@@ -21,15 +23,21 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     paper: "003",
     label: "MIS",
     bias: Bias::Unbiased,
-    needs: Needs::SURFACE.and(Needs::AREA_LIGHTS),
-    summary: "one BRDF + one light sample per round, balance heuristic (power = 2: power heuristic)",
+    needs: Needs::NONE,
+    summary: "one BRDF + one light sample per round, balance heuristic (power = 2: power heuristic); on point-light single scattering (paper 002), source- + scattering-driven points, balance heuristic",
     build: |p| {
-        p.reject_unknown("mis", &["power"])?;
-        let power = p.f64("power", 1.0)?;
-        if power != 1.0 && power != 2.0 {
-            return Err(ConfigError::invalid("mis.power", power, "must be 1 (balance) or 2 (power heuristic)"));
-        }
-        Ok(Box::new(Mis { power }))
+        crate::single_scatter::SingleScatterOr::build(
+            "mis",
+            p,
+            (&["power"], |p| {
+                let power = p.f64("power", 1.0)?;
+                if power != 1.0 && power != 2.0 {
+                    return Err(ConfigError::invalid("mis.power", power, "must be 1 (balance) or 2 (power heuristic)"));
+                }
+                Ok(Box::new(Mis { power }))
+            }),
+            (crate::single_scatter::mis::PARAMS, |p| Ok(Box::new(crate::single_scatter::mis::MisScatter::from_params(p)?))),
+        )
     },
 };
 
@@ -100,5 +108,11 @@ impl Estimator for Mis {
             rounds += 1;
         }
         Ok(if rounds > 0 { sum / rounds as f64 } else { Rgb::ZERO })
+    }
+    fn supports(&self, bed: &dyn crate::testbed::TestBed) -> Result<(), String> {
+        match bed.hemisphere() {
+            Some(h) if !h.lights().is_empty() => Ok(()),
+            _ => Err("mis needs a surface with area lights (paper 003) or point-light single scattering in a medium (paper 002)".into()),
+        }
     }
 }

@@ -33,6 +33,11 @@ impl SamplingDensity {
         debug_assert!(t.windows(2).all(|w| w[0] < w[1]), "knots must increase");
         SamplingDensity { t, v: v.into_iter().map(|x| x.max(0.0)).collect(), interp }
     }
+    /// The same knots with every value raised to at least `floor` (a density that is positive
+    /// wherever `floor > 0`).
+    pub fn floored(&self, floor: f64) -> SamplingDensity {
+        SamplingDensity { t: self.t.clone(), v: self.v.iter().map(|v| v.max(floor)).collect(), interp: self.interp }
+    }
     /// The density at `s`.
     pub fn eval(&self, s: f64) -> f64 {
         let n = self.t.len();
@@ -101,6 +106,23 @@ impl SamplingDensity {
     pub fn sample(&self, start: f64, xi: f64) -> f64 {
         self.solve(start, -(-xi).ln_1p())
     }
+    /// A free flight from `t0` conditioned to end before `t1` (paper 002 §4.3 scattering-driven
+    /// sampling mimics `T sigma_t` this way), by inverting its CDF
+    /// `(1 - exp(-Lambda(t))) / (1 - exp(-Lambda(t1)))` with `xi` in `[0, 1)`. Needs
+    /// `int_{t0}^{t1} sigma > 0` (see [`SamplingDensity::pdf_truncated`]).
+    pub fn sample_truncated(&self, (t0, t1): (f64, f64), xi: f64) -> f64 {
+        let total = self.integral(t0, t1);
+        self.solve(t0, -(xi * (-total).exp_m1()).ln_1p()).clamp(t0, t1)
+    }
+    /// The density of [`SamplingDensity::sample_truncated`] at `t`: zero outside `[t0, t1]` or
+    /// when the density accumulates nothing there.
+    pub fn pdf_truncated(&self, (t0, t1): (f64, f64), t: f64) -> f64 {
+        let norm = -(-self.integral(t0, t1)).exp_m1();
+        if !(t0..=t1).contains(&t) || norm <= 0.0 {
+            return 0.0;
+        }
+        self.eval(t) * (-self.integral(t0, t)).exp() / norm
+    }
 }
 
 #[cfg(test)]
@@ -152,6 +174,21 @@ mod tests {
             let s = d.solve(0.5, tau);
             assert!((d.integral(0.5, s) - tau).abs() < 1e-12, "tau {tau}");
         }
+    }
+
+    /// The truncated free flight (scattering-driven sampling) follows its reported density.
+    #[test]
+    fn truncated_free_flight_fits_its_pdf() {
+        let d = SamplingDensity::new(vec![1.0, 3.0, 6.0, 9.0], vec![0.05, 0.9, 0.02, 0.4], Interp::Linear);
+        let edges: Vec<f64> = (0..=48).map(|k| 1.0 + 10.0 * k as f64 / 48.0).collect();
+        crate::samplers::testing::assert_interval_sampler_fits(
+            "truncated free flight",
+            &edges,
+            200_000,
+            23,
+            |r| d.sample_truncated((1.0, 11.0), r.gen()),
+            |t| d.pdf_truncated((1.0, 11.0), t),
+        );
     }
 
     #[test]

@@ -5,6 +5,7 @@
 
 pub mod cone;
 pub mod cosine_hemisphere;
+pub mod equiangular;
 pub mod free_flight;
 pub mod mixture;
 pub mod phong_lobe;

@@ -13,7 +13,7 @@ use std::f64::consts::PI;
 
 /// How many sampler chi-square tests the workspace runs (the Sidak family size). Raise it when
 /// adding a sampler test.
-pub const SAMPLER_TESTS: usize = 57;
+pub const SAMPLER_TESTS: usize = 60;
 
 /// The per-test significance level: Sidak-corrected 0.01 over [`SAMPLER_TESTS`].
 pub fn sampler_alpha() -> f64 {
@@ -114,6 +114,62 @@ pub fn assert_sampler_fits(
     pdf: impl Fn(Vec3) -> f64,
 ) {
     let c = sampler_chi_square(grid, n, seed, sample, pdf);
+    let alpha = sampler_alpha();
+    assert!(
+        c.p_value > alpha,
+        "{name}: chi-square {} on {} dof, p = {:e} < alpha {alpha:e}",
+        c.statistic,
+        c.dof,
+        c.p_value
+    );
+}
+
+/// Draws `n` values of a one-dimensional sampler (distances along a ray) with a fixed seed, bins
+/// them on the increasing `edges` (values outside them fall in one more cell), and runs the
+/// chi-square test against the cell probabilities of the reported density `pdf`, integrated by
+/// 12-point Gauss-Legendre per cell.
+pub fn interval_chi_square(
+    edges: &[f64],
+    n: usize,
+    seed: u64,
+    mut sample: impl FnMut(&mut StreamRng) -> f64,
+    pdf: impl Fn(f64) -> f64,
+) -> ChiSquare {
+    let mut rng = stream(seed, "interval chi-square");
+    let cells = edges.len() - 1;
+    let mut counts = vec![0u64; cells + 1];
+    for _ in 0..n {
+        let t = sample(&mut rng);
+        let inside = t >= edges[0] && t < edges[cells];
+        counts[if inside { edges.partition_point(|&e| e <= t) - 1 } else { cells }] += 1;
+    }
+    let (x, w) = gauss_legendre(12);
+    let mut probs: Vec<f64> = edges
+        .windows(2)
+        .map(|e| {
+            let (c, h) = (0.5 * (e[0] + e[1]), 0.5 * (e[1] - e[0]));
+            x.iter().zip(&w).map(|(xi, wi)| wi * pdf(c + h * xi)).sum::<f64>() * h
+        })
+        .collect();
+    let inside: f64 = probs.iter().sum();
+    probs.push((1.0 - inside).max(0.0));
+    match chi_square_gof(&counts, &probs) {
+        Ok(c) => c,
+        Err(e) => panic!("chi-square could not run: {e}"),
+    }
+}
+
+/// Asserts that a one-dimensional sampler follows `pdf` at the family's significance level
+/// ([`interval_chi_square`]).
+pub fn assert_interval_sampler_fits(
+    name: &str,
+    edges: &[f64],
+    n: usize,
+    seed: u64,
+    sample: impl FnMut(&mut StreamRng) -> f64,
+    pdf: impl Fn(f64) -> f64,
+) {
+    let c = interval_chi_square(edges, n, seed, sample, pdf);
     let alpha = sampler_alpha();
     assert!(
         c.p_value > alpha,

@@ -2,7 +2,9 @@
 //! constant majorant (declared by the scene, or parameter `sigma_samp`, which must be a majorant).
 //! Transmittance: terminate with probability `r = sigma_t / sigma_samp`. Radiance (particle
 //! tracing): the analog collision of Eq. 7 (scatter with probability `a r`, absorb `(1 - a) r`,
-//! pass `1 - r`), i.e. the terminating single particle model at a majorant.
+//! pass `1 - r`), i.e. the terminating single particle model at a majorant. Point-light single
+//! scattering: Woodcock tracking to the first real collision and a Woodcock shadow ray
+//! ([`crate::single_scatter::delta_tracking`]).
 
 use super::spm::{trace, SpmMode};
 use super::{sigma_samp_param, track, transmittance, Rule};
@@ -23,10 +25,18 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "Woodcock (delta) tracking",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM,
-    summary: "Woodcock tracking with the majorant: transmittance, or analog particle tracing",
+    summary:
+        "Woodcock tracking with the majorant: transmittance, analog particle tracing, or point-light single scattering",
     build: |p| {
-        p.reject_unknown("delta_tracking", &["sigma_samp"])?;
-        Ok(Box::new(DeltaTracking { sigma_samp: sigma_samp_param(p, "delta_tracking")? }))
+        crate::single_scatter::SingleScatterOr::build(
+            "delta_tracking",
+            p,
+            (&["sigma_samp"], |p| Ok(Box::new(DeltaTracking { sigma_samp: sigma_samp_param(p, "delta_tracking")? }))),
+            (&["sigma_samp"], |p| {
+                let sigma_samp = sigma_samp_param(p, "delta_tracking")?;
+                Ok(Box::new(crate::single_scatter::delta_tracking::DeltaTrackingScatter { sigma_samp }))
+            }),
+        )
     },
 };
 
@@ -42,7 +52,16 @@ impl Estimator for DeltaTracking {
         let sigma = self.sigma_samp.unwrap_or(probe.majorant());
         if let MediumQuantity::Transmittance { .. } = probe.ray().quantity {
             return transmittance(task, rng, |probe, seg, rng| {
-                track(probe, probe.ray(), seg, &SamplingDensity::constant(sigma), None, Rule::Delta, rng, |_| ())
+                track(
+                    probe,
+                    (probe.ray().origin, probe.ray().dir),
+                    seg,
+                    &SamplingDensity::constant(sigma),
+                    None,
+                    Rule::Delta,
+                    rng,
+                    |_| (),
+                )
             });
         }
         let mut mean = RgbMean::new();

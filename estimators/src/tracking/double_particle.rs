@@ -54,7 +54,16 @@ impl Estimator for DoubleParticle {
             }
             let samp = SamplingDensity::constant(self.sigma_samp);
             let m = main.as_ref();
-            let e = track(probe, probe.ray(), seg, &samp, m.map(|x| &x.0), Rule::Double, rng, |_| ())?;
+            let e = track(
+                probe,
+                (probe.ray().origin, probe.ray().dir),
+                seg,
+                &samp,
+                m.map(|x| &x.0),
+                Rule::Double,
+                rng,
+                |_| (),
+            )?;
             Ok(e * m.map_or(1.0, |x| x.1))
         })
     }

@@ -15,12 +15,12 @@ pub mod spm;
 
 use crate::accumulate::RgbMean;
 use crate::error::{ConfigError, EstimateError};
-use crate::math::Rgb;
+use crate::math::{Rgb, Vec3};
 use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::{MediumProbe, Task};
-use crate::testbed::{MediumQuantity, MediumRay, TestBed};
+use crate::testbed::{MediumQuantity, TestBed};
 use rand::Rng;
 
 /// How the weight of the transmitted particle changes at an interaction with
@@ -74,19 +74,36 @@ pub fn interact(rule: Rule, r: f64, xi: f64) -> Result<f64, EstimateError> {
     }
 }
 
-/// The paper's `Transmittance` algorithm (§4.2) on `[t0, t1]` of `ray` for the difference
-/// extinction `sigma_t - main(t)`: free flights from `samp` (Eq. 4), `rule` at each interaction.
-/// Returns the weight of the transmitted particle (multiply by the main part's transmittance).
+/// One interaction of the `Transmittance` algorithm: where it happened, the extinction fetched
+/// there, the difference extinction, and the transmitted weight before and after it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interaction {
+    /// Ray parameter.
+    pub s: f64,
+    /// Real extinction `sigma_t` (one fetch).
+    pub sigma_t: f64,
+    /// `sigma_t - sigma_main`.
+    pub sigma_diff: f64,
+    /// Weight of the transmitted particle before the interaction.
+    pub before: f64,
+    /// Weight after it.
+    pub after: f64,
+}
+
+/// The paper's `Transmittance` algorithm (§4.2) on `[t0, t1]` of the line `origin + s dir` for
+/// the difference extinction `sigma_t - main(s)`: free flights from `samp` (Eq. 4), `rule` at each
+/// interaction, which is reported to `seen`. Returns the weight of the transmitted particle
+/// (multiply by the main part's transmittance).
 #[allow(clippy::too_many_arguments)] // the tracker loop of paper 002 Alg. 1: probe, ray, segment, densities, weights, callbacks
 pub fn track(
     probe: &MediumProbe<'_>,
-    ray: &MediumRay,
+    (origin, dir): (Vec3, Vec3),
     (t0, t1): (f64, f64),
     samp: &SamplingDensity,
     main: Option<&SamplingDensity>,
     rule: Rule,
     rng: &mut StreamRng,
-    mut seen: impl FnMut(f64),
+    mut seen: impl FnMut(&Interaction),
 ) -> Result<f64, EstimateError> {
     let (mut e, mut s) = (1.0, t0);
     loop {
@@ -94,9 +111,11 @@ pub fn track(
         if s >= t1 {
             return Ok(e);
         }
-        let sigma_diff = probe.sigma_t(ray.origin + ray.dir * s) - main.map_or(0.0, |m| m.eval(s));
-        seen(sigma_diff);
+        let sigma_t = probe.sigma_t(origin + dir * s);
+        let sigma_diff = sigma_t - main.map_or(0.0, |m| m.eval(s));
+        let before = e;
         e *= interact(rule, sigma_diff / samp.eval(s), rng.gen::<f64>())?;
+        seen(&Interaction { s, sigma_t, sigma_diff, before, after: e });
         if e == 0.0 {
             return Ok(0.0);
         }

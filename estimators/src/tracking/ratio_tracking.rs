@@ -35,7 +35,7 @@ impl Estimator for RatioTracking {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         transmittance(task, rng, |probe, seg, rng| {
             let samp = SamplingDensity::constant(self.sigma_samp.unwrap_or(probe.majorant()));
-            track(probe, probe.ray(), seg, &samp, None, Rule::Double, rng, |_| ())
+            track(probe, (probe.ray().origin, probe.ray().dir), seg, &samp, None, Rule::Double, rng, |_| ())
         })
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {

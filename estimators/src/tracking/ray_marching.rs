@@ -5,6 +5,8 @@
 //! Biased by construction (Jensen: E[exp(-X)] > exp(-E[X]), about `T Var(X) / 2`): with a fine step
 //! on a smooth medium the bias is far below what a run can detect, so the harness's control is a
 //! coarse step (`ray_marching[step=5]`).
+//! On point-light single-scatter integrals the same id marches the primary and shadow rays
+//! ([`crate::single_scatter::ray_marching`]).
 
 use super::{supports_transmittance, transmittance};
 use crate::budget::BudgetKind;
@@ -24,16 +26,32 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "ray marching (biased control)",
     bias: Bias::Biased,
     needs: Needs::MEDIUM,
-    summary: "biased control: fixed-step ray marching of the optical depth (step 0.9; one ray = the fetch budget)",
+    summary: "biased control: fixed-step ray marching of the optical depth (step 0.9; one ray = the fetch budget); on single scattering, of the primary and shadow rays",
     build: |p| {
-        p.reject_unknown("ray_marching", &["step"])?;
-        let step = p.f64("step", 0.9)?;
-        if step <= 0.0 {
-            return Err(ConfigError::invalid("ray_marching.step", step, "must be > 0"));
-        }
-        Ok(Box::new(RayMarching { step, fixed_step: p.0.contains_key("step") }))
+        crate::single_scatter::SingleScatterOr::build(
+            "ray_marching",
+            p,
+            (&["step"], |p| Ok(Box::new(RayMarching { step: step(p)?, fixed_step: p.0.contains_key("step") }))),
+            (&["step", "jitter"], |p| {
+                let fixed_step = p.0.contains_key("step");
+                let jitter = match p.f64("jitter", 1.0)? {
+                    j if j == 0.0 || j == 1.0 => j == 1.0,
+                    j => return Err(ConfigError::invalid("ray_marching.jitter", j, "must be 0 or 1")),
+                };
+                Ok(Box::new(crate::single_scatter::ray_marching::RayMarchingScatter { step: step(p)?, fixed_step, jitter }))
+            }),
+        )
     },
 };
+
+/// The `step` parameter (> 0, default 0.9).
+fn step(p: &crate::params::Params) -> Result<f64, ConfigError> {
+    let step = p.f64("step", 0.9)?;
+    if step <= 0.0 {
+        return Err(ConfigError::invalid("ray_marching.step", step, "must be > 0"));
+    }
+    Ok(step)
+}
 
 /// The estimator.
 pub struct RayMarching {

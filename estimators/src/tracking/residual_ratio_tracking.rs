@@ -11,7 +11,7 @@
 use super::{supports_transmittance, track, transmittance, Rule};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
+use crate::math::{Rgb, Vec3};
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::{Interp, SamplingDensity};
@@ -28,17 +28,8 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::MEDIUM,
     summary: "control variate through explorer points + constant sigma_samp ~ max |sigma_diff| of the last rays",
     build: |p| {
-        p.reject_unknown("residual_ratio_tracking", &["explorer_spacing", "recent", "sigma_floor", "sigma_samp0"])?;
-        let spacing = p.f64("explorer_spacing", 0.5)?;
-        let floor = p.f64("sigma_floor", 0.05)?;
-        let first = p.f64("sigma_samp0", 0.0)?;
-        for (name, v) in [("explorer_spacing", spacing), ("sigma_floor", floor)] {
-            if v <= 0.0 {
-                return Err(ConfigError::invalid(format!("residual_ratio_tracking.{name}"), v, "must be > 0"));
-            }
-        }
-        let recent = p.count("recent", 4, 1000)?;
-        Ok(Box::new(ResidualRatioTracking { spacing, recent, floor, first: (first > 0.0).then_some(first) }))
+        p.reject_unknown("residual_ratio_tracking", ResidualRatioTracking::PARAMS)?;
+        Ok(Box::new(ResidualRatioTracking::from_params(p, "residual_ratio_tracking")?))
     },
 };
 
@@ -54,37 +45,96 @@ pub struct ResidualRatioTracking {
     pub first: Option<f64>,
 }
 
-/// The piecewise-linear main part through explorer points on `[t0, t1]` and its transmittance
-/// `exp(-int sigma_main)` (cheap fetches, or full ones when the scene has no approximation).
-pub fn main_part(probe: &MediumProbe<'_>, (t0, t1): (f64, f64), spacing: f64) -> (SamplingDensity, f64) {
-    let n = ((t1 - t0) / spacing).ceil().max(1.0) as usize;
+impl ResidualRatioTracking {
+    /// The parameter names (shared by the single-scatter estimators, whose rays are tracked the
+    /// same way).
+    pub const PARAMS: &'static [&'static str] = &["explorer_spacing", "recent", "sigma_floor", "sigma_samp0"];
+
+    /// Reads the parameters (unknown names are the caller's to refuse), naming `owner` on error.
+    pub fn from_params(p: &crate::params::Params, owner: &str) -> Result<Self, ConfigError> {
+        let spacing = p.f64("explorer_spacing", 0.5)?;
+        let floor = p.f64("sigma_floor", 0.05)?;
+        let first = p.f64("sigma_samp0", 0.0)?;
+        for (name, v) in [("explorer_spacing", spacing), ("sigma_floor", floor)] {
+            if v <= 0.0 {
+                return Err(ConfigError::invalid(format!("{owner}.{name}"), v, "must be > 0"));
+            }
+        }
+        let recent = p.count("recent", 4, 1000)?;
+        Ok(ResidualRatioTracking { spacing, recent, floor, first: (first > 0.0).then_some(first) })
+    }
+
+    /// A fresh sigma_samp memory for a scene with this majorant.
+    pub fn memory(&self, majorant: f64) -> RecentMaximum {
+        RecentMaximum::new(self.recent, self.floor, self.first.unwrap_or(0.3 * majorant))
+    }
+}
+
+/// The piecewise-linear main part through explorer points on `[t0, t1]` of the integral's ray and
+/// its transmittance `exp(-int sigma_main)` (cheap fetches, or full ones when the scene has no
+/// approximation).
+pub fn main_part(probe: &MediumProbe<'_>, seg: (f64, f64), spacing: f64) -> (SamplingDensity, f64) {
     let ray = *probe.ray();
+    main_part_along(probe, (ray.origin, ray.dir), seg, spacing)
+}
+
+/// [`main_part`] along any line `origin + s dir` (e.g. a shadow ray).
+pub fn main_part_along(
+    probe: &MediumProbe<'_>,
+    (origin, dir): (Vec3, Vec3),
+    (t0, t1): (f64, f64),
+    spacing: f64,
+) -> (SamplingDensity, f64) {
+    let n = ((t1 - t0) / spacing).ceil().max(1.0) as usize;
     let t: Vec<f64> = (0..=n).map(|j| t0 + (t1 - t0) * j as f64 / n as f64).collect();
-    let v: Vec<f64> = t.iter().map(|&s| probe.sigma_approx(ray.origin + ray.dir * s)).collect();
+    let v: Vec<f64> = t.iter().map(|&s| probe.sigma_approx(origin + dir * s)).collect();
     let main = SamplingDensity::new(t, v, Interp::Linear);
     let tm = (-main.integral(t0, t1)).exp();
     (main, tm)
 }
 
+/// The paper's constant `sigma_samp` (§4.3): the largest `|sigma_diff|` seen on the last `recent`
+/// rays, at least `floor`; `first` before any ray was seen.
+#[derive(Clone, Debug)]
+pub struct RecentMaximum {
+    recent: usize,
+    floor: f64,
+    first: f64,
+    maxima: VecDeque<f64>,
+}
+
+impl RecentMaximum {
+    /// An empty memory.
+    pub fn new(recent: usize, floor: f64, first: f64) -> Self {
+        RecentMaximum { recent, floor, first, maxima: VecDeque::new() }
+    }
+    /// The sampling extinction for the next ray.
+    pub fn sigma(&self) -> f64 {
+        self.maxima.iter().copied().reduce(f64::max).unwrap_or(self.first).max(self.floor)
+    }
+    /// Remembers the largest `|sigma_diff|` of a finished ray.
+    pub fn push(&mut self, seen: f64) {
+        self.maxima.push_back(seen);
+        if self.maxima.len() > self.recent {
+            self.maxima.pop_front();
+        }
+    }
+}
+
 impl Estimator for ResidualRatioTracking {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         let mut main: Option<(SamplingDensity, f64)> = None;
-        let mut maxima: VecDeque<f64> = VecDeque::new();
+        let mut memory: Option<RecentMaximum> = None;
         transmittance(task, rng, |probe, seg, rng| {
             let (m, tm) = main.get_or_insert_with(|| main_part(probe, seg, self.spacing));
-            let sigma = match maxima.iter().copied().reduce(f64::max) {
-                Some(x) => x.max(self.floor),
-                None => self.first.unwrap_or(0.3 * probe.majorant()).max(self.floor),
-            };
+            let memory = memory.get_or_insert_with(|| self.memory(probe.majorant()));
+            let sigma = memory.sigma();
             let mut seen = 0.0f64;
-            let e =
-                track(probe, probe.ray(), seg, &SamplingDensity::constant(sigma), Some(m), Rule::Double, rng, |d| {
-                    seen = seen.max(d.abs())
-                })?;
-            maxima.push_back(seen);
-            if maxima.len() > self.recent {
-                maxima.pop_front();
-            }
+            let line = (probe.ray().origin, probe.ray().dir);
+            let e = track(probe, line, seg, &SamplingDensity::constant(sigma), Some(m), Rule::Double, rng, |i| {
+                seen = seen.max(i.sigma_diff.abs())
+            })?;
+            memory.push(seen);
             task.note("sigma_samp", sigma);
             Ok(e * *tm)
         })

@@ -76,7 +76,16 @@ impl Estimator for SingleParticle {
         transmittance(task, rng, |probe, seg, rng| {
             let a = probe.albedo();
             let rule = if self.terminating { Rule::Terminating { a } } else { Rule::NonTerminating { a } };
-            track(probe, probe.ray(), seg, &SamplingDensity::constant(self.sigma_samp), None, rule, rng, |_| ())
+            track(
+                probe,
+                (probe.ray().origin, probe.ray().dir),
+                seg,
+                &SamplingDensity::constant(self.sigma_samp),
+                None,
+                rule,
+                rng,
+                |_| (),
+            )
         })
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {

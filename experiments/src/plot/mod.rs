@@ -197,6 +197,10 @@ fn figure(
             .collect();
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
         let mut label = label_of(report, name).to_string();
+        // Parametrised runs of one id share its label: keep their parameters in the legend.
+        if let Some(params) = name.find('[').map(|i| &name[i..]).filter(|p| !label.ends_with(p)) {
+            label = format!("{label} {params}");
+        }
         if kind == PlotKind::Rmse {
             let fit = report.fits.iter().find(|f| f.testbed == testbed && f.variant == variant && f.estimator == *name);
             if let Some(f) = fit.filter(|f| f.slope.is_finite()) {

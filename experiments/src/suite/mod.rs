@@ -10,6 +10,8 @@ pub mod media_smc_post;
 pub mod particle_sweep;
 pub mod particle_sweep_post;
 pub mod pmc_hi;
+pub mod single_scatter;
+pub mod single_scatter_post;
 pub mod surface_smc;
 pub mod transmittance;
 pub mod transmittance_post;
@@ -47,8 +49,15 @@ pub struct ExperimentDef {
 pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &Path, Option<&Path>) -> crate::error::Result<Vec<PathBuf>>;
 
 /// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] =
-    &[&surface_smc::DEF, &media_smc::DEF, &transmittance::DEF, &particle_sweep::DEF, &pmc_hi::DEF, &envmap_smc::DEF];
+pub static EXPERIMENTS: &[&ExperimentDef] = &[
+    &surface_smc::DEF,
+    &media_smc::DEF,
+    &transmittance::DEF,
+    &particle_sweep::DEF,
+    &pmc_hi::DEF,
+    &envmap_smc::DEF,
+    &single_scatter::DEF,
+];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {
