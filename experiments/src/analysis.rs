@@ -167,7 +167,9 @@ fn skewness_se(n: u64) -> f64 {
 /// [`t_test_skewness_limit`] by more than twice its own standard error, so that symmetric data are
 /// not dropped for the noise of their skewness estimate; a delta-tracking pixel of low
 /// transmittance scores mostly 0) or all agree on a value off the reference is counted in
-/// `untested` instead, because its t statistic measures the skew, not a bias. When the mean skewness
+/// `untested` instead, because its t statistic measures the skew, not a bias (unless every integral
+/// of the cell has zero variance: a deterministic estimator off an exact reference beyond its
+/// bound is biased, p = 0). When the mean skewness
 /// over all the cell's integrals is beyond the limit, every integral is (a heavy tail shows across
 /// integrals even where one integral's repetitions missed it), and the Holm verdict is `untested`.
 ///
@@ -190,6 +192,9 @@ pub fn unbiasedness(cell: &CellResult, reference: &Reference, claim: Bias) -> Ve
     let (mut dev, mut dev_var, mut ref_sum) = (0.0, 0.0, 0.0);
     let per_test_alpha = UNBIASEDNESS_ALPHA / m as f64;
     let skew_limit = t_test_skewness_limit(reps, per_test_alpha);
+    // A deterministic estimator (no repetition of any integral differs: a noise-free quadrature)
+    // is compared exactly: any value off an exact reference by more than its bound is a bias.
+    let deterministic = reps >= 2 && cell.moments.iter().flatten().all(|m| m.std_err() == 0.0);
     for (i, mom) in cell.moments.iter().enumerate() {
         // The channels of one integral come from the same samples (often exactly proportional), so
         // their deviations are summed with the worst-case (fully correlated) standard error.
@@ -209,6 +214,9 @@ pub fn unbiasedness(cell: &CellResult, reference: &Reference, claim: Bias) -> Ve
                 // (e.g. 0 for a radiance of 1e-38): nothing to test, no evidence of bias.
                 None if se == 0.0 && (mc.mean() - r).abs() <= exact_bound => {
                     estimators::stats::TestOutcome { statistic: 0.0, p_value: 1.0, dof: f64::INFINITY }
+                }
+                None if deterministic => {
+                    estimators::stats::TestOutcome { statistic: f64::INFINITY, p_value: 0.0, dof: f64::INFINITY }
                 }
                 _ if se == 0.0 || mc.skewness().abs() > skew_limit + 2.0 * skewness_se(reps) => {
                     untested += 1;
@@ -424,6 +432,30 @@ mod tests {
         assert!(t.statistic.is_infinite() && t.p_value == 0.0 && t.verdict == "biased");
         let back: TestRow = serde_json::from_str(&serde_json::to_string(t).unwrap()).unwrap();
         assert!(back.statistic.is_nan() && back.p_value == 0.0 && back.verdict == "biased");
+    }
+
+    /// A rare-hit estimator (10 with probability 0.1, else 0; mean 1, skewness 2.7) over 200
+    /// integrals of 16 repetitions: its per-integral t-tests are not run (many integrals see no
+    /// hit), the pooled test passes it against the true mean and flags a 40% shifted reference (it detects ~19% with 80% power).
+    #[test]
+    fn skewed_cells_are_judged_by_the_pooled_test() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(0x5ce3);
+        let mut c = cell(&[[1.0, 1.0, 1.0]], 16);
+        c.moments = (0..200)
+            .map(|_| {
+                let mut m = Moments::default();
+                (0..16).for_each(|_| m.push(if rng.gen::<f64>() < 0.1 { 10.0 } else { 0.0 }));
+                [m.clone(), m.clone(), m]
+            })
+            .collect();
+        let truth = exact(&vec![[1.0; 3]; 200]);
+        let t = unbiasedness(&c, &truth, Bias::Unbiased);
+        assert_eq!((t[0].verdict.as_str(), t[0].untested), ("untested", 600), "{t:?}");
+        assert_eq!(t[1].test, "pooled_z");
+        assert!(t[1].verdict == "pass" && t[1].agrees, "{:?}", t[1]);
+        let shifted = unbiasedness(&c, &exact(&vec![[1.4; 3]; 200]), Bias::Unbiased);
+        assert_eq!(shifted[1].verdict, "biased", "{:?}", shifted[1]);
     }
 
     #[test]
