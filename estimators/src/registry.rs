@@ -90,6 +90,7 @@ pub static TESTBEDS: &[&TestBedEntry] = &[
     &crate::testbeds::gradient_plane::ENTRY,
     &crate::testbeds::envmap_sequence::ENTRY,
     &crate::testbeds::checker::ENTRY,
+    &crate::testbeds::checker_image::ENTRY,
     &crate::media::EQ21,
     &crate::media::PERLIN,
     &crate::testbeds::gradient_box::ENTRY,
