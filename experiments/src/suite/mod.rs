@@ -9,6 +9,9 @@ pub mod media_smc;
 pub mod media_smc_post;
 pub mod particle_sweep;
 pub mod pmc_hi;
+pub mod pmc_hi_post;
+pub mod pmc_ip;
+pub mod pmc_ip_post;
 pub mod surface_smc;
 pub mod transmittance;
 pub mod variance_claims;
@@ -45,8 +48,15 @@ pub struct ExperimentDef {
 pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &Path, Option<&Path>) -> crate::error::Result<Vec<PathBuf>>;
 
 /// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] =
-    &[&surface_smc::DEF, &media_smc::DEF, &transmittance::DEF, &particle_sweep::DEF, &pmc_hi::DEF, &envmap_smc::DEF];
+pub static EXPERIMENTS: &[&ExperimentDef] = &[
+    &surface_smc::DEF,
+    &media_smc::DEF,
+    &transmittance::DEF,
+    &particle_sweep::DEF,
+    &pmc_hi::DEF,
+    &pmc_ip::DEF,
+    &envmap_smc::DEF,
+];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {
