@@ -1,6 +1,9 @@
 //! Analytic lighting shared by the test beds.
 
 use crate::math::{Rgb, Vec3};
+use crate::samplers::{mixture::pick, rect_light};
+use crate::testbed::ShadingPoint;
+use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 /// The gradient background of papers 000/001: `L_b(w) = c0 + c1 w_z + c2 w_x` per channel
@@ -88,4 +91,73 @@ impl RectLight {
         let (x, y) = (p.x + t * w.x, p.y + t * w.y);
         (self.min[0] <= x && x <= self.max[0] && self.min[1] <= y && y <= self.max[1]).then_some(t)
     }
+}
+
+/// Light selection probabilities proportional to power (radiance x area): the light strategy of
+/// paper 003's MIS baseline (§5.3) and of `checker-image`'s pixel samples (SPEC §3.6).
+pub fn light_selection(lights: &[RectLight]) -> Vec<f64> {
+    let w: Vec<f64> = lights.iter().map(|l| l.radiance.mean() * l.area()).collect();
+    let t: f64 = w.iter().sum();
+    w.iter().map(|x| x / t).collect()
+}
+
+/// The solid-angle density at `w` of the light strategy that picks light `j` with probability
+/// `select[j]` and a uniform point on it, seen from `x`: `sum_j P_j pdf_j(w)`.
+pub fn light_pdf(lights: &[RectLight], select: &[f64], x: Vec3, w: Vec3) -> f64 {
+    lights.iter().zip(select).map(|(l, s)| s * rect_light::pdf(l, x, w)).sum()
+}
+
+/// The light and BRDF strategies of paper 003's MIS baseline (Veach 1997): light `j` picked with
+/// probability `select[j]` and a uniform point on it, combined with BRDF sampling by the balance
+/// heuristic (`power` 1) or the power heuristic (`power` 2).
+#[derive(Clone, Copy, Debug)]
+pub struct MisStrategy<'a> {
+    /// The lights.
+    pub lights: &'a [RectLight],
+    /// Selection probability of each light ([`light_selection`]).
+    pub select: &'a [f64],
+    /// Heuristic exponent: 1 balance, 2 power.
+    pub power: f64,
+}
+
+impl MisStrategy<'_> {
+    /// The MIS weight of a strategy with density `a` against one with density `b`, divided by `a`
+    /// (0 when both densities are 0, where the sample cannot have been drawn).
+    fn weight(&self, a: f64, b: f64) -> f64 {
+        let w = if self.power == 1.0 { 1.0 / (a + b) } else { a / (a * a + b * b) };
+        if w.is_finite() {
+            w
+        } else {
+            0.0
+        }
+    }
+}
+
+/// One MIS round at `point`: a BRDF sample and, when `light` is set, a light sample, each weighted
+/// by the heuristic: `f(x_b) w_b / p_b + f(x_l) w_l / p_l`, an unbiased estimate of the direct
+/// lighting. Without the light sample it is the BRDF-only estimate `f / p_b`. `integrand` gives
+/// `L_in f cos` of a direction (the caller counts it).
+pub fn mis_round<R: Rng + ?Sized>(
+    point: &ShadingPoint,
+    strategy: &MisStrategy<'_>,
+    light: bool,
+    mut integrand: impl FnMut(Vec3) -> Rgb,
+    rng: &mut R,
+) -> Rgb {
+    let p = point;
+    let (lights, select) = (strategy.lights, strategy.select);
+    let b = p.brdf.sample(p.wo, p.normal, rng);
+    let fb = integrand(b.w);
+    if !light {
+        return if b.pdf > 0.0 { fb / b.pdf } else { Rgb::ZERO };
+    }
+    let mut est = fb * strategy.weight(b.pdf, light_pdf(lights, select, p.position, b.w));
+    let j = pick(select, rng);
+    let ls = rect_light::sample(&lights[j], p.position, rng);
+    let fl = integrand(ls.w);
+    let pl = light_pdf(lights, select, p.position, ls.w);
+    if pl > 0.0 {
+        est += fl * strategy.weight(pl, p.brdf.pdf(ls.w, p.wo, p.normal));
+    }
+    est
 }

@@ -7,7 +7,9 @@ use crate::brdf::DirectionSample;
 use crate::budget::{Budget, BudgetKind};
 use crate::envmap::EnvFrame;
 use crate::math::{Rgb, Vec3};
-use crate::testbed::{EnvQuantity, EnvSequenceScene, HemisphereScene, MediumRay, MediumScene, ShadingPoint, TestBed};
+use crate::testbed::{
+    EnvQuantity, EnvSequenceScene, HemisphereScene, ImagePlaneScene, MediumRay, MediumScene, ShadingPoint, TestBed,
+};
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 use std::cell::{Cell, RefCell};
@@ -133,6 +135,10 @@ impl<'a> Task<'a> {
         let (pixel, frame) = (self.integral / frames, self.integral % frames);
         Some(EnvProbe { scene, task: self, pixel, frame, point: scene.shading(pixel), env: scene.environment(frame) })
     }
+    /// The image-plane probe of this integral (pixel), when the scene has one.
+    pub fn image_plane(&self) -> Option<ImageProbe<'_>> {
+        Some(ImageProbe { scene: self.bed.image_plane()?, task: self })
+    }
     fn count(&self, f: impl FnOnce(&mut Costs)) {
         let mut c = self.costs.get();
         f(&mut c);
@@ -168,6 +174,29 @@ impl HemisphereProbe<'_> {
         }
         self.task.count(|c| c.rays += 1);
         self.scene.incident(self.task.integral, wi) * p.brdf.eval(wi, p.wo, p.normal) * cos
+    }
+}
+
+/// Counted access to one pixel of an image-plane scene (paper 003 §4): every pixel sample counts
+/// one sample (the papers' spp) and the rays it traced.
+pub struct ImageProbe<'a> {
+    scene: &'a dyn ImagePlaneScene,
+    task: &'a Task<'a>,
+}
+
+impl ImageProbe<'_> {
+    /// One pixel sample at footprint position `(u, v)` in `[0, 1)^2`.
+    pub fn sample(&self, u: f64, v: f64, rng: &mut crate::rng::StreamRng) -> Rgb {
+        let (value, rays) = self.scene.pixel_sample(self.task.integral, u, v, rng);
+        self.task.count(|c| {
+            c.samples += 1;
+            c.rays += rays;
+        });
+        value
+    }
+    /// Records a diagnostic on this pixel's task ([`Task::note`]).
+    pub fn note(&self, name: &'static str, value: f64) {
+        self.task.note(name, value);
     }
 }
 

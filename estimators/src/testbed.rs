@@ -23,12 +23,15 @@ impl Needs {
     pub const ENV_SEQUENCE: Needs = Needs(8);
     /// Area lights that can be sampled.
     pub const AREA_LIGHTS: Needs = Needs(16);
-    const NAMES: [(Needs, &'static str); 5] = [
+    /// Pixel integrals over the image plane, sampled at chosen positions ([`ImagePlaneScene`]).
+    pub const IMAGE_PLANE: Needs = Needs(32);
+    const NAMES: [(Needs, &'static str); 6] = [
         (Needs::SURFACE, "surface"),
         (Needs::MEDIUM, "medium"),
         (Needs::POINT_LIGHT, "point light"),
         (Needs::ENV_SEQUENCE, "environment sequence"),
         (Needs::AREA_LIGHTS, "area lights"),
+        (Needs::IMAGE_PLANE, "image plane"),
     ];
     /// Union of two sets.
     pub const fn and(self, o: Needs) -> Needs {
@@ -131,6 +134,17 @@ pub trait HemisphereScene: Send + Sync {
     }
 }
 
+/// A scene whose integrals are pixel integrals over the image plane (paper 003 Eq. 2, SPEC §3.6):
+/// `I_p = int_{pixel p} E[S(p, u, v)] du dv` with a box filter, where one *pixel sample*
+/// `S(p, u, v)` is a random, unbiased estimate of the radiance seen through position `(u, v)` of
+/// the pixel's footprint. Image-plane samplers (PMC-IP, §4) choose how many samples each pixel
+/// gets and where; the scene decides what one sample costs.
+pub trait ImagePlaneScene: Send + Sync {
+    /// One pixel sample of pixel `pixel` at footprint position `(u, v)` in `[0, 1)^2`, and the
+    /// number of rays it traced.
+    fn pixel_sample(&self, pixel: usize, u: f64, v: f64, rng: &mut crate::rng::StreamRng) -> (Rgb, u64);
+}
+
 /// What integral `i` of a medium scene asks for (SPEC §3.3-3.4).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MediumQuantity {
@@ -225,6 +239,10 @@ pub trait TestBed: Send + Sync {
     }
     /// The participating-medium view of the scene, when it has one.
     fn medium(&self) -> Option<&dyn MediumScene> {
+        None
+    }
+    /// The image-plane view of the scene (paper 003 PMC-IP), when it has one.
+    fn image_plane(&self) -> Option<&dyn ImagePlaneScene> {
         None
     }
     /// The environment-sequence view of the scene (paper 004), when it has one.

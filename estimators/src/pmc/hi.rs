@@ -197,21 +197,24 @@ impl Estimator for PmcHi {
         let mut s = Sums { sum: Rgb::ZERO, n: 0, perplexity: 0.0, ess: 0.0, populations: 0 };
         let budget = task.budget().amount;
         let mut state = Adapted { alpha: Self::initial(m), cone: None };
+        let mut last = state.clone();
         for pass in 0..self.passes {
             let share = budget / self.passes as u64 + u64::from((pass as u64) < budget % self.passes as u64);
-            let adapted = self.run(&probe, task, &state, share.max(1), &mut s, rng);
+            last = self.run(&probe, task, &state, share.max(1), &mut s, rng);
             // Feedback (§6.1): the next pass starts from these weights; the cone needs a
             // population of its own, so it restarts empty.
-            let mut alpha = adapted.alpha;
+            let mut alpha = last.alpha.clone();
             let cone = alpha[m - 1];
             alpha[m - 1] = 0.0;
             alpha.iter_mut().for_each(|a| *a /= 1.0 - cone);
             state = Adapted { alpha, cone: None };
         }
+        // The adapted weights of the last kernel, cone included (paper 003 Fig. 7's maps).
         let names = ["alpha_brdf", "alpha_light0", "alpha_light1"];
         for (k, name) in names.iter().enumerate().take(m - 1) {
-            task.note(name, state.alpha[k]);
+            task.note(name, last.alpha[k]);
         }
+        task.note("alpha_cone", last.alpha[m - 1]);
         if s.populations > 0 {
             task.note("perplexity", s.perplexity / s.populations as f64);
             task.note("ess", s.ess / s.populations as f64);

@@ -8,12 +8,9 @@
 
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
-use crate::lighting::RectLight;
-use crate::math::{Rgb, Vec3};
+use crate::math::Rgb;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
-use crate::samplers::mixture::pick;
-use crate::samplers::rect_light;
 use crate::task::{HemisphereProbe, Task};
 use crate::testbed::Needs;
 
@@ -47,46 +44,15 @@ pub struct Mis {
     pub power: f64,
 }
 
-/// Light selection probabilities proportional to power (radiance x area).
-pub fn light_selection(lights: &[RectLight]) -> Vec<f64> {
-    let w: Vec<f64> = lights.iter().map(|l| l.radiance.mean() * l.area()).collect();
-    let t: f64 = w.iter().sum();
-    w.iter().map(|x| x / t).collect()
-}
-
-/// The density of the light strategy at `w`: `sum_j P_j pdf_j(w)`.
-pub fn light_pdf(lights: &[RectLight], select: &[f64], x: Vec3, w: Vec3) -> f64 {
-    lights.iter().zip(select).map(|(l, s)| s * rect_light::pdf(l, x, w)).sum()
-}
+pub use crate::lighting::{light_pdf, light_selection};
+use crate::lighting::{mis_round, MisStrategy};
 
 impl Mis {
-    fn weight(&self, a: f64, b: f64) -> f64 {
-        // The MIS weight of a strategy with density `a` against one with `b`, divided by `a`.
-        if self.power == 1.0 {
-            1.0 / (a + b)
-        } else {
-            a / (a * a + b * b)
-        }
-    }
-
-    /// One round: a BRDF sample and (when `light` is set) a light sample.
+    /// One round: a BRDF sample and (when `light` is set) a light sample
+    /// ([`crate::lighting::mis_round`] through the counted integrand).
     pub fn round(&self, probe: &HemisphereProbe<'_>, select: &[f64], light: bool, rng: &mut StreamRng) -> Rgb {
-        let p = *probe.point();
-        let lights = probe.lights();
-        let b = p.brdf.sample(p.wo, p.normal, rng);
-        let fb = probe.integrand(b.w);
-        if !light {
-            return if b.pdf > 0.0 { fb / b.pdf } else { Rgb::ZERO };
-        }
-        let mut est = fb * self.weight(b.pdf, light_pdf(lights, select, p.position, b.w));
-        let j = pick(select, rng);
-        let ls = rect_light::sample(&lights[j], p.position, rng);
-        let fl = probe.integrand(ls.w);
-        let pl = light_pdf(lights, select, p.position, ls.w);
-        if pl > 0.0 {
-            est += fl * self.weight(pl, p.brdf.pdf(ls.w, p.wo, p.normal));
-        }
-        est
+        let strategy = MisStrategy { lights: probe.lights(), select, power: self.power };
+        mis_round(probe.point(), &strategy, light, |w| probe.integrand(w), rng)
     }
 }
 

@@ -2,8 +2,13 @@
 //! feedback variant (§6.1), and the image-plane samplers (§4).
 
 pub mod hi;
+pub mod ip;
 pub mod kernel;
 pub mod mis;
+pub mod threshold_image;
+pub mod uniform_image;
 
+#[cfg(test)]
+mod stability_tests;
 #[cfg(test)]
 mod tests;

@@ -1,6 +1,8 @@
 //! The analytic test beds (SPEC §3), each with its exact or stored reference.
 
 pub mod checker;
+pub mod checker_image;
+pub mod checker_image_reference;
 pub mod checker_reference;
 pub mod envmap_reference;
 pub mod envmap_sequence;

@@ -5,6 +5,7 @@
 //! Text uses the DejaVu Sans font bundled in `assets/fonts` (no system fonts are needed).
 
 mod draw;
+pub(crate) mod maps;
 #[cfg(test)]
 pub(crate) mod tests;
 

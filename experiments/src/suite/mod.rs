@@ -10,6 +10,9 @@ pub mod media_smc_post;
 pub mod particle_sweep;
 pub mod particle_sweep_post;
 pub mod pmc_hi;
+pub mod pmc_hi_post;
+pub mod pmc_ip;
+pub mod pmc_ip_post;
 pub mod single_scatter;
 pub mod single_scatter_post;
 pub mod surface_smc;
@@ -55,6 +58,7 @@ pub static EXPERIMENTS: &[&ExperimentDef] = &[
     &transmittance::DEF,
     &particle_sweep::DEF,
     &pmc_hi::DEF,
+    &pmc_ip::DEF,
     &envmap_smc::DEF,
     &single_scatter::DEF,
 ];

@@ -19,7 +19,7 @@ pub static DEF: ExperimentDef = ExperimentDef {
     ids: IDS,
     sweep,
     claims,
-    post: None,
+    post: Some(super::pmc_hi_post::post),
 };
 
 fn sweep(mode: Mode) -> Sweep {

@@ -1,0 +1,244 @@
+//! `pmc_ip`: Population Monte Carlo image-plane sampling (paper 003 §4, Fig. 3).
+//!
+//! The kernel is a mixture with one component per pixel, uniform over the pixel's footprint
+//! (§4.1): `K(x) = sum_p alpha_p h_p(x)`. The initial image takes `initial` (2) samples in every
+//! pixel; each of the `iterations` (2) following populations spends an equal share of the rest of
+//! the image budget (`N_t` samples, 4 per pixel on average for 2 + 4 + 4 = 10 spp) and adapts the
+//! weights to the perceptually weighted variance seen so far (§4.2):
+//! `alpha_p ∝ eps + sigma_p^2 / tvi(L_p)` (`eps` = 0.01, Ferwerda tvi, `sigma_p^2` the sample
+//! variance and `L_p` the mean of the luminance of every sample of pixel `p` so far). Samples are
+//! allocated by deterministic mixture sampling (§4.3): `floor(N alpha_p)` per pixel plus i.i.d.
+//! residual draws.
+//!
+//! Estimate (Eq. 3 per pixel, p(x) = h_p(x), "each pixel as an individual integral"): every
+//! sample of pixel `p` is weighted by its own pixel component's density, so the sub-image of an
+//! iteration is the mean of that pixel's samples. Two decisions keep the whole estimate unbiased
+//! (not only each sub-image given its allocation):
+//! - the sub-images are combined with weights fixed in advance, their share of the planned
+//!   budget (`N_t / N`: 2/10, 4/10, 4/10), never with the realised counts: those depend on the
+//!   earlier samples of the same pixel (through `sigma_p^2`), and pooling every sample of a pixel
+//!   would correlate the weight of the first sub-image with its value (a bias). The paper averages
+//!   its sub-images unweighted (§4.4); fixed shares give the initial 2-spp image less weight and
+//!   are just as unbiased;
+//! - a sub-image is the mean of its samples only where the allocation guarantees at least one
+//!   (`min_samples` per pixel are reserved in every iteration, default 1: a defensive uniform
+//!   share of the kernel, Hesterberg 1995, which the paper's `eps` serves). Where it does not
+//!   (`min_samples = 0`, or fewer samples than pixels), the sub-image is the Horvitz-Thompson
+//!   estimate `sum f / E[n_p]` with `E[n_p] = N alpha_p` exact under DMS: unbiased, and zero when
+//!   no sample lands, but noisier (its count varies).
+//!
+//! Each estimate notes `alpha_perplexity` (normalised perplexity `exp(H(alpha)) / P` of the
+//! kernel weights, 1 = uniform, mean over iterations) and `ht_share` (share of pixel-iterations
+//! estimated by Horvitz-Thompson).
+
+use crate::budget::BudgetKind;
+use crate::error::{ConfigError, EstimateError};
+use crate::estimator::{Bias, Estimator};
+use crate::math::Rgb;
+use crate::params::Params;
+use crate::perception::{luminance, tvi};
+use crate::registry::EstimatorEntry;
+use crate::rng::StreamRng;
+use crate::samplers::mixture::dms_allocate;
+use crate::stats::Moments;
+use crate::task::{ImageProbe, Task};
+use crate::testbed::Needs;
+use rand::Rng;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "pmc_ip",
+    paper: "003",
+    label: "PMC-IP",
+    bias: Bias::Unbiased,
+    needs: Needs::IMAGE_PLANE,
+    summary: "PMC image-plane sampler: per-pixel mixture, alpha ∝ eps + sigma^2/tvi(L), DMS allocation (§4)",
+    build: |p| Ok(Box::new(PmcIp::from_params(p)?)),
+};
+
+/// The configured sampler.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PmcIp {
+    /// Samples per pixel of the initial (uniform) image.
+    pub initial: u64,
+    /// Adaptive iterations after the initial image.
+    pub iterations: usize,
+    /// The defensive constant of §4.2.
+    pub eps: f64,
+    /// Samples reserved for every pixel in every iteration.
+    pub min_samples: usize,
+}
+
+/// The allocation of one population (§4.3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Allocation {
+    /// Samples per pixel.
+    pub counts: Vec<usize>,
+    /// Expected samples per pixel, `N alpha~_p` (the kernel weight times the population size).
+    pub expected: Vec<f64>,
+    /// Whether the allocation guarantees pixel `p` at least one sample.
+    pub guaranteed: Vec<bool>,
+}
+
+/// Everything one run leaves behind (for the experiment's maps, paper Fig. 4).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trace {
+    /// The final estimate per pixel.
+    pub estimate: Vec<Rgb>,
+    /// The initial (uniform) sub-image.
+    pub initial_image: Vec<Rgb>,
+    /// The kernel weights `alpha~_p` (summing to 1) of each adaptive iteration.
+    pub alpha: Vec<Vec<f64>>,
+    /// Samples per pixel of each population, the initial one first.
+    pub counts: Vec<Vec<usize>>,
+    /// Pixel-iterations estimated by Horvitz-Thompson.
+    pub horvitz_thompson: usize,
+}
+
+impl PmcIp {
+    /// Reads `initial` (default 2), `iterations` (2), `eps` (0.01), `min_samples` (1).
+    pub fn from_params(p: &Params) -> Result<Self, ConfigError> {
+        p.reject_unknown("pmc_ip", &["initial", "iterations", "eps", "min_samples"])?;
+        let initial = p.count("initial", 2, 1 << 20)? as u64;
+        let iterations = p.count("iterations", 2, 4096)?;
+        let eps = p.f64_in("eps", 0.01, 1e-12, 1e12)?;
+        let min_samples = p.f64_in("min_samples", 1.0, 0.0, 1024.0)?;
+        if min_samples.fract() != 0.0 {
+            return Err(ConfigError::invalid("pmc_ip.min_samples", min_samples, "must be a whole number"));
+        }
+        Ok(PmcIp { initial, iterations, eps, min_samples: min_samples as usize })
+    }
+
+    /// The kernel weights of §4.2 from each pixel's luminance statistics:
+    /// `alpha_p ∝ eps + sigma_p^2 / tvi(L_p)` (a pixel with fewer than two samples counts as
+    /// variance 0). Every weight is positive and finite.
+    pub fn weights(&self, stats: &[Moments]) -> Vec<f64> {
+        let raw: Vec<f64> = stats
+            .iter()
+            .map(|m| {
+                let var = if m.count() >= 2 { m.variance() } else { 0.0 };
+                let mean = if m.count() >= 1 { m.mean() } else { 0.0 };
+                let v = var / tvi(mean);
+                self.eps + if v.is_finite() && v > 0.0 { v } else { 0.0 }
+            })
+            .collect();
+        let total: f64 = raw.iter().sum();
+        raw.iter().map(|a| a / total).collect()
+    }
+
+    /// Allocates a population of `n` samples over the pixels with weights `alpha`: `min_samples`
+    /// per pixel first (when `n` allows it), the rest by deterministic mixture sampling.
+    pub fn allocate<R: Rng + ?Sized>(&self, alpha: &[f64], n: usize, rng: &mut R) -> Allocation {
+        let pixels = alpha.len();
+        let m = if n >= self.min_samples * pixels { self.min_samples } else { 0 };
+        let rest = n - m * pixels;
+        let extra = dms_allocate(alpha, rest, rng);
+        let counts = extra.iter().map(|e| m + e).collect();
+        let expected = alpha.iter().map(|a| m as f64 + rest as f64 * a).collect();
+        let guaranteed = alpha.iter().map(|a| m + (rest as f64 * a).floor() as usize >= 1).collect();
+        Allocation { counts, expected, guaranteed }
+    }
+
+    /// One PMC-IP run over the pixels of `probes` with `spp` samples per pixel on average.
+    pub fn run(&self, probes: &[ImageProbe<'_>], spp: u64, rng: &mut StreamRng) -> Trace {
+        let pixels = probes.len();
+        let total = spp as usize * pixels;
+        let s0 = self.initial.min(spp) as usize;
+        let rest = total - s0 * pixels;
+        let iterations = if rest > 0 { self.iterations.min(rest) } else { 0 };
+        let mut stats = vec![Moments::default(); pixels];
+        let mut trace = Trace { estimate: vec![Rgb::ZERO; pixels], ..Trace::default() };
+        // The initial image: s0 uniform samples per pixel, weight s0 P / N.
+        let share = (s0 * pixels) as f64 / total as f64;
+        for (p, probe) in probes.iter().enumerate() {
+            let sum = sample_pixel(probe, s0, &mut stats[p], rng);
+            let sub = if s0 > 0 { sum / s0 as f64 } else { Rgb::ZERO };
+            trace.initial_image.push(sub);
+            trace.estimate[p] += sub * share;
+        }
+        trace.counts.push(vec![s0; pixels]);
+        for t in 0..iterations {
+            let n = rest / iterations + usize::from(t < rest % iterations);
+            let alpha = self.weights(&stats);
+            let a = self.allocate(&alpha, n, rng);
+            let share = n as f64 / total as f64;
+            let mut kernel = Vec::with_capacity(pixels);
+            for (p, probe) in probes.iter().enumerate() {
+                let sum = sample_pixel(probe, a.counts[p], &mut stats[p], rng);
+                let sub = if a.guaranteed[p] {
+                    sum / a.counts[p] as f64
+                } else {
+                    trace.horvitz_thompson += 1;
+                    sum / a.expected[p]
+                };
+                trace.estimate[p] += sub * share;
+                kernel.push(a.expected[p] / n as f64);
+            }
+            trace.alpha.push(kernel);
+            trace.counts.push(a.counts);
+        }
+        trace
+    }
+}
+
+/// `n` samples of one pixel at uniform footprint positions: their sum, with the luminance of
+/// each recorded in `stats`.
+fn sample_pixel(probe: &ImageProbe<'_>, n: usize, stats: &mut Moments, rng: &mut StreamRng) -> Rgb {
+    let mut sum = Rgb::ZERO;
+    for _ in 0..n {
+        let (u, v): (f64, f64) = (rng.gen(), rng.gen());
+        let x = probe.sample(u, v, rng);
+        stats.push(luminance(x));
+        sum += x;
+    }
+    sum
+}
+
+/// The image-plane probes of a sequence of tasks under a sample budget, or why not.
+pub fn image_probes<'a>(tasks: &'a [Task<'a>], id: &str) -> Result<(Vec<ImageProbe<'a>>, u64), EstimateError> {
+    let Some(first) = tasks.first() else { return Ok((Vec::new(), 0)) };
+    let budget = first.budget();
+    if budget.kind != BudgetKind::Samples || tasks.iter().any(|t| t.budget() != budget) {
+        return Err(EstimateError::Refused(format!("{id} needs the same sample budget (spp) for every pixel")));
+    }
+    let probes = tasks
+        .iter()
+        .map(|t| t.image_plane().ok_or_else(|| EstimateError::Refused(format!("{id} needs an image-plane scene"))))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok((probes, budget.amount))
+}
+
+/// Normalised perplexity `exp(H(alpha)) / K` of weights summing to 1.
+pub fn normalised_perplexity(alpha: &[f64]) -> f64 {
+    let h: f64 = alpha.iter().filter(|&&a| a > 0.0).map(|&a| -a * a.ln()).sum();
+    h.exp() / alpha.len().max(1) as f64
+}
+
+impl Estimator for PmcIp {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        Ok(self.estimate_sequence(std::slice::from_ref(task), rng)?[0])
+    }
+    fn estimate_sequence(&self, tasks: &[Task<'_>], rng: &mut StreamRng) -> Result<Vec<Rgb>, EstimateError> {
+        let (probes, spp) = image_probes(tasks, "pmc_ip")?;
+        if probes.is_empty() {
+            return Ok(Vec::new());
+        }
+        let trace = self.run(&probes, spp, rng);
+        let iterations = trace.alpha.len();
+        let perplexity = if iterations > 0 {
+            trace.alpha.iter().map(|a| normalised_perplexity(a)).sum::<f64>() / iterations as f64
+        } else {
+            1.0
+        };
+        let ht = trace.horvitz_thompson as f64 / (iterations * probes.len()).max(1) as f64;
+        for t in tasks {
+            t.note("alpha_perplexity", perplexity);
+            t.note("ht_share", ht);
+        }
+        Ok(trace.estimate)
+    }
+}
+
+#[cfg(test)]
+#[path = "ip_tests.rs"]
+mod tests;

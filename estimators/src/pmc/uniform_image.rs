@@ -1,0 +1,46 @@
+//! `uniform_image`: the baseline of paper 003 Table 1, "uniform image-plane sampling": every pixel
+//! gets the budget's samples at independent uniform positions in its footprint, and the estimate
+//! is their mean (Eq. 3 with `p = h_p`, the same per-sample sampler PMC-IP uses, so the two differ
+//! only in where the samples go).
+
+use crate::error::EstimateError;
+use crate::estimator::{Bias, Estimator};
+use crate::math::Rgb;
+use crate::registry::EstimatorEntry;
+use crate::rng::StreamRng;
+use crate::task::Task;
+use crate::testbed::Needs;
+use rand::Rng;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "uniform_image",
+    paper: "003",
+    label: "Uniform",
+    bias: Bias::Unbiased,
+    needs: Needs::IMAGE_PLANE,
+    summary: "uniform image-plane sampling: spp samples at uniform positions in every pixel (Table 1 baseline)",
+    build: |p| {
+        p.reject_unknown("uniform_image", &[])?;
+        Ok(Box::new(UniformImage))
+    },
+};
+
+/// The estimator.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct UniformImage;
+
+impl Estimator for UniformImage {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let probe = task
+            .image_plane()
+            .ok_or_else(|| EstimateError::Refused("uniform_image needs an image-plane scene".into()))?;
+        let (mut sum, mut n) = (Rgb::ZERO, 0u64);
+        while task.more() {
+            let (u, v): (f64, f64) = (rng.gen(), rng.gen());
+            sum += probe.sample(u, v, rng);
+            n += 1;
+        }
+        Ok(if n > 0 { sum / n as f64 } else { Rgb::ZERO })
+    }
+}

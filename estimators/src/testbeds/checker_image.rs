@@ -1,0 +1,232 @@
+//! `checker-image` (paper 003 §4.4, Table 1; SPEC §3.6): the `checker-direct` scene with pixel
+//! integrals over each pixel's footprint (box filter, paper 003 Eq. 2),
+//! `I_p = int_{pixel p} L(x(u, v)) du dv`, where `L(x)` is the direct lighting at the floor point
+//! seen through image position `(u, v)` (zero where the ray misses the board).
+//!
+//! One *pixel sample* is a position in the footprint plus one MIS direct-lighting estimate with
+//! `light_samples` (default 8, paper 003's Buddha: "8 lighting samples for each pixel sample")
+//! light samples, each paired with a BRDF sample and combined by the balance heuristic (the
+//! `mis` baseline's round, [`crate::lighting::mis_round`]). Its expectation over the MIS
+//! randomness is `L(x)`, so the mean over uniform footprint positions is `I_p`: image-plane
+//! samplers (`uniform_image`, `pmc_ip`) only choose where the pixel samples go.
+//!
+//! Costs: a pixel sample counts one sample and its rays (the camera ray, one per BRDF sample
+//! above the horizon, one per light sample).
+//!
+//! Reference: stored long-run values with standard errors (no closed form: the footprint
+//! integral of a glossy checkerboard under area lights), made by `mcbench reference
+//! checker-image --variant V` ([`super::checker_image_reference`]) and read from
+//! `results/references/checker-image_V.json` with the resolution it was made for.
+
+use super::checker::{CheckerGeometry, ENTRY as DIRECT};
+use crate::error::ConfigError;
+use crate::lighting::{light_selection, mis_round, MisStrategy};
+use crate::math::{Rgb, Vec3};
+use crate::params::Params;
+use crate::registry::TestBedEntry;
+use crate::rng::StreamRng;
+use crate::testbed::{ImagePlaneScene, Needs, Reference, ShadingPoint, TestBed};
+use serde::Deserialize;
+use std::path::PathBuf;
+
+/// Registry entry.
+pub static ENTRY: TestBedEntry = TestBedEntry {
+    id: "checker-image",
+    variants: &["default", "occluded"],
+    provides: Needs::IMAGE_PLANE,
+    summary: "checker scene, pixel-footprint integrals; a pixel sample = jittered position + MIS with 8 light samples (paper 003 Table 1)",
+    build: |variant, params| Ok(Box::new(CheckerImage::new(variant, params)?)),
+    compute_reference: Some(super::checker_image_reference::compute_reference),
+};
+
+/// Parameters the test bed accepts.
+pub const PARAMS: &[&str] = &["resolution", "light_samples"];
+
+/// The `checker-image` scene.
+pub struct CheckerImage {
+    variant: String,
+    size: usize,
+    light_samples: usize,
+    geometry: CheckerGeometry,
+    select: Vec<f64>,
+    reference: Reference,
+}
+
+/// A stored reference file (written by the CLI's `reference` command).
+#[derive(Deserialize)]
+struct StoredFile {
+    resolution: (usize, usize),
+    reference: Reference,
+}
+
+/// Where the stored reference of a variant lives.
+pub fn stored_path(variant: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../results/references")
+        .join(format!("checker-image_{variant}.json"))
+}
+
+impl CheckerImage {
+    /// Builds a variant with its stored reference. Parameters: `resolution` (square image side,
+    /// default 48; the stored reference loads only at the resolution it was made for) and
+    /// `light_samples` (MIS light samples per pixel sample, default 8; the reference does not
+    /// depend on it).
+    pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+        let bed = Self::without_reference(variant, params)?;
+        let reference = bed.load_stored()?;
+        Ok(CheckerImage { reference, ..bed })
+    }
+
+    /// The scene with an empty reference (the reference computation and the tests sample it).
+    pub fn without_reference(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+        params.reject_unknown("checker-image", PARAMS)?;
+        let size = params.count("resolution", 48, 512)?;
+        let light_samples = params.count("light_samples", 8, 1024)?;
+        let geometry = CheckerGeometry::new(variant).map_err(|_| {
+            ConfigError::unknown("variant", &format!("{}/{variant}", ENTRY.id), DIRECT.variants.iter().copied())
+        })?;
+        let select = light_selection(&geometry.lights);
+        Ok(CheckerImage {
+            variant: variant.to_string(),
+            size,
+            light_samples,
+            geometry,
+            select,
+            reference: Reference::empty(),
+        })
+    }
+
+    fn load_stored(&self) -> Result<Reference, ConfigError> {
+        let path = stored_path(&self.variant);
+        let hint = format!("run `mcbench reference checker-image --variant {}`", self.variant);
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            ConfigError::invalid("reference", path.display(), format!("no stored reference ({e}); {hint}"))
+        })?;
+        let file: StoredFile = serde_json::from_str(&text)
+            .map_err(|e| ConfigError::invalid("reference", path.display(), format!("malformed ({e}); {hint}")))?;
+        let n = self.size * self.size;
+        if file.resolution != (self.size, self.size)
+            || file.reference.value.len() != n
+            || file.reference.std_err.len() != n
+        {
+            let msg = format!("the stored reference is for {:?} pixels; use that resolution", file.resolution);
+            return Err(ConfigError::invalid("resolution", self.size, msg));
+        }
+        Ok(file.reference)
+    }
+
+    /// The scene geometry (shared with `checker-direct`).
+    pub fn geometry(&self) -> &CheckerGeometry {
+        &self.geometry
+    }
+
+    /// The floor point seen through the centre of pixel `i` (geometry columns), if any.
+    fn centre(&self, i: usize) -> Option<ShadingPoint> {
+        let (px, py) = (i % self.size, i / self.size);
+        self.geometry.shade(px as f64 + 0.5, py as f64 + 0.5, self.size)
+    }
+}
+
+impl TestBed for CheckerImage {
+    fn id(&self) -> &'static str {
+        ENTRY.id
+    }
+    fn variant(&self) -> &str {
+        &self.variant
+    }
+    fn provides(&self) -> Needs {
+        ENTRY.provides
+    }
+    fn resolution(&self) -> (usize, usize) {
+        (self.size, self.size)
+    }
+    fn reference(&self) -> &Reference {
+        &self.reference
+    }
+    fn geometry(&self, i: usize) -> Vec<(&'static str, f64)> {
+        match self.centre(i) {
+            Some(p) => {
+                vec![("hit_x", p.position.x), ("hit_y", p.position.y), ("phong_n", p.brdf.n), ("ks", p.brdf.ks[0])]
+            }
+            None => Vec::new(),
+        }
+    }
+    fn image_plane(&self) -> Option<&dyn ImagePlaneScene> {
+        Some(self)
+    }
+    /// The whole image is one sequence: image-plane samplers allocate samples across pixels, so
+    /// they receive every pixel's task in one call.
+    fn sequence_length(&self) -> usize {
+        self.size * self.size
+    }
+    fn integrals(&self) -> usize {
+        self.size * self.size
+    }
+}
+
+impl ImagePlaneScene for CheckerImage {
+    fn pixel_sample(&self, pixel: usize, u: f64, v: f64, rng: &mut StreamRng) -> (Rgb, u64) {
+        let (px, py) = (pixel % self.size, pixel / self.size);
+        let Some(point) = self.geometry.shade(px as f64 + u, py as f64 + v, self.size) else {
+            return (Rgb::ZERO, 1);
+        };
+        let strategy = MisStrategy { lights: &self.geometry.lights, select: &self.select, power: 1.0 };
+        let mut rays = 1u64;
+        let mut sum = Rgb::ZERO;
+        for _ in 0..self.light_samples {
+            let integrand = |w: Vec3| {
+                if w.dot(point.normal) <= 0.0 {
+                    return Rgb::ZERO;
+                }
+                rays += 1;
+                self.geometry.incident(point.position, w) * point.brdf.eval(w, point.wo, point.normal) * w.z
+            };
+            sum += mis_round(&point, &strategy, true, integrand, rng);
+        }
+        (sum / self.light_samples as f64, rays)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::stream;
+    use crate::stats::Moments;
+    use crate::testbeds::checker::CheckerDirect;
+
+    /// At a pixel centre, the mean of many pixel samples is the exact direct lighting of
+    /// `checker-direct` at the same point (the MIS estimate is unbiased), for a diffuse, a glossy
+    /// and an occluded pixel.
+    #[test]
+    fn pixel_samples_at_the_centre_average_to_the_direct_lighting() {
+        for variant in ["default", "occluded"] {
+            let params = Params::new().with("resolution", 8.0);
+            let image = CheckerImage::without_reference(variant, &params).unwrap();
+            let direct = CheckerDirect::new(variant, &params).unwrap();
+            let mut rng = stream(4, "checker-image centre");
+            for i in [27, 36, 44, 51] {
+                let mut m = Moments::default();
+                for _ in 0..4000 {
+                    let (v, rays) = image.pixel_sample(i, 0.5, 0.5, &mut rng);
+                    assert!((1..=17).contains(&rays));
+                    m.push(v[0]);
+                }
+                let r = direct.reference().value[i][0];
+                let z = (m.mean() - r) / m.std_err();
+                assert!(z.abs() < 4.5, "{variant} pixel {i}: mean {} se {} exact {r}", m.mean(), m.std_err());
+            }
+        }
+    }
+
+    #[test]
+    fn bad_parameters_and_missing_references_name_the_field() {
+        let e = CheckerImage::without_reference("default", &Params::new().with("light_samples", 0.0));
+        assert!(e.err().unwrap().to_string().contains("light_samples"));
+        let e = CheckerImage::without_reference("nope", &Params::new());
+        assert!(e.err().unwrap().to_string().contains("checker-image/nope"));
+        // No reference is stored at resolution 7 (the error names the resolution, or the missing
+        // file when no reference is stored at all).
+        let e = CheckerImage::new("default", &Params::new().with("resolution", 7.0)).err().unwrap().to_string();
+        assert!(e.contains("resolution") || e.contains("checker-image_default.json"), "{e}");
+    }
+}
