@@ -1,13 +1,14 @@
 //! `delta_tracking` (Woodcock tracking, the classic baseline of paper 002): free flights with the
-//! constant majorant (declared by the scene, or parameter `sigma_samp`, which must be a majorant).
+//! constant majorant (declared by the scene, or parameter `sigma_samp` / `sigma_samp_ratio`, which
+//! must give a majorant: a smaller density is refused as a skipped pair with the reason).
 //! Transmittance: terminate with probability `r = sigma_t / sigma_samp`. Radiance (particle
 //! tracing): the analog collision of Eq. 7 (scatter with probability `a r`, absorb `(1 - a) r`,
 //! pass `1 - r`), i.e. the terminating single particle model at a majorant.
 
 use super::spm::{trace, SpmMode};
-use super::{sigma_samp_param, track, transmittance, Rule};
+use super::{track, transmittance, Rule, SigmaSamp};
 use crate::accumulate::RgbMean;
-use crate::error::{ConfigError, EstimateError};
+use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::registry::EstimatorEntry;
@@ -25,21 +26,21 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::MEDIUM,
     summary: "Woodcock tracking with the majorant: transmittance, or analog particle tracing",
     build: |p| {
-        p.reject_unknown("delta_tracking", &["sigma_samp"])?;
-        Ok(Box::new(DeltaTracking { sigma_samp: sigma_samp_param(p, "delta_tracking")? }))
+        p.reject_unknown("delta_tracking", &["sigma_samp", "sigma_samp_ratio"])?;
+        Ok(Box::new(DeltaTracking { sigma_samp: SigmaSamp::from_params(p, "delta_tracking", SigmaSamp::Majorant)? }))
     },
 };
 
 /// The estimator.
 pub struct DeltaTracking {
-    /// Sampling extinction (`None`: the scene's majorant).
-    pub sigma_samp: Option<f64>,
+    /// Sampling extinction (a majorant).
+    pub sigma_samp: SigmaSamp,
 }
 
 impl Estimator for DeltaTracking {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         let probe = task.medium().ok_or_else(|| EstimateError::Refused("the test bed has no medium".into()))?;
-        let sigma = self.sigma_samp.unwrap_or(probe.majorant());
+        let sigma = self.sigma_samp.resolve(probe.majorant());
         if let MediumQuantity::Transmittance { .. } = probe.ray().quantity {
             return transmittance(task, rng, |probe, seg, rng| {
                 track(probe, probe.ray(), seg, &SamplingDensity::constant(sigma), None, Rule::Delta, rng, |_| ())
@@ -52,14 +53,7 @@ impl Estimator for DeltaTracking {
         }
         Ok(mean.mean())
     }
-    fn validate(&self, bed: &dyn TestBed) -> Result<(), ConfigError> {
-        match (bed.medium(), self.sigma_samp) {
-            (Some(m), Some(s)) if s < m.majorant() => Err(ConfigError::invalid(
-                "delta_tracking.sigma_samp",
-                s,
-                format!("delta tracking needs a majorant (>= {} on {}/{})", m.majorant(), bed.id(), bed.variant()),
-            )),
-            _ => Ok(()),
-        }
+    fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
+        self.sigma_samp.require_majorant("delta_tracking", bed)
     }
 }

@@ -145,6 +145,64 @@ pub fn sigma_samp_param(p: &Params, owner: &str) -> Result<Option<f64>, ConfigEr
     Ok(Some(v))
 }
 
+/// A tracker's constant sampling density `sigma_samp` (paper 002 Eq. 4 with a constant density):
+/// absolute (parameter `sigma_samp`), relative to the scene's declared majorant (parameter
+/// `sigma_samp_ratio`, the axis of the canonical sweep: below 1 it is not a majorant), or the
+/// declared majorant itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SigmaSamp {
+    /// The scene's declared majorant.
+    Majorant,
+    /// A fixed value (> 0).
+    Absolute(f64),
+    /// This multiple (> 0) of the scene's declared majorant.
+    Ratio(f64),
+}
+
+impl SigmaSamp {
+    /// Reads `sigma_samp` or `sigma_samp_ratio` (not both; each finite and > 0), else `default`.
+    pub fn from_params(p: &Params, owner: &str, default: SigmaSamp) -> Result<SigmaSamp, ConfigError> {
+        let ratio = if p.0.contains_key("sigma_samp_ratio") { Some(p.f64("sigma_samp_ratio", 1.0)?) } else { None };
+        match (sigma_samp_param(p, owner)?, ratio) {
+            (Some(_), Some(_)) => Err(ConfigError::invalid(
+                format!("{owner}.sigma_samp_ratio"),
+                ratio.unwrap_or(f64::NAN),
+                "give sigma_samp or sigma_samp_ratio, not both",
+            )),
+            (Some(v), None) => Ok(SigmaSamp::Absolute(v)),
+            (None, Some(r)) if r > 0.0 => Ok(SigmaSamp::Ratio(r)),
+            (None, Some(r)) => Err(ConfigError::invalid(format!("{owner}.sigma_samp_ratio"), r, "must be > 0")),
+            (None, None) => Ok(default),
+        }
+    }
+    /// The density on a scene declaring `majorant`.
+    pub fn resolve(self, majorant: f64) -> f64 {
+        match self {
+            SigmaSamp::Majorant => majorant,
+            SigmaSamp::Absolute(v) => v,
+            SigmaSamp::Ratio(r) => r * majorant,
+        }
+    }
+    /// For trackers that need a majorant (delta and ratio tracking): why this density cannot run
+    /// on `bed` (a skipped pair with the reason), or `Ok` when it is at least the declared majorant.
+    pub fn require_majorant(self, owner: &str, bed: &dyn TestBed) -> Result<(), String> {
+        let Some(m) = bed.medium() else { return Ok(()) };
+        let (sigma, majorant) = (self.resolve(m.majorant()), m.majorant());
+        if sigma >= majorant {
+            return Ok(());
+        }
+        let field = match self {
+            SigmaSamp::Ratio(r) => format!("{owner}.sigma_samp_ratio = {r}"),
+            _ => format!("{owner}.sigma_samp = {sigma}"),
+        };
+        Err(format!(
+            "{field}: {owner} needs a majorant, but sigma_samp = {sigma:.6} is below the declared majorant {majorant:.6} of {}/{} (r = sigma_t/sigma_samp would exceed 1; the double and single particle models accept it)",
+            bed.id(),
+            bed.variant()
+        ))
+    }
+}
+
 /// Refuses (as a skipped pair) test beds whose integrals are not transmittances.
 pub fn supports_transmittance(bed: &dyn TestBed) -> Result<(), String> {
     match bed.medium() {

@@ -37,7 +37,8 @@ fn holm_p(bed: &MediumBed, est: &dyn Estimator, reps: usize, spp: u64, seed: u64
 
 /// Every unbiased transmittance estimator passes (Holm over the central ray's points, family-wise
 /// alpha 1e-3), including sigma_samp below the maximum extinction (not a majorant) and control
-/// variates with negative difference extinction; the coarse ray-marching control is flagged.
+/// variates (piecewise-linear and constant main parts) with negative difference extinction; the
+/// coarse ray-marching control is flagged.
 #[test]
 fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
     let eq21 = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 8.0)).unwrap();
@@ -54,6 +55,9 @@ fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
         (&eq21, "single_particle_terminating", s(0.9)),
         (&perlin, "residual_ratio_tracking", Params::new()),
         (&perlin, "double_particle", s(0.3).with("control", 1.0)),
+        (&eq21, "double_particle", s(0.4).with("control", 2.0)),
+        (&perlin, "residual_ratio_tracking", Params::new().with("control", 2.0)),
+        (&eq21, "single_particle_nonterminating", Params::new().with("sigma_samp_ratio", 0.25)),
     ];
     for (k, (bed, id, p)) in cases.into_iter().enumerate() {
         let est = build(id, p.clone());
@@ -71,10 +75,31 @@ fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
 #[test]
 fn invalid_terminating_configurations_are_refused() {
     let bed = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 4.0)).unwrap();
-    for id in ["single_particle_terminating", "delta_tracking"] {
-        let err = build(id, Params::new().with("sigma_samp", 0.4)).validate(&bed).unwrap_err().to_string();
-        assert!(err.contains(&format!("{id}.sigma_samp")), "{err}");
+    let err = build("single_particle_terminating", Params::new().with("sigma_samp", 0.4))
+        .validate(&bed)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("single_particle_terminating.sigma_samp"), "{err}");
+    // Delta and ratio tracking need a majorant: a smaller density is a skipped pair with the
+    // reason naming the field (absolute or relative to the declared majorant 1); at the majorant
+    // (ratio 1) and above they run.
+    for id in ["delta_tracking", "ratio_tracking"] {
+        for (name, v) in [("sigma_samp", 0.4), ("sigma_samp_ratio", 0.75)] {
+            let err = build(id, Params::new().with(name, v)).supports(&bed).unwrap_err();
+            assert!(err.contains(&format!("{id}.{name} = {v}")) && err.contains("majorant"), "{err}");
+        }
+        for v in [1.0, 8.0] {
+            assert!(build(id, Params::new().with("sigma_samp_ratio", v)).supports(&bed).is_ok());
+        }
+        let both = Params::new().with("sigma_samp", 1.0).with("sigma_samp_ratio", 1.0);
+        assert!((registry::estimator(id).unwrap().build)(&both).err().unwrap().to_string().contains("not both"));
     }
+    for bad in [("control", 3.0), ("control", 0.5), ("sigma_samp_ratio", -1.0)] {
+        let err = (registry::estimator("double_particle").unwrap().build)(&Params::new().with(bad.0, bad.1));
+        assert!(err.err().unwrap().to_string().contains(&format!("double_particle.{}", bad.0)));
+    }
+    let err = (registry::estimator("residual_ratio_tracking").unwrap().build)(&Params::new().with("control", 0.0));
+    assert!(err.err().unwrap().to_string().contains("residual_ratio_tracking.control"));
     let multiple =
         MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("resolution", 4.0)).unwrap();
     let err =
