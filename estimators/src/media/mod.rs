@@ -16,6 +16,7 @@
 
 pub mod density;
 pub mod environment;
+pub mod moments;
 pub mod reference;
 pub mod variance;
 
