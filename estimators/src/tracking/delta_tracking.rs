@@ -6,11 +6,12 @@
 //! pass `1 - r`), i.e. the terminating single particle model at a majorant.
 
 use super::spm::{trace, SpmMode};
-use super::{track, transmittance, Rule, SigmaSamp};
+use super::{ray_moments, track, transmittance, Rule, SigmaSamp};
 use crate::accumulate::RgbMean;
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::EstimateMoments;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -52,6 +53,9 @@ impl Estimator for DeltaTracking {
             mean.push(trace(&probe, sigma, SpmMode::Terminating, rng)?);
         }
         Ok(mean.mean())
+    }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        ray_moments(task, self.sigma_samp, |_| Rule::Delta, None)
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         self.sigma_samp.require_majorant("delta_tracking", bed)

@@ -7,10 +7,11 @@
 //! the constant at its mean (the L2-optimal constant of §3.4).
 
 use super::residual_ratio_tracking::{main_part, MainPart};
-use super::{supports_transmittance, track, transmittance, Rule, SigmaSamp};
+use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::EstimateMoments;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -60,6 +61,9 @@ impl Estimator for DoubleParticle {
             let e = track(probe, probe.ray(), seg, &samp, m.map(|x| &x.0), Rule::Double, rng, |_| ())?;
             Ok(e * m.map_or(1.0, |x| x.1))
         })
+    }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        ray_moments(task, self.sigma_samp, |_| Rule::Double, self.control.map(|k| (k, self.spacing)))
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_transmittance(bed)

@@ -16,12 +16,14 @@ pub mod spm;
 use crate::accumulate::RgbMean;
 use crate::error::{ConfigError, EstimateError};
 use crate::math::Rgb;
+use crate::media::moments::{tracker_moments, EstimateMoments};
 use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::{MediumProbe, Task};
 use crate::testbed::{MediumQuantity, MediumRay, TestBed};
 use rand::Rng;
+use residual_ratio_tracking::{main_part, MainPart};
 
 /// How the weight of the transmitted particle changes at an interaction with
 /// `r = sigma_diff / sigma_samp` (paper 002 §3).
@@ -131,6 +133,30 @@ pub fn transmittance(
         mean.push(Rgb::splat(one(&probe, seg, rng)?));
     }
     Ok(weight * mean.mean().0[0])
+}
+
+/// The exact moments of one tracker ray on `task`'s transmittance integral
+/// ([`crate::media::moments`]): constant density `sigma_samp`, the rule `rule(albedo)`, and the
+/// main part `control` (shape, explorer spacing) computed exactly as the estimator computes it;
+/// `None` for radiance integrals or where the rule is invalid on the ray.
+pub fn ray_moments(
+    task: &Task<'_>,
+    sigma_samp: SigmaSamp,
+    rule: impl Fn(f64) -> Rule,
+    control: Option<(MainPart, f64)>,
+) -> Option<EstimateMoments> {
+    let probe = task.medium()?;
+    let MediumQuantity::Transmittance { weight } = probe.ray().quantity else { return None };
+    let Some(seg) = segment(&probe) else {
+        return Some(EstimateMoments { mean: weight[0], rel_variance: 0.0, rel_central4: 0.0 });
+    };
+    let main = control.map(|(kind, spacing)| main_part(&probe, seg, spacing, kind));
+    let ray = *probe.ray();
+    let diff = |t: f64| probe.sigma_t(ray.origin + ray.dir * t) - main.as_ref().map_or(0.0, |m| m.0.eval(t));
+    let depth = main.as_ref().map_or(0.0, |m| -m.1.ln());
+    let samp = sigma_samp.resolve(probe.majorant());
+    let m = tracker_moments(diff, depth, samp, rule(probe.albedo()), seg, &[])?;
+    Some(EstimateMoments { mean: m.mean * weight[0], ..m })
 }
 
 /// A positive finite `sigma_samp` parameter (`None` when absent).

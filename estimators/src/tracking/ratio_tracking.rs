@@ -3,10 +3,11 @@
 //! must give a majorant: a smaller density is the double particle model, and is refused here as a
 //! skipped pair with the reason), weight `*= 1 - r`.
 
-use super::{supports_transmittance, track, transmittance, Rule, SigmaSamp};
+use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::EstimateMoments;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -39,6 +40,9 @@ impl Estimator for RatioTracking {
             let samp = SamplingDensity::constant(self.sigma_samp.resolve(probe.majorant()));
             track(probe, probe.ray(), seg, &samp, None, Rule::Double, rng, |_| ())
         })
+    }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        ray_moments(task, self.sigma_samp, |_| Rule::Double, None)
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_transmittance(bed)?;

@@ -3,14 +3,16 @@
 //! Under a fetch budget, one ray spends the whole budget: `N = budget` equal steps. Biased by
 //! construction (Jensen: E[exp(-X)] > exp(-E[X])).
 
-use super::{supports_transmittance, transmittance};
+use super::{segment, supports_transmittance, transmittance};
 use crate::budget::BudgetKind;
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::{ray_marching_moments, EstimateMoments};
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::task::Task;
+use crate::testbed::MediumQuantity;
 use crate::testbed::{Needs, TestBed};
 use rand::Rng;
 
@@ -54,6 +56,21 @@ impl Estimator for RayMarching {
                 (0..n as u64).map(|j| probe.sigma_t(ray.origin + ray.dir * (t0 + (j as f64 + u) * h))).sum::<f64>() * h;
             Ok((-tau).exp())
         })
+    }
+    /// One marched ray: its exact moments over the random offset (the steps as in `estimate`).
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        let probe = task.medium()?;
+        let MediumQuantity::Transmittance { weight } = probe.ray().quantity else { return None };
+        let Some((t0, t1)) = segment(&probe) else {
+            return Some(EstimateMoments { mean: weight[0], rel_variance: 0.0, rel_central4: 0.0 });
+        };
+        let n = match task.budget().kind {
+            BudgetKind::Fetches => task.budget().amount.max(1) as usize,
+            _ => ((t1 - t0) / self.step).ceil().max(1.0) as usize,
+        };
+        let ray = *probe.ray();
+        let m = ray_marching_moments(|t| probe.sigma_t(ray.origin + ray.dir * t), (t0, t1), n, &[]);
+        Some(EstimateMoments { mean: m.mean * weight[0], ..m })
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_transmittance(bed)

@@ -7,10 +7,11 @@
 //!   before the run (`ConfigError`, exit 2), and an `r` out of range met at run time is refused.
 //! - `single_particle_nonterminating`: Eq. 12 probabilities, any `r`.
 
-use super::{supports_transmittance, track, transmittance, Rule, SigmaSamp};
+use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::EstimateMoments;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -80,6 +81,11 @@ impl Estimator for SingleParticle {
             let samp = SamplingDensity::constant(self.sigma_samp.resolve(probe.majorant()));
             track(probe, probe.ray(), seg, &samp, None, rule, rng, |_| ())
         })
+    }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        let terminating = self.terminating;
+        let rule = move |a| if terminating { Rule::Terminating { a } } else { Rule::NonTerminating { a } };
+        ray_moments(task, self.sigma_samp, rule, None)
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_transmittance(bed)
