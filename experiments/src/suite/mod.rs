@@ -1,6 +1,12 @@
 //! The named experiments (SPEC §7): each builds a sweep for quick or full mode and states the
 //! paper's claims, which are judged against what the run measured.
 
+pub mod canonical_cells;
+pub mod canonical_sweep;
+pub mod canonical_sweep_claims;
+pub mod canonical_sweep_plots;
+pub mod canonical_sweep_post;
+pub mod canonical_winners;
 pub mod claims;
 pub mod envmap_smc;
 pub mod envmap_smc_post;
@@ -45,8 +51,15 @@ pub struct ExperimentDef {
 pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &Path, Option<&Path>) -> crate::error::Result<Vec<PathBuf>>;
 
 /// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] =
-    &[&surface_smc::DEF, &media_smc::DEF, &transmittance::DEF, &particle_sweep::DEF, &pmc_hi::DEF, &envmap_smc::DEF];
+pub static EXPERIMENTS: &[&ExperimentDef] = &[
+    &surface_smc::DEF,
+    &media_smc::DEF,
+    &transmittance::DEF,
+    &particle_sweep::DEF,
+    &pmc_hi::DEF,
+    &envmap_smc::DEF,
+    &canonical_sweep::DEF,
+];
 
 /// Looks an experiment up by name.
 pub fn experiment(name: &str) -> Result<&'static ExperimentDef, ConfigError> {
