@@ -153,11 +153,15 @@ pub fn z_crit(m: usize) -> f64 {
     detectable_shift(1.0, AGREEMENT_ALPHA / m.max(1) as f64, 0.5)
 }
 
-/// The terminating model at ratios where `r = 1/ratio > 2/(a+1)`: refused before the run by the
-/// estimator itself (`validate`); listed as skipped with its own reason.
+/// The terminating model at ratios where `r = 1/ratio > 2/(a+1)`, when the sweep runs it at all:
+/// refused before the run by the estimator itself (`validate`); listed as skipped with its own
+/// reason.
 pub fn refused_terminating(plan: &Plan) -> Vec<Skipped> {
     let mut out = Vec::new();
     let Ok(entry) = registry::estimator("single_particle_terminating") else { return out };
+    if !plan.estimators.iter().any(|e| e.spec.id == entry.id) {
+        return out;
+    }
     let family = FAMILIES.iter().find(|f| f.id == entry.id);
     for b in plan.beds.iter().filter(|b| b.spec.id == "canonical-1d") {
         for r in RATIOS.into_iter().filter(|&r| r < terminating_min_ratio()) {

@@ -129,7 +129,7 @@ fn best_figure(a: &Analysis, with_cv: bool) -> HeatFigure {
                                 if w.tie.is_some() {
                                     text.push('≈');
                                 }
-                                HeatCell { fill: Fill::Category(w.best.family), text }
+                                HeatCell { fill: Fill::Category(w.colour_family()), text }
                             }
                             None => HeatCell { fill: Fill::Empty, text: "-".into() },
                         })
@@ -154,7 +154,7 @@ fn best_figure(a: &Analysis, with_cv: bool) -> HeatFigure {
 pub fn heat_maps(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>> {
     let mut files = write_heatmap(dir, "heat_best_estimator", &best_figure(a, true))?;
     files.extend(write_heatmap(dir, "heat_best_without_cv", &best_figure(a, false))?);
-    for p in Profile::ALL {
+    for p in Profile::ALL.into_iter().filter(|p| a.rows.iter().any(|r| r.profile == *p)) {
         files.extend(write_heatmap(dir, &format!("heat_var_cost_{}", p.name()), &var_cost_figure(a, p))?);
         files.extend(write_heatmap(dir, &format!("heat_agreement_{}", p.name()), &agreement_figure(a, p))?);
     }

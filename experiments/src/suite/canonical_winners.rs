@@ -31,6 +31,19 @@ pub struct Win<'a> {
     pub resolved: bool,
 }
 
+impl Win<'_> {
+    /// The family whose colour the winner takes: one per merged pair (ratio tracking for `RT/DP`,
+    /// delta tracking for `DT/ST`), so equal estimators look equal in the heat maps.
+    pub fn colour_family(&self) -> usize {
+        let key = match self.label.split('@').next() {
+            Some("RT/DP") => "ratio",
+            Some("DT/ST") => "delta",
+            _ => return self.best.family,
+        };
+        FAMILIES.iter().position(|f| f.key == key).unwrap_or(self.best.family)
+    }
+}
+
 /// The label of a family at a ratio, merging the exact equivalents at ratio >= 1 (with `@ratio`
 /// when `at`).
 fn class_label(r: &CellRow, at: bool) -> String {

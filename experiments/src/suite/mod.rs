@@ -6,6 +6,8 @@ pub mod canonical_sweep;
 pub mod canonical_sweep_claims;
 pub mod canonical_sweep_plots;
 pub mod canonical_sweep_post;
+#[cfg(test)]
+mod canonical_tests;
 pub mod canonical_winners;
 pub mod claims;
 pub mod envmap_smc;
