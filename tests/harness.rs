@@ -190,3 +190,36 @@ fn sequences_are_deterministic_whatever_the_thread_count() {
         .skip(1)
         .all(|l| l.split(',').nth(4).is_some_and(|px| px.parse::<usize>().is_ok_and(|v| v < 3))));
 }
+
+#[test]
+fn a_fetch_budget_buys_a_fixed_calibrated_number_of_rays() {
+    // Delta tracking scores 0 on a ray that collides early, and that ray is also cheap: stopping
+    // each estimate when its fetches run out would bias the mean. The harness fixes the ray count
+    // from a pilot instead, so every estimate of every pixel takes exactly the same number of rays.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut s = sweep(&["delta_tracking", "ratio_tracking"], 8);
+    s.testbeds = vec![TestBedSpec {
+        id: "eq21-medium".into(),
+        variant: Some("transmittance".into()),
+        params: Params::new().with("resolution", 4.0),
+    }];
+    s.budgets = vec![estimators::budget::Budget { kind: estimators::budget::BudgetKind::Fetches, amount: 40 }];
+    s.baseline = None;
+    let out = run_into(dir.path(), s, 2, false);
+    for row in &out.report.rows {
+        let fixed = out
+            .report
+            .diagnostics
+            .iter()
+            .find(|d| d.estimator == row.estimator && d.name == "samples_per_estimate")
+            .map(|d| d.mean)
+            .expect("the calibrated ray count is reported");
+        assert!(fixed >= 1.0 && fixed == fixed.round(), "{fixed}");
+        // Rays that miss the sphere cost one sample each and no fetch; every other estimate takes
+        // exactly `fixed` rays, so the mean sample count is at most `fixed` and never a fraction
+        // of a ray off from a mix of the two.
+        assert!(row.samples <= fixed && row.samples >= 1.0, "{} samples vs {fixed}", row.samples);
+        // The calibration aims at the budget: the mean fetches land within a factor 2 of it.
+        assert!(row.fetches > 20.0 && row.fetches < 80.0, "{}: {} fetches", row.estimator, row.fetches);
+    }
+}

@@ -30,11 +30,22 @@ pub struct Costs {
 /// (rays that fetch nothing cannot spend a fetch budget).
 pub const FETCH_BUDGET_SAMPLE_CAP: u64 = 64;
 
+/// How a task decides it is done.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stop {
+    /// By its budget: samples, fetches (a stopping rule on the running cost) or wall time.
+    Budget,
+    /// After exactly this many samples: a fetch budget the harness has converted into a fixed
+    /// sample count ([`Task::with_samples`]).
+    Samples(u64),
+}
+
 /// One estimate of one integral under one budget.
 pub struct Task<'a> {
     bed: &'a dyn TestBed,
     integral: usize,
     budget: Budget,
+    stop: Stop,
     costs: Cell<Costs>,
     started: Instant,
     diagnostics: RefCell<Vec<(&'static str, f64)>>,
@@ -47,10 +58,21 @@ impl<'a> Task<'a> {
             bed,
             integral,
             budget,
+            stop: Stop::Budget,
             costs: Cell::new(Costs::default()),
             started: Instant::now(),
             diagnostics: RefCell::new(Vec::new()),
         }
+    }
+    /// A task that keeps `budget` (estimators still see it, e.g. ray marching spends a fetch budget
+    /// as its step count) but stops after exactly `samples` samples.
+    ///
+    /// The harness uses it for fetch budgets: stopping an estimate when its fetches run out makes
+    /// the number of samples a stopping time that depends on the samples' values (a delta-tracking
+    /// ray that collides early is cheap *and* scores 0), so the mean of those samples is biased.
+    /// A sample count fixed in advance (calibrated on an independent pilot stream) is not.
+    pub fn with_samples(bed: &'a dyn TestBed, integral: usize, budget: Budget, samples: u64) -> Self {
+        Task { stop: Stop::Samples(samples.max(1)), ..Task::new(bed, integral, budget) }
     }
     /// The integral index.
     pub fn integral(&self) -> usize {
@@ -67,6 +89,9 @@ impl<'a> Task<'a> {
     /// True while the budget is not spent (checked before each sample).
     pub fn more(&self) -> bool {
         let c = self.costs.get();
+        if let Stop::Samples(n) = self.stop {
+            return c.samples < n;
+        }
         match self.budget.kind {
             BudgetKind::Samples => c.samples < self.budget.amount,
             // A sample cap keeps a ray that fetches nothing (it misses the medium, or its free

@@ -4,7 +4,9 @@
 use crate::cell::CellResult;
 use crate::metrics::SummaryRow;
 use estimators::estimator::Bias;
-use estimators::stats::{detectable_shift, holm_bonferroni, log_log_fit, one_sample_t, welch, z_test};
+use estimators::stats::{
+    detectable_shift, holm_bonferroni, log_log_fit, one_sample_t, t_test_skewness_limit, welch, z_test,
+};
 use estimators::testbed::{Reference, ReferenceKind};
 use serde::{Deserialize, Serialize};
 
@@ -23,14 +25,19 @@ pub struct Fit {
     /// Estimator name.
     pub estimator: String,
     /// Fitted slope (the order of convergence is -slope).
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub slope: f64,
     /// 95% confidence interval, low end.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub slope_ci_low: f64,
     /// 95% confidence interval, high end.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub slope_ci_high: f64,
     /// Coefficient of determination.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub r2: f64,
     /// Intercept of the fit (log RMSE at budget 1).
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub intercept: f64,
     /// Budgets used.
     pub budgets: Vec<u64>,
@@ -89,23 +96,40 @@ pub struct TestRow {
     /// Budget the test ran at.
     pub budget: u64,
     /// Test statistic (largest |t| for the Holm tests).
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub statistic: f64,
-    /// Smallest Holm-adjusted p-value (or the pooled test's p-value).
+    /// Smallest Holm-adjusted p-value (or the pooled test's p-value); `NaN` when nothing was tested.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub p_value: f64,
-    /// `pass` (no bias detected) or `biased` (flagged at alpha).
+    /// `pass` (no bias detected), `biased` (flagged at alpha) or `untested` (every integral too
+    /// skewed for a t-test at this many repetitions, see `untested`).
     pub verdict: String,
     /// Family-wise alpha.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub alpha: f64,
     /// Relative bias the test detects with 80% power (median over integrals for Holm tests).
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub detectable_rel_bias: f64,
     /// What the paper claims (`unbiased`, `consistent`, `biased`).
     pub claim: String,
     /// Whether the verdict agrees with the claim (a biased control must be flagged).
     pub agrees: bool,
+    /// Holm tests: integral-channels left out because their sample skewness exceeds
+    /// [`t_test_skewness_limit`] at the per-test alpha or their repetitions all agree (the t-test's
+    /// p-value would reflect the skew, not a bias); the pooled test covers them.
+    #[serde(default)]
+    pub untested: usize,
 }
 
 fn row(cell: &CellResult, claim: Bias, test: &str, statistic: f64, p: f64, detectable: f64) -> TestRow {
     let flagged = p < UNBIASEDNESS_ALPHA;
+    let verdict = if p.is_nan() {
+        "untested"
+    } else if flagged {
+        "biased"
+    } else {
+        "pass"
+    };
     TestRow {
         testbed: cell.key.testbed.clone(),
         variant: cell.key.variant.clone(),
@@ -114,7 +138,7 @@ fn row(cell: &CellResult, claim: Bias, test: &str, statistic: f64, p: f64, detec
         budget: cell.key.budget.amount,
         statistic,
         p_value: p,
-        verdict: if flagged { "biased" } else { "pass" }.to_string(),
+        verdict: verdict.to_string(),
         alpha: UNBIASEDNESS_ALPHA,
         detectable_rel_bias: detectable,
         claim: claim.name().to_string(),
@@ -123,12 +147,33 @@ fn row(cell: &CellResult, claim: Bias, test: &str, statistic: f64, p: f64, detec
             Bias::Biased => flagged,
             Bias::Consistent => true,
         },
+        untested: 0,
     }
 }
 
-/// The SPEC §6 unbiasedness tests of one cell: per integral and channel a t-test (exact
-/// reference) or Welch test (stored reference), Holm-Bonferroni over all of them; and a pooled
-/// z-test of the mean relative bias.
+/// The standard error of the sample skewness of `n` normal observations,
+/// `sqrt(6 n (n - 1) / ((n - 2) (n + 1) (n + 3)))`.
+fn skewness_se(n: u64) -> f64 {
+    let n = n as f64;
+    (6.0 * n * (n - 1.0) / ((n - 2.0) * (n + 1.0) * (n + 3.0))).sqrt()
+}
+
+/// The SPEC §6 unbiasedness tests of one cell.
+///
+/// `holm_t` / `holm_welch`: per integral and channel a t-test (exact reference) or Welch test
+/// (stored reference), Holm-Bonferroni over those that are valid: an integral-channel whose
+/// repetitions are too skewed for a t-test at the per-test alpha (sample skewness beyond
+/// [`t_test_skewness_limit`] by more than twice its own standard error, so that symmetric data are
+/// not dropped for the noise of their skewness estimate; a delta-tracking pixel of low
+/// transmittance scores mostly 0) or all agree on a value off the reference is counted in
+/// `untested` instead, because its t statistic measures the skew, not a bias. When the mean skewness
+/// over all the cell's integrals is beyond the limit, every integral is (a heavy tail shows across
+/// integrals even where one integral's repetitions missed it), and the Holm verdict is `untested`.
+///
+/// `pooled_z`: the summed deviation `sum (mean - ref)` over every integral and channel against its
+/// standard error (integrals independent, channels of an integral taken as fully correlated). Its weights do not depend on the outcomes and the sum of many
+/// independent deviations is close to normal, so skewed or zero-variance integrals cannot fake a bias
+/// (a sum of relative deviations would be dominated by the integrals of smallest reference).
 pub fn unbiasedness(cell: &CellResult, reference: &Reference, claim: Bias) -> Vec<TestRow> {
     let reps = cell.key.reps as u64;
     let m = cell.moments.len() * 3;
@@ -140,43 +185,77 @@ pub fn unbiasedness(cell: &CellResult, reference: &Reference, claim: Bias) -> Ve
         ReferenceKind::Exact { bound, .. } => bound.max(0.0),
         ReferenceKind::Stored { .. } => 0.0,
     };
-    let (mut ps, mut max_t, mut detect) = (Vec::with_capacity(m), 0.0f64, Vec::with_capacity(m));
-    let (mut pooled, mut pooled_var, mut pooled_n) = (0.0, 0.0, 0usize);
+    let (mut ps, mut max_t, mut detect, mut untested) = (Vec::with_capacity(m), 0.0f64, Vec::with_capacity(m), 0);
+    let (mut dev, mut dev_var, mut ref_sum) = (0.0, 0.0, 0.0);
     let per_test_alpha = UNBIASEDNESS_ALPHA / m as f64;
+    let skew_limit = t_test_skewness_limit(reps, per_test_alpha);
     for (i, mom) in cell.moments.iter().enumerate() {
+        // The channels of one integral come from the same samples (often exactly proportional), so
+        // their deviations are summed with the worst-case (fully correlated) standard error.
+        let mut se_channels = 0.0;
         for (c, mc) in mom.iter().enumerate() {
             let (r, rse) = (reference.value[i][c], reference.std_err[i][c]);
             let se = mc.std_err();
             // An exact reference is only known to within its error bound, so a mean inside
-            // [r - bound, r + bound] is no evidence of bias: the test measures the distance from
+            // [r - bound, r + bound] is no evidence of bias: the tests measure the distance from
             // that interval (the composite null; e.g. a zero-variance estimator whose estimates
             // differ from a closed form by rounding, or 0 for a radiance of 1e-38).
             let r_test = if stored_n.is_none() { mc.mean().clamp(r - exact_bound, r + exact_bound) } else { r };
+            let se_total = (se * se + rse * rse).sqrt();
+            dev += mc.mean() - r_test;
+            se_channels += se_total;
+            ref_sum += r.abs();
+            if r != 0.0 {
+                detect.push(detectable_shift(se_total, per_test_alpha, POWER) / r.abs());
+            }
             let t = match stored_n {
+                // Every repetition returned the same value within the reference's own error bound:
+                // nothing to test, no evidence of bias.
+                None if se == 0.0 && mc.mean() == r_test => {
+                    estimators::stats::TestOutcome { statistic: 0.0, p_value: 1.0, dof: f64::INFINITY }
+                }
+                _ if se == 0.0 || mc.skewness().abs() > skew_limit + 2.0 * skewness_se(reps) => {
+                    untested += 1;
+                    continue;
+                }
                 None => one_sample_t(mc.mean(), se, reps, r_test),
                 Some(n) => welch(mc.mean(), se, reps, r_test, rse, n),
             };
             max_t = max_t.max(t.statistic.abs());
             ps.push(t.p_value);
-            let se_total = (se * se + rse * rse).sqrt();
-            if r != 0.0 {
-                detect.push(detectable_shift(se_total, per_test_alpha, POWER) / r.abs());
-                pooled += (mc.mean() - r_test) / r;
-                pooled_var += (se_total / r).powi(2);
-                pooled_n += 1;
-            }
         }
+        dev_var += se_channels * se_channels;
+    }
+    // Rare large values that none of the repetitions of an integral happened to draw leave no trace
+    // in its own sample skewness (its mean and standard error are then both low, and t is large and
+    // negative); across the cell's integrals they do show. When the mean skewness over the cell is
+    // beyond the limit by more than twice its standard error, no per-integral t-test is valid.
+    let skews: Vec<f64> = cell.moments.iter().flatten().map(|m| m.skewness()).filter(|g| g.is_finite()).collect();
+    let cell_skew = skews.iter().sum::<f64>() / skews.len().max(1) as f64;
+    if !skews.is_empty() && cell_skew.abs() > skew_limit + 2.0 * skewness_se(reps) / (skews.len() as f64).sqrt() {
+        untested += ps.len();
+        ps.clear();
     }
     let adjusted = holm_bonferroni(&ps);
-    let min_p = adjusted.iter().copied().filter(|p| !p.is_nan()).fold(1.0, f64::min);
+    let min_p =
+        if ps.is_empty() { f64::NAN } else { adjusted.iter().copied().filter(|p| !p.is_nan()).fold(1.0, f64::min) };
     detect.sort_by(f64::total_cmp);
     let median_detect = detect.get(detect.len() / 2).copied().unwrap_or(f64::NAN);
     let name = if stored_n.is_some() { "holm_welch" } else { "holm_t" };
-    let mut out = vec![row(cell, claim, name, max_t, min_p, median_detect)];
-    if pooled_n > 0 {
-        let (mean, se) = (pooled / pooled_n as f64, pooled_var.sqrt() / pooled_n as f64);
-        let z = z_test(mean, se, 0.0);
-        out.push(row(cell, claim, "pooled_z", z.statistic, z.p_value, detectable_shift(se, UNBIASEDNESS_ALPHA, POWER)));
+    let mut holm = row(cell, claim, name, max_t, min_p, median_detect);
+    holm.untested = untested;
+    let mut out = vec![holm];
+    if dev_var > 0.0 && ref_sum > 0.0 {
+        let se = dev_var.sqrt();
+        let z = z_test(dev, se, 0.0);
+        out.push(row(
+            cell,
+            claim,
+            "pooled_z",
+            z.statistic,
+            z.p_value,
+            detectable_shift(se, UNBIASEDNESS_ALPHA, POWER) / ref_sum,
+        ));
     }
     out
 }
@@ -197,10 +276,13 @@ pub struct SpeedUp {
     /// The rightmost budget.
     pub budget: u64,
     /// Baseline samples needed for the method's RMSE over the method's samples.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub sample_ratio: f64,
     /// Method seconds per estimate over the baseline's at the same budget.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub overhead: f64,
     /// sample_ratio / overhead.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub speedup: f64,
 }
 

@@ -231,24 +231,43 @@ fn print_summary(r: &crate::output::RunReport, seconds: f64) {
         .fits
         .iter()
         .map(|f| {
-            let t = r.tests.iter().find(|t| {
-                t.testbed == f.testbed
-                    && t.variant == f.variant
-                    && t.estimator == f.estimator
-                    && t.test.starts_with("holm")
-            });
+            let find = |prefix: &str| {
+                r.tests.iter().find(|t| {
+                    t.testbed == f.testbed
+                        && t.variant == f.variant
+                        && t.estimator == f.estimator
+                        && t.test.starts_with(prefix)
+                })
+            };
+            let (holm, pooled) = (find("holm"), find("pooled"));
+            let p = |t: Option<&crate::analysis::TestRow>| {
+                t.filter(|t| !t.p_value.is_nan()).map(|t| sig(t.p_value, 3)).unwrap_or_else(|| "-".into())
+            };
             vec![
                 format!("{}/{}", f.testbed, f.variant),
                 f.estimator.clone(),
                 format!("{:.3} [{:.3}, {:.3}]", f.slope, f.slope_ci_low, f.slope_ci_high),
-                t.map(|t| sig(t.p_value, 3)).unwrap_or_else(|| "-".into()),
-                t.map(|t| format!("{} ({})", t.verdict, t.claim)).unwrap_or_else(|| "-".into()),
+                p(holm),
+                holm.map(|t| format!("{} ({})", t.verdict, t.claim)).unwrap_or_else(|| "-".into()),
+                p(pooled),
+                pooled.map(|t| t.verdict.clone()).unwrap_or_else(|| "-".into()),
             ]
         })
         .collect();
     println!(
         "{}",
-        markdown_table(&["test bed", "estimator", "slope [95% CI]", "Holm p", "unbiasedness (claim)"], &fits)
+        markdown_table(
+            &[
+                "test bed",
+                "estimator",
+                "slope [95% CI]",
+                "Holm p",
+                "Holm verdict (claim)",
+                "pooled p",
+                "pooled verdict"
+            ],
+            &fits
+        )
     );
     let claims: Vec<Vec<String>> = r
         .paper

@@ -47,6 +47,7 @@ pub struct Meta {
     /// Repetitions.
     pub reps: usize,
     /// Wall-clock seconds of the whole run (timing).
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub wall_seconds: f64,
     /// Free-form notes (noise corrections applied, references used, ...).
     pub notes: Vec<String>,
@@ -110,6 +111,7 @@ pub struct Diagnostic {
     /// Diagnostic name.
     pub name: String,
     /// Mean per estimate.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub mean: f64,
 }
 
@@ -244,6 +246,13 @@ pub fn write_summary_json(path: &Path, report: &RunReport) -> Result<()> {
     write_atomic(path, text.as_bytes())
 }
 
+/// Reads back a number of summary.json that serde_json wrote as `null` (it writes NaN and the
+/// infinities so: a slope that could not be fitted, a test that did not run) as NaN.
+pub fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    use serde::Deserialize;
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
 /// Reads a results folder back (`summary.json` and `summary.csv`), for `mcbench plot`.
 pub fn read_results(dir: &Path) -> Result<RunReport> {
     let json = dir.join("summary.json");
@@ -256,4 +265,33 @@ pub fn read_results(dir: &Path) -> Result<RunReport> {
         .collect::<std::result::Result<Vec<SummaryRow>, _>>()
         .map_err(|e| HarnessError::bad_file(&csv_path, e))?;
     Ok(report)
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::analysis::TestRow;
+
+    #[test]
+    fn numbers_written_as_null_read_back_as_nan() {
+        let row = TestRow {
+            testbed: "t".into(),
+            variant: "v".into(),
+            estimator: "e".into(),
+            test: "holm_t".into(),
+            budget: 4,
+            statistic: 0.0,
+            p_value: f64::NAN,
+            verdict: "untested".into(),
+            alpha: 1e-3,
+            detectable_rel_bias: f64::INFINITY,
+            claim: "unbiased".into(),
+            agrees: true,
+            untested: 3,
+        };
+        let text = serde_json::to_string(&row).expect("serialises");
+        assert!(text.contains("\"p_value\":null"), "{text}");
+        let back: TestRow = serde_json::from_str(&text).expect("reads back");
+        assert!(back.p_value.is_nan() && back.detectable_rel_bias.is_nan());
+        assert_eq!(back.untested, 3);
+    }
 }

@@ -6,12 +6,12 @@ use crate::cell::{add_diagnostics, CellKey, CellResult, TimeStats};
 use crate::error::{HarnessError, Result};
 use crate::output::write_atomic;
 use crate::plan::Plan;
-use estimators::budget::Budget;
+use estimators::budget::{Budget, BudgetKind};
 use estimators::error::EstimateError;
 use estimators::math::Rgb;
 use estimators::rng::StreamKey;
 use estimators::stats::Moments;
-use estimators::task::{Costs, Task};
+use estimators::task::{Costs, Task, FETCH_BUDGET_SAMPLE_CAP};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -45,6 +45,7 @@ pub struct RunResults {
     pub cells: Vec<(usize, usize, CellResult)>,
 }
 
+#[derive(Default)]
 struct Item {
     values: Vec<Rgb>,
     costs: Costs,
@@ -59,61 +60,129 @@ fn add(a: &mut Costs, b: &Costs) {
     a.rays += b.rays;
 }
 
+/// Repetition index of the pilot stream that calibrates fetch budgets (never a real repetition).
+const PILOT_REP: u64 = u64::MAX;
+/// At most this many sequences (spread evenly over the test bed) run in a fetch-budget pilot.
+const PILOT_SEQUENCES: usize = 64;
+
+/// One cell's fixed inputs: which pair, which budget, and the sample count a fetch budget became.
+struct CellRun<'a> {
+    plan: &'a Plan,
+    bi: usize,
+    ei: usize,
+    budget: Budget,
+    /// A fetch budget converted into a fixed sample count ([`Task::with_samples`]).
+    samples: Option<u64>,
+}
+
+/// One sequence of integrals (`frames` long, from integral `first`) estimated on its own stream.
+fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> Result<()> {
+    let CellRun { plan, bi, ei, budget, samples } = *cell;
+    let (b, e) = (&plan.beds[bi], &plan.estimators[ei]);
+    let label = b.label();
+    let frames = b.bed.sequence_length().max(1);
+    let key = StreamKey {
+        seed: plan.sweep.seed,
+        testbed: &label,
+        estimator: &e.name,
+        budget: budget.amount,
+        rep,
+        integral: first as u64,
+    };
+    let mut rng = key.rng();
+    let task = |i| match samples {
+        Some(n) => Task::with_samples(b.bed.as_ref(), i, budget, n),
+        None => Task::new(b.bed.as_ref(), i, budget),
+    };
+    let tasks: Vec<Task<'_>> = (first..first + frames).map(task).collect();
+    let t0 = Instant::now();
+    let values = e.estimator.estimate_sequence(&tasks, &mut rng);
+    let seconds = t0.elapsed().as_secs_f64() / frames as f64;
+    let wrap = |source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.clone(), source };
+    let values = values.map_err(wrap)?;
+    if values.len() != frames {
+        let msg = format!("estimate_sequence returned {} values for {frames} integrals", values.len());
+        return Err(wrap(EstimateError::Refused(msg)));
+    }
+    for (k, (v, task)) in values.into_iter().zip(&tasks).enumerate() {
+        if !v.is_finite() {
+            return Err(wrap(EstimateError::NonFinite { integral: first + k, value: v.0 }));
+        }
+        if let Some(n) = samples {
+            task.note("samples_per_estimate", n as f64);
+        }
+        out.time.push(seconds);
+        add(&mut out.costs, &task.costs());
+        add_diagnostics(&mut out.diagnostics, &task.diagnostics());
+        out.values.push(v);
+    }
+    Ok(())
+}
+
+/// The fixed number of samples per estimate that a fetch budget buys (paper 002 compares
+/// estimators at equal fetches per pixel). Stopping each estimate when its fetches run out would
+/// bias it ([`Task::with_samples`]), so a pilot pass on its own stream (repetition [`PILOT_REP`],
+/// up to [`PILOT_SEQUENCES`] sequences spread over the test bed) runs with that stopping rule, and
+/// `n = round(budget x pilot samples / pilot fetches)` over the pilot sequences that fetched at all,
+/// the same for every integral and repetition, as a renderer sets one spp for the whole image. The
+/// reported costs are the fetches the estimates really spent (pixels whose rays miss the medium
+/// spend none, so the image's mean is below the budget).
+fn samples_for_fetch_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<u64> {
+    let b = &plan.beds[bi];
+    let frames = b.bed.sequence_length().max(1);
+    let sequences = b.bed.integrals() / frames;
+    let picks = sequences.min(PILOT_SEQUENCES);
+    let pilot = CellRun { plan, bi, ei, budget, samples: None };
+    let pilots: Vec<Result<Item>> = (0..picks)
+        .into_par_iter()
+        .map(|k| {
+            let mut out = Item::default();
+            run_sequence(&pilot, PILOT_REP, k * sequences / picks * frames, &mut out)?;
+            Ok(out)
+        })
+        .collect();
+    // Sequences that fetch nothing (their rays miss the medium) ran into the sample cap; they say
+    // nothing about what a fetch costs in samples, and every estimate there is free anyway.
+    let mut costs = Costs::default();
+    for p in pilots {
+        let p = p?;
+        if p.costs.fetches > 0 {
+            add(&mut costs, &p.costs);
+        }
+    }
+    let cap = budget.amount.saturating_mul(FETCH_BUDGET_SAMPLE_CAP);
+    if costs.fetches == 0 {
+        return Ok(cap);
+    }
+    let n = (budget.amount as f64 * costs.samples as f64 / costs.fetches as f64).round();
+    Ok((n as u64).clamp(1, cap))
+}
+
 /// Runs one cell (no resume logic). Work items are whole sequences (test beds whose integrals
 /// come in frames, [`estimators::testbed::TestBed::sequence_length`]), batched to about `BATCH`
 /// integrals; each sequence draws from the stream of its first integral, so a static test bed
-/// (sequence length 1) keeps exactly the per-integral streams and batches it always had.
+/// (sequence length 1) keeps exactly the per-integral streams and batches it always had. A fetch
+/// budget first becomes a fixed sample count ([`samples_for_fetch_budget`]).
 pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<CellResult> {
-    let (b, e) = (&plan.beds[bi], &plan.estimators[ei]);
-    let label = b.label();
+    let b = &plan.beds[bi];
     let n = b.bed.integrals();
     let frames = b.bed.sequence_length().max(1);
     let sequences = n / frames;
     let per_item = BATCH.div_ceil(frames);
     let reps = plan.sweep.reps;
     let batches = sequences.div_ceil(per_item);
+    let samples = match budget.kind {
+        BudgetKind::Fetches => Some(samples_for_fetch_budget(plan, bi, ei, budget)?),
+        _ => None,
+    };
+    let cell = CellRun { plan, bi, ei, budget, samples };
     let items: Vec<Result<Item>> = (0..reps * batches)
         .into_par_iter()
         .map(|item| {
             let (rep, batch) = (item / batches, item % batches);
-            let mut out = Item {
-                values: Vec::with_capacity(per_item * frames),
-                costs: Costs::default(),
-                time: TimeStats::default(),
-                diagnostics: Vec::new(),
-            };
+            let mut out = Item::default();
             for s in batch * per_item..((batch + 1) * per_item).min(sequences) {
-                let first = s * frames;
-                let key = StreamKey {
-                    seed: plan.sweep.seed,
-                    testbed: &label,
-                    estimator: &e.name,
-                    budget: budget.amount,
-                    rep: rep as u64,
-                    integral: first as u64,
-                };
-                let mut rng = key.rng();
-                let tasks: Vec<Task<'_>> =
-                    (first..first + frames).map(|i| Task::new(b.bed.as_ref(), i, budget)).collect();
-                let t0 = Instant::now();
-                let values = e.estimator.estimate_sequence(&tasks, &mut rng);
-                let seconds = t0.elapsed().as_secs_f64() / frames as f64;
-                let wrap =
-                    |source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.clone(), source };
-                let values = values.map_err(wrap)?;
-                if values.len() != frames {
-                    let msg = format!("estimate_sequence returned {} values for {frames} integrals", values.len());
-                    return Err(wrap(EstimateError::Refused(msg)));
-                }
-                for (k, (v, task)) in values.into_iter().zip(&tasks).enumerate() {
-                    if !v.is_finite() {
-                        return Err(wrap(EstimateError::NonFinite { integral: first + k, value: v.0 }));
-                    }
-                    out.time.push(seconds);
-                    add(&mut out.costs, &task.costs());
-                    add_diagnostics(&mut out.diagnostics, &task.diagnostics());
-                    out.values.push(v);
-                }
+                run_sequence(&cell, rep as u64, s * frames, &mut out)?;
             }
             Ok(out)
         })

@@ -155,6 +155,22 @@ pub fn detectable_shift(std_err: f64, alpha: f64, power: f64) -> f64 {
     (z_alpha + z_power) * std_err
 }
 
+/// The largest sample skewness at which a one-sample t-test of `n` observations keeps its two-sided
+/// tail at `alpha` within a factor 2 of nominal, by the first Edgeworth term of the studentised
+/// mean: one tail moves by about `phi(z) |G1| (2 z^2 + 1) / (6 sqrt(n))` against
+/// `1 - Phi(z) ~ phi(z) / z` at the critical value `z`, so the limit is
+/// `6 sqrt(n) / (z (2 z^2 + 1))`. A skewed estimator (a rare large value, a binary outcome) needs
+/// many repetitions before a t-test at a tiny per-test alpha means anything; beyond the limit the
+/// test is not run (its p-value would be an artefact of the skew, not evidence of bias).
+pub fn t_test_skewness_limit(n: u64, alpha: f64) -> f64 {
+    if n < 3 || !(alpha > 0.0 && alpha < 1.0) {
+        return 0.0;
+    }
+    let normal = Normal::new(0.0, 1.0).expect("standard normal parameters are valid");
+    let z = -normal.inverse_cdf(alpha / 2.0);
+    6.0 * (n as f64).sqrt() / (z * (2.0 * z * z + 1.0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -284,5 +300,38 @@ mod tests {
         let normal = Normal::new(0.0, 1.0).unwrap();
         let power = normal.sf(crit - shift / se) + normal.cdf(-crit - shift / se);
         assert!((power - 0.9).abs() < 1e-6, "{power}");
+    }
+
+    /// Type I error of the two-sided t-test at `alpha` over `trials` samples of 16 draws of `draw`
+    /// (whose mean is `mu`).
+    fn t_test_size(mut draw: impl FnMut(&mut rand_pcg::Pcg64) -> f64, mu: f64, alpha: f64, trials: usize) -> f64 {
+        use rand::SeedableRng;
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(0x7e57);
+        let mut rejected = 0;
+        for _ in 0..trials {
+            let m: crate::stats::Moments = (0..16).map(|_| draw(&mut rng)).collect();
+            rejected += usize::from(one_sample_t(m.mean(), m.std_err(), 16, mu).p_value < alpha);
+        }
+        rejected as f64 / trials as f64
+    }
+
+    #[test]
+    fn skewness_limit_separates_valid_from_invalid_t_tests() {
+        use rand::Rng;
+        // n = 16 at the Holm per-test alpha of a 768-integral cell at family alpha 1e-3.
+        let tiny = t_test_skewness_limit(16, 1e-3 / 768.0);
+        assert!((tiny - 0.1037).abs() < 1e-3, "{tiny}");
+        assert!(t_test_skewness_limit(64, 0.01) > t_test_skewness_limit(16, 0.01));
+        assert_eq!(t_test_skewness_limit(2, 0.01), 0.0);
+        // At alpha = 0.01 and n = 16 the limit is about 0.65. Exponential draws (skewness 2, beyond
+        // it) give a size more than twice nominal; Gamma(44) draws (skewness 0.30, within it) do not.
+        let limit = t_test_skewness_limit(16, 0.01);
+        assert!((limit - 0.653).abs() < 1e-2, "{limit}");
+        let exp = |r: &mut rand_pcg::Pcg64| -(1.0 - r.gen::<f64>()).ln();
+        let skewed = t_test_size(exp, 1.0, 0.01, 40_000);
+        let gamma = |r: &mut rand_pcg::Pcg64| (0..44).map(|_| exp(r)).sum::<f64>();
+        let mild = t_test_size(gamma, 44.0, 0.01, 40_000);
+        assert!(skewed > 0.02, "exponential: size {skewed}");
+        assert!(mild < 0.02 && mild > 0.005, "gamma(44): size {mild}");
     }
 }

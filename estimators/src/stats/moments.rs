@@ -72,16 +72,19 @@ impl FromIterator<f64> for NeumaierSum {
     }
 }
 
-/// Running count, mean and sum of squared deviations of a sample.
+/// Running count, mean and sums of squared and cubed deviations of a sample.
 ///
 /// Updated one value at a time with Welford's algorithm ([`Moments::push`]) and combined with
 /// Chan, Golub and LeVeque's pairwise formula ([`Moments::merge`]), both numerically stable when the
-/// mean is large compared with the spread.
+/// mean is large compared with the spread; the third moment follows Terriberry's online update and
+/// Pébay's pairwise formula (it feeds [`Moments::skewness`], which says whether a t-test is valid).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Moments {
     n: u64,
     mean: f64,
     m2: f64,
+    #[serde(default)]
+    m3: f64,
 }
 
 impl Moments {
@@ -93,8 +96,11 @@ impl Moments {
     /// Adds one observation.
     pub fn push(&mut self, x: f64) {
         self.n += 1;
+        let nf = self.n as f64;
         let delta = x - self.mean;
-        self.mean += delta / self.n as f64;
+        let delta_n = delta / nf;
+        self.m3 += delta * delta_n * delta_n * (nf - 1.0) * (nf - 2.0) - 3.0 * delta_n * self.m2;
+        self.mean += delta_n;
         self.m2 += delta * (x - self.mean);
     }
 
@@ -115,6 +121,9 @@ impl Moments {
         let n = self.n + other.n;
         let nf = n as f64;
         let delta = other.mean - self.mean;
+        self.m3 += other.m3
+            + delta * delta * delta * (na * nb * (na - nb) / (nf * nf))
+            + 3.0 * delta * (na * other.m2 - nb * self.m2) / nf;
         self.mean += delta * (nb / nf);
         self.m2 += other.m2 + delta * delta * (na * nb / nf);
         self.n = n;
@@ -146,6 +155,17 @@ impl Moments {
     /// Standard error of the mean, `sqrt(variance / n)`; `NaN` when fewer than 2 observations.
     pub fn std_err(&self) -> f64 {
         (self.variance() / self.n as f64).sqrt()
+    }
+
+    /// Adjusted Fisher-Pearson sample skewness `G1 = sqrt(n (n - 1)) / (n - 2) * g1` with
+    /// `g1 = sqrt(n) m3 / m2^1.5`; `NaN` with fewer than 3 observations or no spread.
+    pub fn skewness(&self) -> f64 {
+        if self.n < 3 || self.m2 <= 0.0 {
+            return f64::NAN;
+        }
+        let n = self.n as f64;
+        let g1 = n.sqrt() * self.m3 / self.m2.powf(1.5);
+        g1 * (n * (n - 1.0)).sqrt() / (n - 2.0)
     }
 }
 
@@ -247,6 +267,7 @@ mod tests {
         assert_eq!(merged.count(), seq.count());
         assert!(rel(merged.mean(), seq.mean()) < 1e-12);
         assert!(rel(merged.variance(), seq.variance()) < 1e-12);
+        assert!(rel(merged.skewness(), seq.skewness()) < 1e-9);
         // Merging is deterministic and empty samples are neutral.
         let mut again = Moments::new();
         for chunk in xs.chunks(997) {
@@ -257,5 +278,21 @@ mod tests {
         let mut into_empty = Moments::new();
         into_empty.merge(&seq);
         assert_eq!(into_empty, seq);
+    }
+
+    #[test]
+    fn skewness_matches_the_two_pass_formula() {
+        let xs = [0.0, 0.0, 0.0, 1.0, 0.0, 3.0, 0.5, 0.0, 0.0, 10.0];
+        let m: Moments = xs.iter().copied().collect();
+        let n = xs.len() as f64;
+        let mean = xs.iter().sum::<f64>() / n;
+        let (m2, m3) = xs.iter().fold((0.0, 0.0), |(a, b), x| (a + (x - mean).powi(2), b + (x - mean).powi(3)));
+        let g1 = n.sqrt() * m3 / m2.powf(1.5);
+        let want = g1 * (n * (n - 1.0)).sqrt() / (n - 2.0);
+        assert!(rel(m.skewness(), want) < 1e-12, "{} vs {want}", m.skewness());
+        let sym: Moments = [1.0, 2.0, 3.0, 4.0, 5.0].into_iter().collect();
+        assert!(sym.skewness().abs() < 1e-12);
+        let flat: Moments = [2.0; 5].into_iter().collect();
+        assert!(flat.skewness().is_nan());
     }
 }

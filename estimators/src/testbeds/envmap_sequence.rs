@@ -277,6 +277,38 @@ mod tests {
         }
     }
 
+    /// The dawn-to-dusk option (SPEC §3.7): frame n shows the sky at time (n + 1/2) / F, the sky
+    /// scaled by 0.2 + 0.8 sin(pi t) and the sun by sin(pi t)^2; the exact references follow it.
+    #[test]
+    fn dawn_to_dusk_scales_the_sky_per_frame_and_references_follow() {
+        let p = Params::new()
+            .with("resolution", 3.0)
+            .with("frames", 3.0)
+            .with("env_width", 64.0)
+            .with("env_height", 32.0)
+            .with("dawn_dusk", 1.0);
+        let bed = EnvmapSequence::new("mixed", &p).unwrap();
+        // Straight down sees the ground only (no lobe, the sun is above the horizon), which the
+        // rotation about z leaves alone: frame 1 (noon, scale 1) over frame 0 (t = 1/6, scale 0.6).
+        let down = Vec3::new(0.0, 0.0, -1.0);
+        let (dusk, noon) = (bed.environment(0).radiance(down), bed.environment(1).radiance(down));
+        for c in 0..3 {
+            assert!((noon[c] / dusk[c] - 1.0 / 0.6).abs() < 1e-9, "channel {c}: {} / {}", noon[c], dusk[c]);
+        }
+        let refs = bed.pixel_references();
+        for i in [0, 1, 2, 13] {
+            let (lns, lr) = brute(&bed, i, 4);
+            for c in 0..3 {
+                assert!((lns[c] - refs[i].lns[c]).abs() <= 1e-7 * refs[i].lns[c].abs().max(1e-3), "integral {i}");
+                assert!((lr[c] - refs[i].lr[c]).abs() <= 1e-7 * refs[i].lr[c].abs().max(1e-3), "integral {i}");
+            }
+        }
+        // Noon is brighter than the first frame at every pixel (sky 1.67x, sun 4x).
+        for px in 0..9 {
+            assert!(refs[px * 3 + 1].lns.0[1] > refs[px * 3].lns.0[1], "pixel {px}");
+        }
+    }
+
     /// The sky spans the dynamic range SPEC §3.7 and §10 ask for; references are positive.
     #[test]
     fn sky_has_the_required_dynamic_range_and_references_are_positive() {

@@ -161,6 +161,13 @@ fn stability_cases_are_finite() {
         assert_eq!(v, image.reference().value[0], "{id}");
         assert_eq!(task.costs().samples, 1);
     }
+    // A fetch budget the harness converted into a fixed ray count stops after exactly that many
+    // rays, however many fetches they spent (an inner pixel, 7 rays, a budget of only 10 fetches).
+    for id in ["ratio_tracking", "delta_tracking"] {
+        let task = Task::with_samples(&image, 5, Budget::new(BudgetKind::Fetches, 10).unwrap(), 7);
+        build(id, Params::new()).estimate(&task, &mut stream(5, id)).unwrap();
+        assert_eq!(task.costs().samples, 7, "{id}");
+    }
     let white = MediumBed::without_reference(
         Field::Eq21,
         "multiple",

@@ -56,6 +56,7 @@ pub(crate) fn synthetic_report() -> RunReport {
         detectable_rel_bias: 3.2e-3,
         claim: "unbiased".into(),
         agrees: verdict == "pass",
+        untested: 0,
     };
     RunReport {
         meta: Meta {

@@ -6,6 +6,7 @@
 //! not run keep their reason.
 
 use super::canonical_sweep::{family_of, spec, terminating_min_ratio, FAMILIES, RATIOS};
+use super::claims::decisive_test;
 use crate::output::RunReport;
 use crate::plan::{Plan, Skipped};
 use crate::runner::RunResults;
@@ -67,9 +68,22 @@ pub struct Measured {
     pub mean: f64,
     /// Sample variance of one estimate.
     pub variance: f64,
-    /// The harness's verdict: smallest Holm-adjusted p, `pass` / `biased`, the relative bias the
-    /// test detects with 80% power.
-    pub test: Option<(f64, String, f64)>,
+    /// The harness's deciding unbiasedness test (`claims::decisive_test`).
+    pub test: Option<Verdict>,
+}
+
+/// The deciding unbiasedness test of a cell: the Holm t-test where it ran, else the pooled z-test
+/// (the cell is too skewed for per-integral t-tests, `analysis.rs`).
+#[derive(Clone, Debug)]
+pub struct Verdict {
+    /// `holm_t` or `pooled_z`.
+    pub test: String,
+    /// Its p-value (smallest Holm-adjusted for `holm_t`).
+    pub p: f64,
+    /// `pass`, `biased` or `untested`.
+    pub verdict: String,
+    /// The relative bias the test detects with 80% power.
+    pub detectable: f64,
 }
 
 /// One cell of the sweep.
@@ -141,9 +155,9 @@ impl CellRow {
             _ => Agreement::Disagrees,
         }
     }
-    /// The Holm verdict (`pass` / `biased`), when the cell ran.
+    /// The deciding test's verdict (`pass`, `biased`, `untested`), when the cell ran.
     pub fn verdict(&self) -> Option<&str> {
-        self.measured.as_ref().and_then(|m| m.test.as_ref()).map(|t| t.1.as_str())
+        self.measured.as_ref().and_then(|m| m.test.as_ref()).map(|t| t.verdict.as_str())
     }
 }
 
@@ -197,11 +211,12 @@ pub fn cell_rows(plan: &Plan, run: &RunResults, report: &RunReport) -> Vec<CellR
         let mc = &cell.moments[i][0];
         let per = |x: u64| x as f64 / cell.estimates.max(1) as f64;
         let rays = per(cell.costs.samples);
-        let test = report
-            .tests
-            .iter()
-            .find(|t| t.variant == b.variant && t.estimator == e.name && t.test.starts_with("holm"))
-            .map(|t| (t.p_value, t.verdict.clone(), t.detectable_rel_bias));
+        let test = decisive_test(&report.tests, &b.variant, &e.name, "").map(|t| Verdict {
+            test: t.test.clone(),
+            p: t.p_value,
+            verdict: t.verdict.clone(),
+            detectable: t.detectable_rel_bias,
+        });
         let task = Task::new(b.bed.as_ref(), i, cell.key.budget);
         rows.push(CellRow {
             profile,

@@ -8,14 +8,14 @@
 //!
 //! Fixed-sample mode (the default): every estimate averages `N` rays, so variance x fetches per
 //! estimate is the cost-normalised variance and the prediction is exact (`Var = V_ray / N`).
-//! Equal-cost mode: a config file with `budget_kind = "fetches"` (see the README); the prediction
-//! then uses the mean number of rays per estimate.
+//! Equal-cost mode: a config file with `budget_kind = "fetches"` (see the README); the harness buys
+//! each estimate a fixed, pilot-calibrated number of rays, for which the prediction is exact too.
 //!
 //! Estimators (family key: what runs): `delta`, `ratio`, `double` (double particle), `double-cv-linear`
 //! and `double-cv-mean` (control variate through explorer points: piecewise-linear fit, or the
 //! constant at its mean, paper 002 §3.4's L2-optimal constant), `single-term`, `single-nonterm`,
 //! each at every ratio; `residual-cv-linear` / `residual-cv-mean` (residual ratio tracking, its own
-//! adaptive sigma_samp) and `ray-marching` (the biased control, step 0.9) once per test bed.
+//! adaptive sigma_samp) and `ray-marching` (the biased control, step 0.5) once per test bed.
 
 use super::{available, ExperimentDef};
 use crate::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
@@ -25,6 +25,9 @@ use estimators::testbeds::canonical_1d::VARIANTS;
 
 /// Sampling density ratios `sigma_samp / max sigma_t`.
 pub const RATIOS: [f64; 8] = [0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0];
+
+/// Step of the ray-marching control: two steps on the segment in both modes.
+pub const RAY_MARCHING_STEP: f64 = 0.5;
 
 /// Albedo of the test bed (its default; it only matters to the single particle models).
 pub const ALBEDO: f64 = 0.7;
@@ -87,6 +90,10 @@ pub fn spec(f: &Family, ratio: Option<f64>) -> EstimatorSpec {
     }
     if let Some(r) = ratio {
         params = params.with("sigma_samp_ratio", r);
+    }
+    if f.id == "ray_marching" {
+        // Two steps on the segment, also under a fetch budget (an explicit step is kept there).
+        params = params.with("step", RAY_MARCHING_STEP);
     }
     EstimatorSpec { id: f.id.to_string(), params }
 }

@@ -48,7 +48,7 @@ pub fn short(r: &CellRow) -> String {
 
 fn csv_text(a: &Analysis) -> String {
     let mut out = String::from(
-        "profile,target,family,ratio,estimator,claim,reps,rays,fetches,reference,mean,variance,var_cost,rel_var_cost,rel_mse_cost,predicted_mean,predicted_variance,variance_sd,z,agreement,holm_p,verdict,detectable_rel_bias,skipped\n",
+        "profile,target,family,ratio,estimator,claim,reps,rays,fetches,reference,mean,variance,var_cost,rel_var_cost,rel_mse_cost,predicted_mean,predicted_variance,variance_sd,z,agreement,test,p_value,verdict,detectable_rel_bias,skipped\n",
     );
     let opt = |x: Option<f64>| x.map(|v| format!("{v:e}")).unwrap_or_default();
     for r in &a.rows {
@@ -75,9 +75,10 @@ fn csv_text(a: &Analysis) -> String {
             opt(r.predicted.zip(m).map(|(p, m)| p.sample_variance_sd(m.reps as f64))),
             opt(r.z()),
             r.agreement(a.z_crit).name().to_string(),
-            opt(test.map(|t| t.0)),
-            test.map(|t| t.1.clone()).unwrap_or_default(),
-            opt(test.map(|t| t.2)),
+            test.map(|t| t.test.clone()).unwrap_or_default(),
+            opt(test.map(|t| t.p)),
+            test.map(|t| t.verdict.clone()).unwrap_or_default(),
+            opt(test.map(|t| t.detectable)),
             r.skipped.as_ref().map(|s| format!("\"{}\"", s.replace('"', "'"))).unwrap_or_default(),
         ];
         out.push_str(&fields.join(","));

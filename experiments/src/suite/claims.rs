@@ -1,11 +1,26 @@
 //! Judging paper claims against a run: slope claims and speed-up claims.
 
-use crate::analysis::Fit;
+use crate::analysis::{Fit, TestRow};
 use crate::output::{Claim, RunReport};
 
 /// The fit of an estimator on a test bed, if the run has one.
 pub fn fit<'a>(report: &'a RunReport, testbed: &str, variant: &str, estimator: &str) -> Option<&'a Fit> {
     report.fits.iter().find(|f| f.testbed == testbed && f.variant == variant && f.estimator == estimator)
+}
+
+/// The test that decides unbiasedness for one (variant, estimator): its Holm test (`holm_t`,
+/// `holm_welch`, with `suffix` appended) when that ran, else its pooled test (`pooled_z` + suffix),
+/// which covers cells too skewed for per-integral t-tests.
+pub fn decisive_test<'a>(tests: &'a [TestRow], variant: &str, estimator: &str, suffix: &str) -> Option<&'a TestRow> {
+    let mine = |t: &&TestRow| t.variant == variant && t.estimator == estimator && t.test.ends_with(suffix);
+    let holm = tests.iter().filter(mine).find(|t| {
+        let base = t.test.trim_end_matches(suffix);
+        base == "holm_t" || base == "holm_welch"
+    });
+    match holm {
+        Some(h) if h.verdict != "untested" => Some(h),
+        _ => tests.iter().filter(mine).find(|t| t.test.trim_end_matches(suffix) == "pooled_z").or(holm),
+    }
 }
 
 fn not_measured(testbed: &str, claim: &str, paper: f64, why: String) -> Claim {
@@ -118,15 +133,27 @@ pub fn speedup_claim(report: &RunReport, tb: (&str, &str), estimator: &str, pape
 
 /// "The biased control is flagged by the unbiasedness test".
 pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
-    let rows: Vec<_> = report.tests.iter().filter(|t| t.estimator == control && t.test.starts_with("holm")).collect();
-    let min_p = rows.iter().map(|t| t.p_value).fold(f64::INFINITY, f64::min);
+    let mut variants: Vec<&str> = Vec::new();
+    for t in report.tests.iter().filter(|t| t.estimator == control) {
+        if !variants.contains(&t.variant.as_str()) {
+            variants.push(&t.variant);
+        }
+    }
+    let decisive: Vec<&TestRow> =
+        variants.iter().filter_map(|v| decisive_test(&report.tests, v, control, "")).collect();
+    let min_p = decisive.iter().map(|t| t.p_value).filter(|p| !p.is_nan()).fold(f64::INFINITY, f64::min);
+    let used: Vec<String> =
+        decisive.iter().map(|t| format!("{}/{}: {} p = {:.2e}", t.testbed, t.variant, t.test, t.p_value)).collect();
     Claim {
-        testbed: rows.first().map(|t| format!("{}/{}", t.testbed, t.variant)).unwrap_or_default(),
+        testbed: decisive.first().map(|t| format!("{}/{}", t.testbed, t.variant)).unwrap_or_default(),
         claim: format!("harness (SPEC §6): the biased control {control} is flagged at p < 1e-6"),
         paper_value: Some(1e-6),
-        our_value: rows.first().map(|_| min_p),
-        held: (!rows.is_empty()).then_some(min_p < 1e-6),
-        note: "smallest Holm-adjusted p-value of the per-integral t-tests".into(),
+        our_value: (!decisive.is_empty()).then_some(min_p),
+        held: (!decisive.is_empty()).then_some(min_p < 1e-6),
+        note: format!(
+            "smallest p of the deciding test per variant (Holm per-integral t-tests, or the pooled z-test where the cell is too skewed for them): {}",
+            used.join("; ")
+        ),
     }
 }
 

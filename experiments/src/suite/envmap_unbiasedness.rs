@@ -2,19 +2,20 @@
 //! the main sweep have a dozen repetitions, too few for the skewed estimates of an HDR sky (a rare
 //! sun hit), so every paper 004 estimator is also run on a small `envmap-sequence` (2x2 pixels,
 //! 4 frames, N = 4 particles) with thousands of repetitions: one-sample t-tests per integral and
-//! channel with Holm-Bonferroni (family-wise alpha 1e-3) and a pooled z-test of the mean relative
-//! bias. Theory: `bidirectional_is`, `smc` and `smc_bridge` are unbiased (the unnormalised SMC
+//! channel with Holm-Bonferroni (family-wise alpha 1e-3) and the pooled z-test, exactly the
+//! harness's [`unbiasedness`] on a cell of these repetitions. Theory: `bidirectional_is`, `smc` and `smc_bridge` are unbiased (the unnormalised SMC
 //! estimate); `smc_path` (exponentiated log) and `smc_adaptive` (particle-dependent schedule) only
 //! consistent; `bidirectional_is_sn` is the biased control and must be flagged.
 
-use crate::analysis::{TestRow, UNBIASEDNESS_ALPHA};
+use crate::analysis::{unbiasedness, TestRow};
+use crate::cell::{CellKey, CellResult};
 use crate::config::Mode;
 use crate::error::Result;
 use estimators::budget::Budget;
 use estimators::params::Params;
 use estimators::registry;
 use estimators::rng::StreamKey;
-use estimators::stats::{holm_bonferroni, one_sample_t, z_test, Moments};
+use estimators::stats::Moments;
 use estimators::task::Task;
 use rayon::prelude::*;
 
@@ -84,58 +85,30 @@ pub fn check(mode: Mode, seed: u64) -> Result<Vec<TestRow>> {
                 }
             }
             let reference = bed.reference();
-            let (mut ps, mut max_t, mut pooled, mut pooled_var, mut k) = (Vec::new(), 0.0f64, 0.0, 0.0, 0usize);
-            let mut detect = Vec::new();
-            for (i, mi) in m.iter().enumerate() {
-                for (c, mc) in mi.iter().enumerate() {
-                    let r = reference.value[i][c];
-                    let t = one_sample_t(mc.mean(), mc.std_err(), reps, r);
-                    max_t = max_t.max(t.statistic.abs());
-                    ps.push(t.p_value);
-                    if r > 0.0 {
-                        detect.push(
-                            estimators::stats::detectable_shift(
-                                mc.std_err(),
-                                UNBIASEDNESS_ALPHA / (bed.integrals() * 3) as f64,
-                                0.8,
-                            ) / r,
-                        );
-                        pooled += (mc.mean() - r) / r;
-                        pooled_var += (mc.std_err() / r).powi(2);
-                        k += 1;
-                    }
-                }
-            }
-            let min_p = holm_bonferroni(&ps).into_iter().filter(|p| !p.is_nan()).fold(1.0, f64::min);
-            let (mean, se) = (pooled / k.max(1) as f64, pooled_var.sqrt() / k.max(1) as f64);
-            let z = z_test(mean, se, 0.0);
-            detect.sort_by(f64::total_cmp);
-            let median_detect = detect.get(detect.len() / 2).copied().unwrap_or(f64::NAN);
-            for (test, stat, p, detect) in [
-                ("holm_t_dedicated", max_t, min_p, median_detect),
-                ("pooled_z_dedicated", z.statistic, z.p_value, mean),
-            ] {
-                let flagged = p < UNBIASEDNESS_ALPHA;
-                rows.push(TestRow {
+            let cell = CellResult {
+                key: CellKey {
                     testbed: "envmap-sequence".into(),
                     variant: variant.into(),
+                    testbed_params: String::new(),
                     estimator: id.into(),
-                    test: test.into(),
-                    budget: n,
-                    statistic: stat,
-                    p_value: p,
-                    verdict: if flagged { "biased" } else { "pass" }.into(),
-                    alpha: UNBIASEDNESS_ALPHA,
-                    // holm: the median relative bias detectable with 80% power; pooled: the measured
-                    // pooled relative bias (its standard error is `se`).
-                    detectable_rel_bias: if detect.is_nan() { 4.0 * se } else { detect },
-                    claim: entry.bias.name().into(),
-                    agrees: match entry.bias {
-                        estimators::estimator::Bias::Unbiased => !flagged,
-                        estimators::estimator::Bias::Biased => flagged || variant.ends_with("-lns"),
-                        estimators::estimator::Bias::Consistent => true,
-                    },
-                });
+                    budget: Budget::samples(n)?,
+                    reps: reps as usize,
+                    seed,
+                    version: env!("CARGO_PKG_VERSION").into(),
+                },
+                moments: m,
+                costs: Default::default(),
+                estimates: reps * bed.integrals() as u64,
+                time: Default::default(),
+                diagnostics: Vec::new(),
+            };
+            for mut row in unbiasedness(&cell, reference, entry.bias) {
+                row.test.push_str("_dedicated");
+                // The self-normalised control is only biased for L_r; its L_ns estimate is unbiased.
+                if entry.bias == estimators::estimator::Bias::Biased && variant.ends_with("-lns") {
+                    row.agrees = true;
+                }
+                rows.push(row);
             }
         }
     }

@@ -16,9 +16,11 @@ pub mod envmap_unbiasedness;
 pub mod media_smc;
 pub mod media_smc_post;
 pub mod particle_sweep;
+pub mod particle_sweep_post;
 pub mod pmc_hi;
 pub mod surface_smc;
 pub mod transmittance;
+pub mod transmittance_post;
 pub mod variance_claims;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};

@@ -24,7 +24,7 @@ pub static DEF: ExperimentDef = ExperimentDef {
     ids: IDS,
     sweep,
     claims,
-    post: None,
+    post: Some(super::particle_sweep_post::post),
 };
 
 fn name(id: &str, s: f64) -> String {
