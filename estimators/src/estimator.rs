@@ -71,6 +71,14 @@ pub trait Estimator: Send + Sync {
         Ok(())
     }
 
+    /// The exact moments of one sample (channel 0) of this configured estimator on `task`'s
+    /// integral under `task`'s budget, where a theory gives them (paper 002 §3.4 for the
+    /// transmittance trackers, see [`crate::media::moments`]); `None` (the default) otherwise. An
+    /// estimate averaging `n` independent samples has the moments `mean_of(n)` of these.
+    fn sample_moments(&self, _task: &Task<'_>) -> Option<crate::media::moments::EstimateMoments> {
+        None
+    }
+
     /// Whether this configuration is *valid* on `bed` (e.g. a terminating particle model whose
     /// sampling density makes `r > 2/(a+1)` somewhere): an error here is bad input (exit 2), not a
     /// skipped pair, because the user asked for something that cannot be computed.

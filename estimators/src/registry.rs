@@ -101,6 +101,7 @@ pub static TESTBEDS: &[&TestBedEntry] = &[
     &crate::media::EQ21,
     &crate::media::PERLIN,
     &crate::testbeds::gradient_box::ENTRY,
+    &crate::testbeds::canonical_1d::ENTRY,
 ];
 
 /// Looks an estimator up by id.

@@ -21,6 +21,7 @@
 
 pub mod density;
 pub mod environment;
+pub mod moments;
 pub mod reference;
 pub mod scatter_reference;
 pub mod variance;

@@ -235,7 +235,7 @@ pub fn compute_stored(
     let samples = params.count("samples", default_n, 100_000_000)? as u64;
     let res = params.count("resolution", 16, 512)?;
     let bed = MediumBed::without_reference(field, variant, &Params::new().with("resolution", res as f64))?;
-    let tracker = crate::tracking::delta_tracking::DeltaTracking { sigma_samp: None };
+    let tracker = crate::tracking::delta_tracking::DeltaTracking { sigma_samp: crate::tracking::SigmaSamp::Majorant };
     let n = bed.integrals();
     let threads = threads.max(1).min(n);
     let next = std::sync::atomic::AtomicUsize::new(0);

@@ -60,6 +60,7 @@ mod tests {
     use crate::testbed::TestBed;
     use crate::tracking::double_particle::DoubleParticle;
     use crate::tracking::single_particle::SingleParticle;
+    use crate::tracking::SigmaSamp::Absolute;
 
     /// Measured variance of one-ray estimates of T(s) on the eq21 central ray agrees with Eq. 16
     /// within 4 standard errors of the sample variance (from the sample fourth moment), for the
@@ -72,12 +73,20 @@ mod tests {
         let sigma = |t: f64| bed.extinction(Vec3::new(0.0, 0.0, t));
         let a = 0.7;
         let cases: Vec<(Model, f64, Box<dyn Estimator>)> = vec![
-            (Model::Double, 0.4, Box::new(DoubleParticle { sigma_samp: 0.4, control: false, spacing: 0.5 })),
-            (Model::Double, 1.0, Box::new(DoubleParticle { sigma_samp: 1.0, control: false, spacing: 0.5 })),
-            (Model::NonTerminating { a }, 0.4, Box::new(SingleParticle { sigma_samp: 0.4, terminating: false })),
-            (Model::NonTerminating { a }, 1.0, Box::new(SingleParticle { sigma_samp: 1.0, terminating: false })),
-            (Model::Terminating, 1.0, Box::new(SingleParticle { sigma_samp: 1.0, terminating: true })),
-            (Model::Terminating, 0.9, Box::new(SingleParticle { sigma_samp: 0.9, terminating: true })),
+            (Model::Double, 0.4, Box::new(DoubleParticle { sigma_samp: Absolute(0.4), control: None, spacing: 0.5 })),
+            (Model::Double, 1.0, Box::new(DoubleParticle { sigma_samp: Absolute(1.0), control: None, spacing: 0.5 })),
+            (
+                Model::NonTerminating { a },
+                0.4,
+                Box::new(SingleParticle { sigma_samp: Absolute(0.4), terminating: false }),
+            ),
+            (
+                Model::NonTerminating { a },
+                1.0,
+                Box::new(SingleParticle { sigma_samp: Absolute(1.0), terminating: false }),
+            ),
+            (Model::Terminating, 1.0, Box::new(SingleParticle { sigma_samp: Absolute(1.0), terminating: true })),
+            (Model::Terminating, 0.9, Box::new(SingleParticle { sigma_samp: Absolute(0.9), terminating: true })),
         ];
         let n = 40_000;
         for (ci, (model, samp, est)) in cases.iter().enumerate() {

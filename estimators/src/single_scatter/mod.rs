@@ -44,7 +44,7 @@ use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::{MediumProbe, Task};
 use crate::testbed::{MediumQuantity, TestBed};
-use crate::tracking::residual_ratio_tracking::{main_part_along, RecentMaximum, ResidualRatioTracking};
+use crate::tracking::residual_ratio_tracking::{main_part_along, MainPart, RecentMaximum, ResidualRatioTracking};
 use crate::tracking::{track, Rule};
 
 /// The geometry of one pixel's integral: the primary ray's medium segment and the light.
@@ -142,13 +142,14 @@ pub fn supports_single_scatter(bed: &dyn TestBed) -> Result<(), String> {
 /// constant `sigma_samp`, the largest `|sigma_diff|` of the last few shadow rays.
 pub struct ShadowRays {
     spacing: f64,
+    kind: MainPart,
     memory: RecentMaximum,
 }
 
 impl ShadowRays {
     /// Shadow rays with the residual tracking parameters `cfg` in a medium with this majorant.
     pub fn new(cfg: &ResidualRatioTracking, majorant: f64) -> Self {
-        ShadowRays { spacing: cfg.spacing, memory: cfg.memory(majorant) }
+        ShadowRays { spacing: cfg.spacing, kind: cfg.kind, memory: cfg.memory(majorant) }
     }
     /// An unbiased estimate of the transmittance from `p` to the light (one ray).
     pub fn transmittance(
@@ -168,7 +169,7 @@ impl ShadowRays {
         let Some(seg) = probe.clip(p, w).map(|(a, b)| (a, b.min(r))).filter(|(a, b)| b > a) else {
             return Ok(1.0);
         };
-        let (main, tm) = main_part_along(probe, (p, w), seg, self.spacing);
+        let (main, tm) = main_part_along(probe, (p, w), seg, self.spacing, self.kind);
         let sigma = self.memory.sigma();
         let mut seen = 0.0f64;
         let e = track(probe, (p, w), seg, &SamplingDensity::constant(sigma), Some(&main), Rule::Double, rng, |i| {

@@ -28,7 +28,10 @@ pub struct PrimaryTracker {
 impl PrimaryTracker {
     /// The tracker of `geo`'s primary ray with the residual tracking parameters `cfg`.
     pub fn new(probe: &MediumProbe<'_>, geo: &Geometry, cfg: &ResidualRatioTracking) -> Self {
-        PrimaryTracker { main: main_part(probe, geo.seg, cfg.spacing).0, memory: cfg.memory(probe.majorant()) }
+        PrimaryTracker {
+            main: main_part(probe, geo.seg, cfg.spacing, cfg.kind).0,
+            memory: cfg.memory(probe.majorant()),
+        }
     }
     /// The piecewise-linear main part of the extinction along the primary ray.
     pub fn main(&self) -> &SamplingDensity {
@@ -133,7 +136,13 @@ mod tests {
             albedo: 0.7,
             phase: crate::phase::Phase::Rayleigh,
         };
-        let cfg = ResidualRatioTracking { spacing: 2.0, recent: 4, floor: 0.05, first: None };
+        let cfg = ResidualRatioTracking {
+            spacing: 2.0,
+            recent: 4,
+            floor: 0.05,
+            first: None,
+            kind: crate::tracking::residual_ratio_tracking::MainPart::Linear,
+        };
         let mut tracker = PrimaryTracker::new(&probe, &geo, &cfg);
         let mut rng = stream(31, "continuous");
         let (mut cont, mut step) = (vec![Moments::default(); 4], vec![Moments::default(); 4]);

@@ -1,5 +1,7 @@
 //! The analytic test beds (SPEC §3), each with its exact or stored reference.
 
+pub mod canonical_1d;
+pub mod canonical_profiles;
 pub mod checker;
 pub mod checker_image;
 pub mod checker_image_reference;

@@ -1,5 +1,6 @@
 //! `delta_tracking` (Woodcock tracking, the classic baseline of paper 002): free flights with the
-//! constant majorant (declared by the scene, or parameter `sigma_samp`, which must be a majorant).
+//! constant majorant (declared by the scene, or parameter `sigma_samp` / `sigma_samp_ratio`, which
+//! must give a majorant: a smaller density is refused as a skipped pair with the reason).
 //! Transmittance: terminate with probability `r = sigma_t / sigma_samp`. Radiance (particle
 //! tracing): the analog collision of Eq. 7 (scatter with probability `a r`, absorb `(1 - a) r`,
 //! pass `1 - r`), i.e. the terminating single particle model at a majorant. Point-light single
@@ -7,11 +8,12 @@
 //! ([`crate::single_scatter::delta_tracking`]).
 
 use super::spm::{trace, SpmMode};
-use super::{sigma_samp_param, track, transmittance, Rule};
+use super::{ray_moments, sigma_samp_param, track, transmittance, Rule, SigmaSamp};
 use crate::accumulate::RgbMean;
-use crate::error::{ConfigError, EstimateError};
+use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::EstimateMoments;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -31,7 +33,11 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         crate::single_scatter::SingleScatterOr::build(
             "delta_tracking",
             p,
-            (&["sigma_samp"], |p| Ok(Box::new(DeltaTracking { sigma_samp: sigma_samp_param(p, "delta_tracking")? }))),
+            (&["sigma_samp", "sigma_samp_ratio"], |p| {
+                Ok(Box::new(DeltaTracking {
+                    sigma_samp: SigmaSamp::from_params(p, "delta_tracking", SigmaSamp::Majorant)?,
+                }))
+            }),
             (&["sigma_samp"], |p| {
                 let sigma_samp = sigma_samp_param(p, "delta_tracking")?;
                 Ok(Box::new(crate::single_scatter::delta_tracking::DeltaTrackingScatter { sigma_samp }))
@@ -42,14 +48,14 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
 
 /// The estimator.
 pub struct DeltaTracking {
-    /// Sampling extinction (`None`: the scene's majorant).
-    pub sigma_samp: Option<f64>,
+    /// Sampling extinction (a majorant).
+    pub sigma_samp: SigmaSamp,
 }
 
 impl Estimator for DeltaTracking {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         let probe = task.medium().ok_or_else(|| EstimateError::Refused("the test bed has no medium".into()))?;
-        let sigma = self.sigma_samp.unwrap_or(probe.majorant());
+        let sigma = self.sigma_samp.resolve(probe.majorant());
         if let MediumQuantity::Transmittance { .. } = probe.ray().quantity {
             return transmittance(task, rng, |probe, seg, rng| {
                 track(
@@ -71,14 +77,10 @@ impl Estimator for DeltaTracking {
         }
         Ok(mean.mean())
     }
-    fn validate(&self, bed: &dyn TestBed) -> Result<(), ConfigError> {
-        match (bed.medium(), self.sigma_samp) {
-            (Some(m), Some(s)) if s < m.majorant() => Err(ConfigError::invalid(
-                "delta_tracking.sigma_samp",
-                s,
-                format!("delta tracking needs a majorant (>= {} on {}/{})", m.majorant(), bed.id(), bed.variant()),
-            )),
-            _ => Ok(()),
-        }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        ray_moments(task, self.sigma_samp, |_| Rule::Delta, None)
+    }
+    fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
+        self.sigma_samp.require_majorant("delta_tracking", bed)
     }
 }

@@ -1,14 +1,17 @@
 //! `double_particle`: the Double Particle Model of paper 002 (Eq. 8, §3.3) for transmittance with
-//! any constant `sigma_samp > 0` (parameter, default 1; a majorant or not): the transmitted
-//! particle's weight is multiplied by `1 - r`, `r = sigma_t / sigma_samp`, which is negative when
-//! `r > 1` (negative energy). Optional `control = 1` subtracts a piecewise-linear main part
-//! through explorer points spaced `explorer_spacing` (negative difference extinction, §3.3).
+//! any constant `sigma_samp > 0` (parameter `sigma_samp`, default 1, or `sigma_samp_ratio` times
+//! the declared majorant; a majorant or not): the transmitted particle's weight is multiplied by
+//! `1 - r`, `r = sigma_diff / sigma_samp`, which is negative when `r > 1` (negative energy).
+//! Optional control variate (negative difference extinction, §3.3): `control = 1` subtracts a
+//! piecewise-linear main part through explorer points spaced `explorer_spacing`, `control = 2`
+//! the constant at its mean (the L2-optimal constant of §3.4).
 
-use super::residual_ratio_tracking::main_part;
-use super::{supports_transmittance, track, transmittance, Rule};
+use super::residual_ratio_tracking::{main_part, MainPart};
+use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::EstimateMoments;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -22,11 +25,12 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "double particle model",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM,
-    summary: "double particle model (Eq. 8) with any sigma_samp (default 1), optional control variate",
+    summary:
+        "double particle model (Eq. 8) with any sigma_samp (default 1), optional control variate (1 linear, 2 mean)",
     build: |p| {
-        p.reject_unknown("double_particle", &["sigma_samp", "control", "explorer_spacing"])?;
-        let sigma_samp = super::sigma_samp_param(p, "double_particle")?.unwrap_or(1.0);
-        let control = p.f64_in("control", 0.0, 0.0, 1.0)? == 1.0;
+        p.reject_unknown("double_particle", &["sigma_samp", "sigma_samp_ratio", "control", "explorer_spacing"])?;
+        let sigma_samp = SigmaSamp::from_params(p, "double_particle", SigmaSamp::Absolute(1.0))?;
+        let control = MainPart::from_control(p, "double_particle", 0.0)?;
         let spacing = p.f64("explorer_spacing", 0.5)?;
         if spacing <= 0.0 {
             return Err(ConfigError::invalid("double_particle.explorer_spacing", spacing, "must be > 0"));
@@ -38,9 +42,9 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
 /// The estimator.
 pub struct DoubleParticle {
     /// Constant sampling extinction.
-    pub sigma_samp: f64,
-    /// Subtract the explorer main part.
-    pub control: bool,
+    pub sigma_samp: SigmaSamp,
+    /// The explorer main part subtracted, if any.
+    pub control: Option<MainPart>,
     /// Explorer spacing.
     pub spacing: f64,
 }
@@ -49,10 +53,10 @@ impl Estimator for DoubleParticle {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         let mut main: Option<(SamplingDensity, f64)> = None;
         transmittance(task, rng, |probe, seg, rng| {
-            if self.control && main.is_none() {
-                main = Some(main_part(probe, seg, self.spacing));
+            if let (Some(kind), None) = (self.control, &main) {
+                main = Some(main_part(probe, seg, self.spacing, kind));
             }
-            let samp = SamplingDensity::constant(self.sigma_samp);
+            let samp = SamplingDensity::constant(self.sigma_samp.resolve(probe.majorant()));
             let m = main.as_ref();
             let e = track(
                 probe,
@@ -66,6 +70,9 @@ impl Estimator for DoubleParticle {
             )?;
             Ok(e * m.map_or(1.0, |x| x.1))
         })
+    }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        ray_moments(task, self.sigma_samp, |_| Rule::Double, self.control.map(|k| (k, self.spacing)))
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_transmittance(bed)

@@ -16,12 +16,14 @@ pub mod spm;
 use crate::accumulate::RgbMean;
 use crate::error::{ConfigError, EstimateError};
 use crate::math::{Rgb, Vec3};
+use crate::media::moments::{tracker_moments, EstimateMoments};
 use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::{MediumProbe, Task};
 use crate::testbed::{MediumQuantity, TestBed};
 use rand::Rng;
+use residual_ratio_tracking::{main_part, MainPart};
 
 /// How the weight of the transmitted particle changes at an interaction with
 /// `r = sigma_diff / sigma_samp` (paper 002 §3).
@@ -152,6 +154,30 @@ pub fn transmittance(
     Ok(weight * mean.mean().0[0])
 }
 
+/// The exact moments of one tracker ray on `task`'s transmittance integral
+/// ([`crate::media::moments`]): constant density `sigma_samp`, the rule `rule(albedo)`, and the
+/// main part `control` (shape, explorer spacing) computed exactly as the estimator computes it;
+/// `None` for radiance integrals or where the rule is invalid on the ray.
+pub fn ray_moments(
+    task: &Task<'_>,
+    sigma_samp: SigmaSamp,
+    rule: impl Fn(f64) -> Rule,
+    control: Option<(MainPart, f64)>,
+) -> Option<EstimateMoments> {
+    let probe = task.medium()?;
+    let MediumQuantity::Transmittance { weight } = probe.ray().quantity else { return None };
+    let Some(seg) = segment(&probe) else {
+        return Some(EstimateMoments { mean: weight[0], rel_variance: 0.0, rel_central4: 0.0 });
+    };
+    let main = control.map(|(kind, spacing)| main_part(&probe, seg, spacing, kind));
+    let ray = *probe.ray();
+    let diff = |t: f64| probe.sigma_t(ray.origin + ray.dir * t) - main.as_ref().map_or(0.0, |m| m.0.eval(t));
+    let depth = main.as_ref().map_or(0.0, |m| -m.1.ln());
+    let samp = sigma_samp.resolve(probe.majorant());
+    let m = tracker_moments(diff, depth, samp, rule(probe.albedo()), seg, &[])?;
+    Some(EstimateMoments { mean: m.mean * weight[0], ..m })
+}
+
 /// A positive finite `sigma_samp` parameter (`None` when absent).
 pub fn sigma_samp_param(p: &Params, owner: &str) -> Result<Option<f64>, ConfigError> {
     if !p.0.contains_key("sigma_samp") {
@@ -162,6 +188,64 @@ pub fn sigma_samp_param(p: &Params, owner: &str) -> Result<Option<f64>, ConfigEr
         return Err(ConfigError::invalid(format!("{owner}.sigma_samp"), v, "must be > 0"));
     }
     Ok(Some(v))
+}
+
+/// A tracker's constant sampling density `sigma_samp` (paper 002 Eq. 4 with a constant density):
+/// absolute (parameter `sigma_samp`), relative to the scene's declared majorant (parameter
+/// `sigma_samp_ratio`, the axis of the canonical sweep: below 1 it is not a majorant), or the
+/// declared majorant itself.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SigmaSamp {
+    /// The scene's declared majorant.
+    Majorant,
+    /// A fixed value (> 0).
+    Absolute(f64),
+    /// This multiple (> 0) of the scene's declared majorant.
+    Ratio(f64),
+}
+
+impl SigmaSamp {
+    /// Reads `sigma_samp` or `sigma_samp_ratio` (not both; each finite and > 0), else `default`.
+    pub fn from_params(p: &Params, owner: &str, default: SigmaSamp) -> Result<SigmaSamp, ConfigError> {
+        let ratio = if p.0.contains_key("sigma_samp_ratio") { Some(p.f64("sigma_samp_ratio", 1.0)?) } else { None };
+        match (sigma_samp_param(p, owner)?, ratio) {
+            (Some(_), Some(_)) => Err(ConfigError::invalid(
+                format!("{owner}.sigma_samp_ratio"),
+                ratio.unwrap_or(f64::NAN),
+                "give sigma_samp or sigma_samp_ratio, not both",
+            )),
+            (Some(v), None) => Ok(SigmaSamp::Absolute(v)),
+            (None, Some(r)) if r > 0.0 => Ok(SigmaSamp::Ratio(r)),
+            (None, Some(r)) => Err(ConfigError::invalid(format!("{owner}.sigma_samp_ratio"), r, "must be > 0")),
+            (None, None) => Ok(default),
+        }
+    }
+    /// The density on a scene declaring `majorant`.
+    pub fn resolve(self, majorant: f64) -> f64 {
+        match self {
+            SigmaSamp::Majorant => majorant,
+            SigmaSamp::Absolute(v) => v,
+            SigmaSamp::Ratio(r) => r * majorant,
+        }
+    }
+    /// For trackers that need a majorant (delta and ratio tracking): why this density cannot run
+    /// on `bed` (a skipped pair with the reason), or `Ok` when it is at least the declared majorant.
+    pub fn require_majorant(self, owner: &str, bed: &dyn TestBed) -> Result<(), String> {
+        let Some(m) = bed.medium() else { return Ok(()) };
+        let (sigma, majorant) = (self.resolve(m.majorant()), m.majorant());
+        if sigma >= majorant {
+            return Ok(());
+        }
+        let field = match self {
+            SigmaSamp::Ratio(r) => format!("{owner}.sigma_samp_ratio = {r}"),
+            _ => format!("{owner}.sigma_samp = {sigma}"),
+        };
+        Err(format!(
+            "{field}: {owner} needs a majorant, but sigma_samp = {sigma:.6} is below the declared majorant {majorant:.6} of {}/{} (r = sigma_t/sigma_samp would exceed 1; the double and single particle models accept it)",
+            bed.id(),
+            bed.variant()
+        ))
+    }
 }
 
 /// Refuses (as a skipped pair) test beds whose integrals are not transmittances.

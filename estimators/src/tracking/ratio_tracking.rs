@@ -1,10 +1,13 @@
 //! `ratio_tracking` (Novák et al. 2014; paper 002 Eq. 8 with a constant majorant): free flights
-//! with `sigma_samp` = the declared majorant (or parameter `sigma_samp`), weight `*= 1 - r`.
+//! with `sigma_samp` = the declared majorant (or parameter `sigma_samp` / `sigma_samp_ratio`, which
+//! must give a majorant: a smaller density is the double particle model, and is refused here as a
+//! skipped pair with the reason), weight `*= 1 - r`.
 
-use super::{sigma_samp_param, supports_transmittance, track, transmittance, Rule};
+use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::EstimateMoments;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -20,25 +23,29 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::MEDIUM,
     summary: "ratio tracking with the constant majorant (paper 002 Eq. 8, [NSJ14])",
     build: |p| {
-        p.reject_unknown("ratio_tracking", &["sigma_samp"])?;
-        Ok(Box::new(RatioTracking { sigma_samp: sigma_samp_param(p, "ratio_tracking")? }))
+        p.reject_unknown("ratio_tracking", &["sigma_samp", "sigma_samp_ratio"])?;
+        Ok(Box::new(RatioTracking { sigma_samp: SigmaSamp::from_params(p, "ratio_tracking", SigmaSamp::Majorant)? }))
     },
 };
 
 /// The estimator.
 pub struct RatioTracking {
-    /// Sampling extinction (`None`: the scene's majorant).
-    pub sigma_samp: Option<f64>,
+    /// Sampling extinction (a majorant).
+    pub sigma_samp: SigmaSamp,
 }
 
 impl Estimator for RatioTracking {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         transmittance(task, rng, |probe, seg, rng| {
-            let samp = SamplingDensity::constant(self.sigma_samp.unwrap_or(probe.majorant()));
+            let samp = SamplingDensity::constant(self.sigma_samp.resolve(probe.majorant()));
             track(probe, (probe.ray().origin, probe.ray().dir), seg, &samp, None, Rule::Double, rng, |_| ())
         })
     }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        ray_moments(task, self.sigma_samp, |_| Rule::Double, None)
+    }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
-        supports_transmittance(bed)
+        supports_transmittance(bed)?;
+        self.sigma_samp.require_majorant("ratio_tracking", bed)
     }
 }

@@ -8,14 +8,16 @@
 //! On point-light single-scatter integrals the same id marches the primary and shadow rays
 //! ([`crate::single_scatter::ray_marching`]).
 
-use super::{supports_transmittance, transmittance};
-use crate::budget::BudgetKind;
+use super::{segment, supports_transmittance, transmittance};
+use crate::budget::{Budget, BudgetKind};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::{ray_marching_moments, EstimateMoments};
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::task::Task;
+use crate::testbed::MediumQuantity;
 use crate::testbed::{Needs, TestBed};
 use rand::Rng;
 
@@ -61,15 +63,22 @@ pub struct RayMarching {
     pub fixed_step: bool,
 }
 
+impl RayMarching {
+    /// The number of equal steps on a segment of length `len` under `budget`.
+    fn steps(&self, budget: Budget, len: f64) -> f64 {
+        match budget.kind {
+            BudgetKind::Fetches if !self.fixed_step => budget.amount.max(1) as f64,
+            _ => (len / self.step).ceil().max(1.0),
+        }
+    }
+}
+
 impl Estimator for RayMarching {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         let budget = task.budget();
         transmittance(task, rng, |probe, (t0, t1), rng| {
             let len = t1 - t0;
-            let n = match budget.kind {
-                BudgetKind::Fetches if !self.fixed_step => budget.amount.max(1) as f64,
-                _ => (len / self.step).ceil().max(1.0),
-            };
+            let n = self.steps(budget, len);
             let h = len / n;
             let u: f64 = rng.gen();
             let ray = *probe.ray();
@@ -77,6 +86,18 @@ impl Estimator for RayMarching {
                 (0..n as u64).map(|j| probe.sigma_t(ray.origin + ray.dir * (t0 + (j as f64 + u) * h))).sum::<f64>() * h;
             Ok((-tau).exp())
         })
+    }
+    /// One marched ray: its exact moments over the random offset (the steps as in `estimate`).
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        let probe = task.medium()?;
+        let MediumQuantity::Transmittance { weight } = probe.ray().quantity else { return None };
+        let Some((t0, t1)) = segment(&probe) else {
+            return Some(EstimateMoments { mean: weight[0], rel_variance: 0.0, rel_central4: 0.0 });
+        };
+        let n = self.steps(task.budget(), t1 - t0) as usize;
+        let ray = *probe.ray();
+        let m = ray_marching_moments(|t| probe.sigma_t(ray.origin + ray.dir * t), (t0, t1), n, &[]);
+        Some(EstimateMoments { mean: m.mean * weight[0], ..m })
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_transmittance(bed)

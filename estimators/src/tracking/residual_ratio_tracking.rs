@@ -1,7 +1,8 @@
-//! `residual_ratio_tracking` (paper 002 §4.2 `Transmittance`, [NSJ14]): a piecewise-linear main
-//! part `sigma_main` through explorer points (cheap approximate extinction, spaced
-//! `explorer_spacing`, default 0.5; computed once per pixel and reused by all its rays, as the
-//! paper reuses explorer data of neighbouring rays), `T = T_main * E` with `E *= 1 - r`,
+//! `residual_ratio_tracking` (paper 002 §4.2 `Transmittance`, [NSJ14]): a main part `sigma_main`
+//! through explorer points (cheap approximate extinction, spaced `explorer_spacing`, default 0.5;
+//! computed once per pixel and reused by all its rays, as the paper reuses explorer data of
+//! neighbouring rays): `control = 1` (default) the piecewise-linear fit of §4, `control = 2` the
+//! constant at its mean, the L2-optimal constant of §3.4; `T = T_main * E` with `E *= 1 - r`,
 //! `r = sigma_diff / sigma_samp`, and a constant `sigma_samp` = the largest `|sigma_diff|` seen on
 //! the last `recent` rays (default 4; at least `sigma_floor`, default 0.05; the first ray uses
 //! `sigma_samp0`, default 0.3 x majorant). Neither a majorant nor `|sigma_diff| <= sigma_samp` is
@@ -12,6 +13,7 @@ use super::{supports_transmittance, track, transmittance, Rule};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::{Rgb, Vec3};
+use crate::params::Params;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::{Interp, SamplingDensity};
@@ -43,15 +45,18 @@ pub struct ResidualRatioTracking {
     pub floor: f64,
     /// sigma_samp of the first ray (`None`: 0.3 x majorant).
     pub first: Option<f64>,
+    /// The main part's shape.
+    pub kind: MainPart,
 }
 
 impl ResidualRatioTracking {
     /// The parameter names (shared by the single-scatter estimators, whose rays are tracked the
     /// same way).
-    pub const PARAMS: &'static [&'static str] = &["explorer_spacing", "recent", "sigma_floor", "sigma_samp0"];
+    pub const PARAMS: &'static [&'static str] =
+        &["explorer_spacing", "recent", "sigma_floor", "sigma_samp0", "control"];
 
     /// Reads the parameters (unknown names are the caller's to refuse), naming `owner` on error.
-    pub fn from_params(p: &crate::params::Params, owner: &str) -> Result<Self, ConfigError> {
+    pub fn from_params(p: &Params, owner: &str) -> Result<Self, ConfigError> {
         let spacing = p.f64("explorer_spacing", 0.5)?;
         let floor = p.f64("sigma_floor", 0.05)?;
         let first = p.f64("sigma_samp0", 0.0)?;
@@ -61,7 +66,14 @@ impl ResidualRatioTracking {
             }
         }
         let recent = p.count("recent", 4, 1000)?;
-        Ok(ResidualRatioTracking { spacing, recent, floor, first: (first > 0.0).then_some(first) })
+        let Some(kind) = MainPart::from_control(p, owner, 1.0)? else {
+            return Err(ConfigError::invalid(
+                format!("{owner}.control"),
+                0,
+                "the residual estimator needs a main part: 1 (piecewise linear) or 2 (mean)",
+            ));
+        };
+        Ok(ResidualRatioTracking { spacing, recent, floor, first: (first > 0.0).then_some(first), kind })
     }
 
     /// A fresh sigma_samp memory for a scene with this majorant.
@@ -70,12 +82,39 @@ impl ResidualRatioTracking {
     }
 }
 
-/// The piecewise-linear main part through explorer points on `[t0, t1]` of the integral's ray and
-/// its transmittance `exp(-int sigma_main)` (cheap fetches, or full ones when the scene has no
-/// approximation).
-pub fn main_part(probe: &MediumProbe<'_>, seg: (f64, f64), spacing: f64) -> (SamplingDensity, f64) {
+/// The shape of a control variate's main part fitted through explorer points (paper 002 §3.3-4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MainPart {
+    /// The piecewise-linear interpolation of the explorer values (paper 002 §4, Fig. 5).
+    Linear,
+    /// The constant mean of that interpolation over the segment: the explorer points' estimate of
+    /// the mean extinction, the L2-optimal constant main part of §3.4.
+    Mean,
+}
+
+impl MainPart {
+    /// The `control` parameter: 0 (none), 1 ([`MainPart::Linear`]) or 2 ([`MainPart::Mean`]).
+    pub fn from_control(p: &Params, owner: &str, default: f64) -> Result<Option<MainPart>, ConfigError> {
+        match p.f64("control", default)? {
+            0.0 => Ok(None),
+            1.0 => Ok(Some(MainPart::Linear)),
+            2.0 => Ok(Some(MainPart::Mean)),
+            v => Err(ConfigError::invalid(
+                format!("{owner}.control"),
+                v,
+                "must be 0 (none), 1 (piecewise-linear main part) or 2 (constant at its mean)",
+            )),
+        }
+    }
+}
+
+/// The main part through explorer points on `[t0, t1]` of the integral's ray and its transmittance
+/// `exp(-int sigma_main)` (cheap fetches, or full ones when the scene has no approximation): the
+/// piecewise-linear fit, or the constant at its mean (both have the same integral, so the same
+/// `T_main`).
+pub fn main_part(probe: &MediumProbe<'_>, seg: (f64, f64), spacing: f64, kind: MainPart) -> (SamplingDensity, f64) {
     let ray = *probe.ray();
-    main_part_along(probe, (ray.origin, ray.dir), seg, spacing)
+    main_part_along(probe, (ray.origin, ray.dir), seg, spacing, kind)
 }
 
 /// [`main_part`] along any line `origin + s dir` (e.g. a shadow ray).
@@ -84,13 +123,18 @@ pub fn main_part_along(
     (origin, dir): (Vec3, Vec3),
     (t0, t1): (f64, f64),
     spacing: f64,
+    kind: MainPart,
 ) -> (SamplingDensity, f64) {
     let n = ((t1 - t0) / spacing).ceil().max(1.0) as usize;
     let t: Vec<f64> = (0..=n).map(|j| t0 + (t1 - t0) * j as f64 / n as f64).collect();
     let v: Vec<f64> = t.iter().map(|&s| probe.sigma_approx(origin + dir * s)).collect();
     let main = SamplingDensity::new(t, v, Interp::Linear);
-    let tm = (-main.integral(t0, t1)).exp();
-    (main, tm)
+    let integral = main.integral(t0, t1);
+    let main = match kind {
+        MainPart::Linear => main,
+        MainPart::Mean => SamplingDensity::constant(integral / (t1 - t0)),
+    };
+    (main, (-integral).exp())
 }
 
 /// The paper's constant `sigma_samp` (§4.3): the largest `|sigma_diff|` seen on the last `recent`
@@ -126,7 +170,7 @@ impl Estimator for ResidualRatioTracking {
         let mut main: Option<(SamplingDensity, f64)> = None;
         let mut memory: Option<RecentMaximum> = None;
         transmittance(task, rng, |probe, seg, rng| {
-            let (m, tm) = main.get_or_insert_with(|| main_part(probe, seg, self.spacing));
+            let (m, tm) = main.get_or_insert_with(|| main_part(probe, seg, self.spacing, self.kind));
             let memory = memory.get_or_insert_with(|| self.memory(probe.majorant()));
             let sigma = memory.sigma();
             let mut seen = 0.0f64;

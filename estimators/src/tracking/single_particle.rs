@@ -1,15 +1,17 @@
 //! Transmittance by the Single Particle Model of paper 002 (Eq. 9, §3.3) with a constant
-//! `sigma_samp` (parameter, default 1): the particle keeps only one offspring; on the ray's
+//! `sigma_samp` (parameter `sigma_samp`, default 1, or `sigma_samp_ratio` times the declared
+//! majorant): the particle keeps only one offspring; on the ray's
 //! transmittance only the transmitted one counts (a scattered or absorbed particle scores 0).
 //! - `single_particle_terminating`: `q_scat = a r`, `q_tran = |1 - r|`; valid only for
 //!   `0 <= r <= 2/(a+1)`: configurations whose declared majorant allows a larger `r` are refused
 //!   before the run (`ConfigError`, exit 2), and an `r` out of range met at run time is refused.
 //! - `single_particle_nonterminating`: Eq. 12 probabilities, any `r`.
 
-use super::{sigma_samp_param, supports_transmittance, track, transmittance, Rule};
+use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::media::moments::EstimateMoments;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -39,14 +41,14 @@ pub static NONTERMINATING: EstimatorEntry = EstimatorEntry {
 };
 
 fn build(p: &crate::params::Params, id: &str, terminating: bool) -> Result<Box<dyn Estimator>, ConfigError> {
-    p.reject_unknown(id, &["sigma_samp"])?;
-    Ok(Box::new(SingleParticle { sigma_samp: sigma_samp_param(p, id)?.unwrap_or(1.0), terminating }))
+    p.reject_unknown(id, &["sigma_samp", "sigma_samp_ratio"])?;
+    Ok(Box::new(SingleParticle { sigma_samp: SigmaSamp::from_params(p, id, SigmaSamp::Absolute(1.0))?, terminating }))
 }
 
 /// The estimator.
 pub struct SingleParticle {
     /// Constant sampling extinction.
-    pub sigma_samp: f64,
+    pub sigma_samp: SigmaSamp,
     /// Terminating (true) or non-terminating.
     pub terminating: bool,
 }
@@ -76,24 +78,22 @@ impl Estimator for SingleParticle {
         transmittance(task, rng, |probe, seg, rng| {
             let a = probe.albedo();
             let rule = if self.terminating { Rule::Terminating { a } } else { Rule::NonTerminating { a } };
-            track(
-                probe,
-                (probe.ray().origin, probe.ray().dir),
-                seg,
-                &SamplingDensity::constant(self.sigma_samp),
-                None,
-                rule,
-                rng,
-                |_| (),
-            )
+            let samp = SamplingDensity::constant(self.sigma_samp.resolve(probe.majorant()));
+            track(probe, (probe.ray().origin, probe.ray().dir), seg, &samp, None, rule, rng, |_| ())
         })
+    }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
+        let terminating = self.terminating;
+        let rule = move |a| if terminating { Rule::Terminating { a } } else { Rule::NonTerminating { a } };
+        ray_moments(task, self.sigma_samp, rule, None)
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_transmittance(bed)
     }
     fn validate(&self, bed: &dyn TestBed) -> Result<(), ConfigError> {
         if self.terminating {
-            check_terminating("single_particle_terminating", self.sigma_samp, bed)?;
+            let majorant = bed.medium().map_or(1.0, |m| m.majorant());
+            check_terminating("single_particle_terminating", self.sigma_samp.resolve(majorant), bed)?;
         }
         Ok(())
     }

@@ -37,7 +37,8 @@ fn holm_p(bed: &MediumBed, est: &dyn Estimator, reps: usize, spp: u64, seed: u64
 
 /// Every unbiased transmittance estimator passes (Holm over the central ray's points, family-wise
 /// alpha 1e-3), including sigma_samp below the maximum extinction (not a majorant) and control
-/// variates with negative difference extinction; the coarse ray-marching control is flagged.
+/// variates (piecewise-linear and constant main parts) with negative difference extinction; the
+/// coarse ray-marching control is flagged.
 #[test]
 fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
     let eq21 = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 8.0)).unwrap();
@@ -54,6 +55,9 @@ fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
         (&eq21, "single_particle_terminating", s(0.9)),
         (&perlin, "residual_ratio_tracking", Params::new()),
         (&perlin, "double_particle", s(0.3).with("control", 1.0)),
+        (&eq21, "double_particle", s(0.4).with("control", 2.0)),
+        (&perlin, "residual_ratio_tracking", Params::new().with("control", 2.0)),
+        (&eq21, "single_particle_nonterminating", Params::new().with("sigma_samp_ratio", 0.25)),
     ];
     for (k, (bed, id, p)) in cases.into_iter().enumerate() {
         let est = build(id, p.clone());
@@ -71,10 +75,31 @@ fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
 #[test]
 fn invalid_terminating_configurations_are_refused() {
     let bed = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 4.0)).unwrap();
-    for id in ["single_particle_terminating", "delta_tracking"] {
-        let err = build(id, Params::new().with("sigma_samp", 0.4)).validate(&bed).unwrap_err().to_string();
-        assert!(err.contains(&format!("{id}.sigma_samp")), "{err}");
+    let err = build("single_particle_terminating", Params::new().with("sigma_samp", 0.4))
+        .validate(&bed)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("single_particle_terminating.sigma_samp"), "{err}");
+    // Delta and ratio tracking need a majorant: a smaller density is a skipped pair with the
+    // reason naming the field (absolute or relative to the declared majorant 1); at the majorant
+    // (ratio 1) and above they run.
+    for id in ["delta_tracking", "ratio_tracking"] {
+        for (name, v) in [("sigma_samp", 0.4), ("sigma_samp_ratio", 0.75)] {
+            let err = build(id, Params::new().with(name, v)).supports(&bed).unwrap_err();
+            assert!(err.contains(&format!("{id}.{name} = {v}")) && err.contains("majorant"), "{err}");
+        }
+        for v in [1.0, 8.0] {
+            assert!(build(id, Params::new().with("sigma_samp_ratio", v)).supports(&bed).is_ok());
+        }
+        let both = Params::new().with("sigma_samp", 1.0).with("sigma_samp_ratio", 1.0);
+        assert!((registry::estimator(id).unwrap().build)(&both).err().unwrap().to_string().contains("not both"));
     }
+    for bad in [("control", 3.0), ("control", 0.5), ("sigma_samp_ratio", -1.0)] {
+        let err = (registry::estimator("double_particle").unwrap().build)(&Params::new().with(bad.0, bad.1));
+        assert!(err.err().unwrap().to_string().contains(&format!("double_particle.{}", bad.0)));
+    }
+    let err = (registry::estimator("residual_ratio_tracking").unwrap().build)(&Params::new().with("control", 0.0));
+    assert!(err.err().unwrap().to_string().contains("residual_ratio_tracking.control"));
     let multiple =
         MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("resolution", 4.0)).unwrap();
     let err =
@@ -154,4 +179,47 @@ fn stability_cases_are_finite() {
         .estimate(&task, &mut stream(5, "w"))
         .unwrap()
         .is_finite());
+}
+
+/// Each tracker's `sample_moments` (paper 002 Eq. 16-20 and higher moments, exact) against the
+/// sample mean and variance of 20000 one-ray estimates on `canonical-1d` (a hole: negative
+/// difference extinction under both control variates, minorant densities): within 5 standard
+/// errors, the variance's error bar from the predicted fourth moment. Ray marching's exact moments
+/// show its bias.
+#[test]
+fn sample_moments_match_one_ray_estimates() {
+    use crate::testbeds::canonical_1d::Canonical1d;
+    let bed = Canonical1d::new("hole-T0.1", &Params::new()).unwrap();
+    let r = |v: f64| Params::new().with("sigma_samp_ratio", v);
+    let cases = [
+        ("delta_tracking", r(1.5)),
+        ("ratio_tracking", r(1.0)),
+        ("double_particle", r(0.5).with("control", 2.0)),
+        ("double_particle", r(2.0).with("control", 1.0)),
+        ("single_particle_nonterminating", r(0.75)),
+        ("single_particle_terminating", r(1.0)),
+        ("ray_marching", Params::new()),
+    ];
+    let n = 20_000;
+    for (k, (id, p)) in cases.into_iter().enumerate() {
+        let est = build(id, p.clone());
+        let budget = Budget::samples(1).unwrap();
+        let m = est.sample_moments(&Task::new(&bed, 0, budget)).unwrap_or_else(|| panic!("{id}: no moments"));
+        let mut rng = stream(k as u64, "sample moments");
+        let mut s = Moments::default();
+        for _ in 0..n {
+            s.push(est.estimate(&Task::new(&bed, 0, budget), &mut rng).unwrap()[0]);
+        }
+        let (mean_se, var_sd) = ((m.variance() / n as f64).sqrt(), m.sample_variance_sd(n as f64));
+        assert!((s.mean() - m.mean).abs() < 5.0 * mean_se, "{id} {p:?}: mean {} vs {}", s.mean(), m.mean);
+        assert!((s.variance() - m.variance()).abs() < 5.0 * var_sd, "{id} {p:?}: {} vs {}", s.variance(), m.variance());
+    }
+    let marching =
+        build("ray_marching", Params::new()).sample_moments(&Task::new(&bed, 0, Budget::samples(1).unwrap()));
+    assert!(marching.unwrap().mean > 0.1 * (1.0 + 1e-3), "ray marching's exact mean shows its bias");
+    let radiance =
+        MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("resolution", 4.0)).unwrap();
+    assert!(build("delta_tracking", Params::new())
+        .sample_moments(&Task::new(&radiance, 0, Budget::samples(1).unwrap()))
+        .is_none());
 }

@@ -5,6 +5,7 @@
 //! Text uses the DejaVu Sans font bundled in `assets/fonts` (no system fonts are needed).
 
 mod draw;
+pub(crate) mod heatmap;
 pub(crate) mod maps;
 #[cfg(test)]
 pub(crate) mod tests;
@@ -108,7 +109,7 @@ fn ensure_font(dir: &Path) -> Result<()> {
 }
 
 /// Draws every plot of `report` into `dir` (created if needed) and returns the files written
-/// (an SVG and a PNG per plot; plots without a single drawable point are left out).
+/// (an SVG and a PNG per plot; plots in which no series has two drawable points are left out).
 pub fn write_plots(report: &RunReport, dir: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
     if report.rows.is_empty() {
@@ -132,7 +133,9 @@ pub fn write_plots(report: &RunReport, dir: &Path) -> Result<Vec<PathBuf>> {
             report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
         for kind in PlotKind::ALL {
             let fig = figure(report, testbed, variant, &rows, &estimators, kind);
-            if fig.series.iter().all(|s| s.points.is_empty()) {
+            // A log-log plot against the budget needs two budgets: a single-budget sweep (e.g.
+            // canonical-sweep, which draws heat maps instead) gets no line plots.
+            if fig.series.iter().all(|s| s.points.len() < 2) {
                 continue;
             }
             let mut stem = plot_stem(testbed, variant, kind);
@@ -225,12 +228,17 @@ fn write_svg(path: &Path, fig: &Figure) -> Result<()> {
 }
 
 fn write_png(path: &Path, fig: &Figure) -> Result<()> {
+    write_png_with(path, |tmp| draw::png(tmp, fig))
+}
+
+/// Writes a PNG atomically: `draw` renders to a temporary path (ending in `.png`, since the
+/// bitmap encoder picks the format from the extension), which is then renamed to `path`.
+pub(crate) fn write_png_with(path: &Path, draw: impl FnOnce(&Path) -> std::result::Result<(), String>) -> Result<()> {
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("plot.png");
     let n = TMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-    // The bitmap encoder picks the format from the extension, so the temp name ends in `.png`.
     let tmp = dir.join(format!(".{name}.tmp-{}-{n}.png", std::process::id()));
-    let result = draw::png(&tmp, fig).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
+    let result = draw(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| e.to_string()));
     result.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         HarnessError::write(path, e)

@@ -142,15 +142,21 @@ fn empty_and_degenerate_reports_do_not_panic() {
     report.rows.clear();
     assert!(write_plots(&report, dir.path()).unwrap().is_empty());
 
+    // Single-point series only (a single-budget sweep): no plot against the budget is drawn.
     let mut report = synthetic_report();
-    report.rows.truncate(1); // a series with a single point
+    report.rows.truncate(2);
+    assert!(write_plots(&report, dir.path()).unwrap().is_empty());
+
+    let mut report = synthetic_report();
+    report.rows.truncate(3); // is0_cv0 at 4 and 16 spp, is1_cv2 at 4 spp only
     report.rows.push(row("nan_estimator", 4, f64::NAN, f64::NAN));
     report.rows.push(row("zero_estimator", 4, 0.0, 0.0));
     report.rows[0].efficiency = None;
     report.rows.push(row("inf", 8, f64::INFINITY, -1.0));
     report.fits[0].slope = f64::NAN;
     let files = write_plots(&report, dir.path()).unwrap();
-    // RMSE and RMSE-vs-time have one point; efficiency has none (None, NaN, zero, negative).
+    // RMSE and RMSE-vs-time have a two-point series beside single points and undrawable values
+    // (NaN, zero, infinite, negative); efficiency has at most one point per series.
     assert_eq!(files.len(), 4, "{files:?}");
 }
 

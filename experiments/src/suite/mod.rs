@@ -1,6 +1,14 @@
 //! The named experiments (SPEC §7): each builds a sweep for quick or full mode and states the
 //! paper's claims, which are judged against what the run measured.
 
+pub mod canonical_cells;
+pub mod canonical_sweep;
+pub mod canonical_sweep_claims;
+pub mod canonical_sweep_plots;
+pub mod canonical_sweep_post;
+#[cfg(test)]
+mod canonical_tests;
+pub mod canonical_winners;
 pub mod claims;
 pub mod envmap_smc;
 pub mod envmap_smc_post;
@@ -61,6 +69,7 @@ pub static EXPERIMENTS: &[&ExperimentDef] = &[
     &pmc_ip::DEF,
     &envmap_smc::DEF,
     &single_scatter::DEF,
+    &canonical_sweep::DEF,
 ];
 
 /// Looks an experiment up by name.
