@@ -255,6 +255,9 @@ impl Estimator for SingleScatterOr {
             self.other.validate(bed)
         }
     }
+    fn sample_moments(&self, task: &Task<'_>) -> Option<crate::media::moments::EstimateMoments> {
+        self.pick(task).sample_moments(task)
+    }
 }
 
 #[cfg(test)]
