@@ -60,27 +60,6 @@ pub fn post(
             ),
         });
     }
-    for b in &plan.beds {
-        let r = b.bed.reference();
-        if r.is_exact() {
-            continue;
-        }
-        let n = (r.std_err.len() * 3).max(1) as f64;
-        let ref_rms = (r.std_err.iter().flat_map(|s| s.0).map(|x| x * x).sum::<f64>() / n).sqrt();
-        let min_rmse = report
-            .rows
-            .iter()
-            .filter(|row| row.variant == b.variant && row.budget == last)
-            .map(|row| row.rmse)
-            .fold(f64::INFINITY, f64::min);
-        report.paper.push(Claim {
-            testbed: b.label(),
-            claim: "SPEC §2 / issue 4: every measured RMSE at the largest budget is >= 3x the stored reference's RMS standard error".into(),
-            paper_value: Some(3.0),
-            our_value: Some(min_rmse / ref_rms),
-            held: Some(min_rmse >= 3.0 * ref_rms),
-            note: format!("smallest RMSE {min_rmse:.3e} at {last} spp, reference RMS standard error {ref_rms:.3e} (its variance is subtracted from every MSE)"),
-        });
-    }
+    report.paper.extend(super::claims::reference_precision(plan, report));
     Ok(Vec::new())
 }
