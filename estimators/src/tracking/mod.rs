@@ -167,7 +167,7 @@ pub fn ray_moments(
     let probe = task.medium()?;
     let MediumQuantity::Transmittance { weight } = probe.ray().quantity else { return None };
     let Some(seg) = segment(&probe) else {
-        return Some(EstimateMoments { mean: weight[0], rel_variance: 0.0, rel_central4: 0.0 });
+        return Some(EstimateMoments::constant(weight[0]));
     };
     let main = control.map(|(kind, spacing)| main_part(&probe, seg, spacing, kind));
     let ray = *probe.ray();

@@ -92,7 +92,7 @@ impl Estimator for RayMarching {
         let probe = task.medium()?;
         let MediumQuantity::Transmittance { weight } = probe.ray().quantity else { return None };
         let Some((t0, t1)) = segment(&probe) else {
-            return Some(EstimateMoments { mean: weight[0], rel_variance: 0.0, rel_central4: 0.0 });
+            return Some(EstimateMoments::constant(weight[0]));
         };
         let n = self.steps(task.budget(), t1 - t0) as usize;
         let ray = *probe.ray();

@@ -29,11 +29,12 @@ pub const AGREEMENT_ALPHA: f64 = 1e-3;
 /// How the measured variance of a cell compares with the prediction.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Agreement {
-    /// Within `z_crit` error bars.
+    /// Within `z_crit` error bars (the interval shifted by the sample variance's skewness).
     Agrees,
     /// Outside.
     Disagrees,
-    /// The error bar exceeds [`RESOLVED_REL_SD`] of the prediction (heavy tails at this many
+    /// The error bar exceeds [`RESOLVED_REL_SD`] of the prediction, or the Cornish-Fisher shift
+    /// of the acceptance interval exceeds half the critical value (heavy tails at this many
     /// repetitions): compared, but not judged.
     Unresolved,
     /// Predicted zero variance, and the measured one is rounding noise.
@@ -149,9 +150,19 @@ impl CellRow {
                 Agreement::Disagrees
             };
         }
+        // The sample variance of skewed estimates is itself skewed (a chi-square for normal
+        // ones), so the acceptance interval is the Cornish-Fisher one: both ends shift by
+        // g (z^2 - 1) / 6 for the predicted skewness g of the sample variance; where that shift
+        // exceeds half the critical value the expansion is not trusted and the cell is unresolved.
+        let shift = if z_crit.is_finite() {
+            p.sample_variance_skewness(m.reps as f64) * (z_crit * z_crit - 1.0) / 6.0
+        } else {
+            0.0
+        };
         match (self.rel_sd(), self.z()) {
             (Some(rel), _) if rel > RESOLVED_REL_SD => Agreement::Unresolved,
-            (_, Some(z)) if z.abs() <= z_crit => Agreement::Agrees,
+            _ if !(shift.abs() <= 0.5 * z_crit) => Agreement::Unresolved,
+            (_, Some(z)) if (z - shift).abs() <= z_crit => Agreement::Agrees,
             _ => Agreement::Disagrees,
         }
     }

@@ -36,7 +36,13 @@ fn row(key: &str, ratio: f64, variance: f64, predicted: EstimateMoments) -> Cell
 
 /// Normal-like moments: relative variance `v`, fourth central moment `3 v^2`.
 fn normal(v: f64) -> EstimateMoments {
-    EstimateMoments { mean: 0.5, rel_variance: v, rel_central4: 3.0 * v * v }
+    EstimateMoments {
+        mean: 0.5,
+        rel_variance: v,
+        rel_central4: 3.0 * v * v,
+        rel_central3: 0.0,
+        rel_central6: 15.0 * v * v * v,
+    }
 }
 
 #[test]
@@ -57,6 +63,24 @@ fn agreement_verdicts_follow_the_error_bar() {
         CellRow { predicted: None, ..row("double", 1.0, v, normal(0.04)) }.agreement(5.0),
         Agreement::NotPredicted
     );
+}
+
+/// Skewed estimates (the mean of 32 exponential rays) have a right-skewed sample variance: the
+/// acceptance interval shifts right by the Cornish-Fisher term g (z^2 - 1) / 6, so a high measured
+/// variance that a normal error bar would reject agrees, and a low one is judged more strictly.
+#[test]
+fn the_acceptance_interval_follows_the_skew_of_the_sample_variance() {
+    let exp =
+        EstimateMoments { mean: 0.5, rel_variance: 1.0, rel_central3: 2.0, rel_central4: 9.0, rel_central6: 265.0 };
+    let p = exp.mean_of(32.0);
+    let (zc, reps) = (5.0, 400.0);
+    let shift = p.sample_variance_skewness(reps) * (zc * zc - 1.0) / 6.0;
+    assert!(shift > 0.5 && shift < 0.5 * zc, "{shift}");
+    let sd = p.sample_variance_sd(reps);
+    let at = |z: f64| row("double", 1.0, p.variance() + z * sd, p).agreement(zc);
+    assert_eq!(at(zc + 0.5 * shift), Agreement::Agrees);
+    assert_eq!(at(-zc + 0.5 * shift), Agreement::Disagrees);
+    assert_eq!(at(zc + 1.5 * shift), Agreement::Disagrees);
 }
 
 #[test]
