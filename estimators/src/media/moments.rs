@@ -299,7 +299,7 @@ mod tests {
             rel_central6: 15.0 * v.powi(3),
         };
         for reps in [16.0, 400.0] {
-            assert!(close(normal.sample_variance_skewness(reps), (8.0 / reps as f64).sqrt()));
+            assert!(close(normal.sample_variance_skewness(reps), (8.0 / reps).sqrt()));
         }
         // Heavy tails skew the sample variance far more: exponential estimates at 400 repetitions.
         assert!(exp.sample_variance_skewness(400.0) > 3.0 * normal.sample_variance_skewness(400.0));

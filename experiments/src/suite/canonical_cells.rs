@@ -161,7 +161,7 @@ impl CellRow {
         };
         match (self.rel_sd(), self.z()) {
             (Some(rel), _) if rel > RESOLVED_REL_SD => Agreement::Unresolved,
-            _ if !(shift.abs() <= 0.5 * z_crit) => Agreement::Unresolved,
+            _ if shift.is_nan() || shift.abs() > 0.5 * z_crit => Agreement::Unresolved,
             (_, Some(z)) if (z - shift).abs() <= z_crit => Agreement::Agrees,
             _ => Agreement::Disagrees,
         }
