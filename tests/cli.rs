@@ -104,3 +104,74 @@ fn reference_command_stores_the_exact_reference() {
     assert!(dir.path().join("results/references/gradient-plane_stiff.json").is_file());
     assert!(String::from_utf8_lossy(&o.stdout).contains("error bound"));
 }
+
+/// summary.csv with the wall-clock columns removed.
+fn without_timing(path: &Path) -> String {
+    let mut rd = csv::Reader::from_path(path).expect("summary.csv readable");
+    let header = rd.headers().expect("header").clone();
+    let timing = experiments::metrics::TIMING_COLUMNS;
+    let keep: Vec<usize> = (0..header.len()).filter(|&i| !timing.contains(&&header[i])).collect();
+    let mut out = keep.iter().map(|&i| header[i].to_string()).collect::<Vec<_>>().join(",");
+    for rec in rd.records() {
+        let rec = rec.expect("record");
+        out.push('\n');
+        out.push_str(&keep.iter().map(|&i| rec[i].to_string()).collect::<Vec<_>>().join(","));
+    }
+    out
+}
+
+/// SPEC §8 / issue 9 item 5: a run killed (SIGKILL) mid-way and run again with the same seed reuses
+/// the cells it had finished, leaves no corrupt file, and ends with the same summary as a run that
+/// was never interrupted (timing columns aside).
+#[test]
+fn a_killed_run_resumes_to_the_same_results() {
+    const SLOW: &str = "name = 'slow'\nreps = 4\nbudgets = [4, 16, 64, 256, 1024, 4096, 16384]\n[[testbeds]]\nid = 'gradient-plane'\nparams = { resolution = 12 }\n[[estimators]]\nid = 'is0_cv0'\n[[estimators]]\nid = 'is1_cv2'\n[[estimators]]\nid = 'clamped_is0_cv0'\n";
+    let (killed, clean) = (tempfile::tempdir().expect("tempdir"), tempfile::tempdir().expect("tempdir"));
+    for d in [killed.path(), clean.path()] {
+        std::fs::write(d.join("slow.toml"), SLOW).expect("write config");
+    }
+    let args = ["run", "--config", "slow.toml", "--threads", "2"];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mcbench"))
+        .current_dir(killed.path())
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("starts");
+    let cells = killed.path().join("results/slow/cells");
+    let count = || {
+        std::fs::read_dir(&cells)
+            .map(|d| d.filter_map(|e| e.ok()).filter(|e| e.path().extension().is_some_and(|x| x == "json")).count())
+            .unwrap_or(0)
+    };
+    let start = std::time::Instant::now();
+    while count() < 3 && start.elapsed() < std::time::Duration::from_secs(120) {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let still_running = child.try_wait().expect("status").is_none();
+    child.kill().expect("SIGKILL");
+    child.wait().expect("reaped");
+    assert!(still_running, "the run finished before it could be killed: make the sweep slower");
+    let stored = count();
+    assert!((3..21).contains(&stored), "{stored} cells stored when killed");
+    // Every stored cell is a whole JSON document (writes are atomic: temp file + rename).
+    for e in std::fs::read_dir(&cells).expect("cells") {
+        let p = e.expect("entry").path();
+        if p.extension().is_some_and(|x| x == "json") {
+            let text = std::fs::read_to_string(&p).expect("read");
+            serde_json::from_str::<serde_json::Value>(&text).unwrap_or_else(|err| panic!("{p:?} corrupt: {err}"));
+        }
+    }
+    let resumed = mcbench(killed.path(), &args);
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
+    let log = String::from_utf8_lossy(&resumed.stdout).to_string() + &stderr(&resumed);
+    assert_eq!(log.matches("(resumed)").count(), stored, "{log}");
+    let uninterrupted = mcbench(clean.path(), &args);
+    assert!(uninterrupted.status.success(), "{}", stderr(&uninterrupted));
+    let (a, b) = (killed.path().join("results/slow"), clean.path().join("results/slow"));
+    assert_eq!(without_timing(&a.join("summary.csv")), without_timing(&b.join("summary.csv")));
+    assert_eq!(
+        std::fs::read_to_string(a.join("integrals.csv")).expect("integrals"),
+        std::fs::read_to_string(b.join("integrals.csv")).expect("integrals")
+    );
+}
