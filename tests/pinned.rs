@@ -1,0 +1,92 @@
+//! Value stability (issue 9 item 6): the first estimate of every registered estimator, on the
+//! first of a list of small test beds it supports, for a fixed seed, pinned bit for bit in
+//! `tests/pinned_estimates.json`. An accidental change to an estimator, a sampler, a test bed or
+//! the random streams fails here; an intended one is re-pinned with
+//! `MCBENCH_REPIN=1 cargo test -p experiments --test pinned` (and the diff reviewed).
+
+use estimators::budget::Budget;
+use estimators::params::Params;
+use estimators::registry::{self, ESTIMATORS};
+use estimators::rng::StreamKey;
+use estimators::task::Task;
+use estimators::testbed::TestBed;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Small test beds, tried in order: (id, variant, params).
+fn beds() -> Vec<(&'static str, &'static str, Params)> {
+    vec![
+        ("gradient-plane", "default", Params::new().with("resolution", 2.0)),
+        ("checker-direct", "default", Params::new().with("resolution", 2.0)),
+        ("eq21-medium", "central-ray", Params::new().with("points", 4.0)),
+        ("eq21-medium", "single-scatter", Params::new().with("resolution", 2.0)),
+        ("eq21-medium", "multiple", Params::new()),
+        ("gradient-box", "albedo-0.8", Params::new()),
+        ("envmap-sequence", "mixed", Params::new().with("resolution", 2.0).with("frames", 2.0)),
+        ("checker-image", "default", Params::new()),
+    ]
+}
+
+/// `estimator -> "bed/variant: bits of the three channels"` for every registered estimator.
+fn first_estimates() -> BTreeMap<String, String> {
+    let built: Vec<(String, Box<dyn TestBed>)> = beds()
+        .into_iter()
+        .map(|(id, v, p)| {
+            let entry = registry::testbed(id).expect("registered test bed");
+            (format!("{id}/{v}"), (entry.build)(v, &p).expect("builds"))
+        })
+        .collect();
+    let mut out = BTreeMap::new();
+    for entry in ESTIMATORS {
+        let est = (entry.build)(&Params::new()).expect("default parameters build");
+        let runs = |b: &dyn TestBed| b.provides().contains(entry.needs) && est.supports(b).is_ok();
+        let Some((label, bed)) = built.iter().find(|(_, b)| runs(b.as_ref())) else {
+            out.insert(entry.id.to_string(), "no small test bed supports it".to_string());
+            continue;
+        };
+        // The centre integral (corner pixels may miss the medium and be exact), estimated with the
+        // sequence that holds it.
+        let frames = bed.sequence_length().max(1);
+        let (w, h) = bed.resolution();
+        let mid = ((h / 2) * w + w / 2).min(bed.integrals() - 1);
+        let first = mid / frames * frames;
+        let budget = Budget::samples(32).expect("budget");
+        let tasks: Vec<Task<'_>> = (first..first + frames).map(|i| Task::new(bed.as_ref(), i, budget)).collect();
+        let key = StreamKey { seed: 7, testbed: label, estimator: entry.id, budget: 32, rep: 0, integral: first as u64 };
+        let value = match est.estimate_sequence(&tasks, &mut key.rng()) {
+            Ok(v) => v[mid - first].0.iter().map(|x| format!("{:016x}", x.to_bits())).collect::<Vec<_>>().join(" "),
+            Err(e) => format!("error: {e}"),
+        };
+        out.insert(entry.id.to_string(), format!("{label}: {value}"));
+    }
+    out
+}
+
+#[test]
+fn first_estimates_are_pinned() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/pinned_estimates.json");
+    let now = first_estimates();
+    if std::env::var_os("MCBENCH_REPIN").is_some() {
+        let text = serde_json::to_string_pretty(&now).expect("json");
+        std::fs::write(&path, text + "\n").expect("write the pins");
+        return;
+    }
+    let text = std::fs::read_to_string(&path).expect("tests/pinned_estimates.json (make it with MCBENCH_REPIN=1)");
+    let pinned: BTreeMap<String, String> = serde_json::from_str(&text).expect("pins parse");
+    let mut diffs = Vec::new();
+    for (id, value) in &now {
+        match pinned.get(id) {
+            Some(p) if p == value => {}
+            Some(p) => diffs.push(format!("{id}: pinned {p}, now {value}")),
+            None => diffs.push(format!("{id}: not pinned yet (now {value})")),
+        }
+    }
+    for id in pinned.keys().filter(|id| !now.contains_key(*id)) {
+        diffs.push(format!("{id}: pinned but no longer registered"));
+    }
+    assert!(
+        diffs.is_empty(),
+        "first estimates changed (re-pin with MCBENCH_REPIN=1 if intended):\n{}",
+        diffs.join("\n")
+    );
+}
