@@ -83,18 +83,36 @@ fn writes_the_contract_files_with_the_contract_columns() {
 
 #[test]
 fn same_seed_same_results_whatever_the_thread_count() {
-    let a = tempfile::tempdir().expect("tempdir");
-    let b = tempfile::tempdir().expect("tempdir");
-    run_into(a.path(), sweep(&["is0_cv0", "brdf_is0_cv0"], 3), 1, false);
-    run_into(b.path(), sweep(&["is0_cv0", "brdf_is0_cv0"], 3), 2, false);
-    let (x, y) = (
-        deterministic_csv(&a.path().join("results/itest/summary.csv")),
-        deterministic_csv(&b.path().join("results/itest/summary.csv")),
-    );
-    assert_eq!(x, y);
-    let ia = std::fs::read(a.path().join("results/itest/integrals.csv")).expect("read");
-    let ib = std::fs::read(b.path().join("results/itest/integrals.csv")).expect("read");
-    assert_eq!(ia, ib);
+    // Adaptive estimators (caches, SMC) and a fetch budget (pilot calibration) too, at 1, 2 and 4
+    // threads.
+    let ids = ["is0_cv0", "brdf_is0_cv0", "is1_cv2"];
+    let runs: Vec<(String, Vec<u8>)> = [1, 2, 4]
+        .into_iter()
+        .map(|threads| {
+            let d = tempfile::tempdir().expect("tempdir");
+            run_into(d.path(), sweep(&ids, 3), threads, false);
+            let mut media = sweep(&["delta_tracking", "residual_ratio_tracking"], 3);
+            media.experiment = "itest-media".into();
+            media.testbeds = vec![TestBedSpec {
+                id: "eq21-medium".into(),
+                variant: Some("transmittance".into()),
+                params: Params::new().with("resolution", 4.0),
+            }];
+            media.budgets =
+                vec![estimators::budget::Budget { kind: estimators::budget::BudgetKind::Fetches, amount: 30 }];
+            media.baseline = None;
+            run_into(d.path(), media, threads, false);
+            let mut csv = deterministic_csv(&d.path().join("results/itest/summary.csv"));
+            csv.push_str(&deterministic_csv(&d.path().join("results/itest-media/summary.csv")));
+            let mut integrals = std::fs::read(d.path().join("results/itest/integrals.csv")).expect("read");
+            integrals.extend(std::fs::read(d.path().join("results/itest-media/integrals.csv")).expect("read"));
+            (csv, integrals)
+        })
+        .collect();
+    for (threads, run) in [2, 4].iter().zip(&runs[1..]) {
+        assert_eq!(run.0, runs[0].0, "summary.csv differs at {threads} threads");
+        assert!(run.1 == runs[0].1, "integrals.csv differs at {threads} threads");
+    }
 }
 
 #[test]

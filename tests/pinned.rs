@@ -52,7 +52,8 @@ fn first_estimates() -> BTreeMap<String, String> {
         let first = mid / frames * frames;
         let budget = Budget::samples(32).expect("budget");
         let tasks: Vec<Task<'_>> = (first..first + frames).map(|i| Task::new(bed.as_ref(), i, budget)).collect();
-        let key = StreamKey { seed: 7, testbed: label, estimator: entry.id, budget: 32, rep: 0, integral: first as u64 };
+        let key =
+            StreamKey { seed: 7, testbed: label, estimator: entry.id, budget: 32, rep: 0, integral: first as u64 };
         let value = match est.estimate_sequence(&tasks, &mut key.rng()) {
             Ok(v) => v[mid - first].0.iter().map(|x| format!("{:016x}", x.to_bits())).collect::<Vec<_>>().join(" "),
             Err(e) => format!("error: {e}"),
