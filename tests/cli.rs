@@ -2,6 +2,9 @@
 //! field, no files written on bad input, and a small custom sweep end to end.
 
 use std::path::Path;
+
+mod common;
+use common::deterministic_csv;
 use std::process::{Command, Output};
 
 fn mcbench(dir: &Path, args: &[&str]) -> Output {
@@ -105,21 +108,6 @@ fn reference_command_stores_the_exact_reference() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("error bound"));
 }
 
-/// summary.csv with the wall-clock columns removed.
-fn without_timing(path: &Path) -> String {
-    let mut rd = csv::Reader::from_path(path).expect("summary.csv readable");
-    let header = rd.headers().expect("header").clone();
-    let timing = experiments::metrics::TIMING_COLUMNS;
-    let keep: Vec<usize> = (0..header.len()).filter(|&i| !timing.contains(&&header[i])).collect();
-    let mut out = keep.iter().map(|&i| header[i].to_string()).collect::<Vec<_>>().join(",");
-    for rec in rd.records() {
-        let rec = rec.expect("record");
-        out.push('\n');
-        out.push_str(&keep.iter().map(|&i| rec[i].to_string()).collect::<Vec<_>>().join(","));
-    }
-    out
-}
-
 /// SPEC §8 / issue 9 item 5: a run killed (SIGKILL) mid-way and run again with the same seed reuses
 /// the cells it had finished, leaves no corrupt file, and ends with the same summary as a run that
 /// was never interrupted (timing columns aside).
@@ -169,7 +157,7 @@ fn a_killed_run_resumes_to_the_same_results() {
     let uninterrupted = mcbench(clean.path(), &args);
     assert!(uninterrupted.status.success(), "{}", stderr(&uninterrupted));
     let (a, b) = (killed.path().join("results/slow"), clean.path().join("results/slow"));
-    assert_eq!(without_timing(&a.join("summary.csv")), without_timing(&b.join("summary.csv")));
+    assert_eq!(deterministic_csv(&a.join("summary.csv")), deterministic_csv(&b.join("summary.csv")));
     assert_eq!(
         std::fs::read_to_string(a.join("integrals.csv")).expect("integrals"),
         std::fs::read_to_string(b.join("integrals.csv")).expect("integrals")

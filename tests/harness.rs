@@ -5,9 +5,11 @@
 use estimators::params::Params;
 use experiments::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use experiments::execute::{execute, prepare, ExecOptions};
-use experiments::metrics::TIMING_COLUMNS;
 use experiments::runner::Silent;
 use std::path::Path;
+
+mod common;
+use common::deterministic_csv;
 
 fn sweep(ids: &[&str], reps: usize) -> Sweep {
     Sweep {
@@ -36,20 +38,6 @@ fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> experiment
         plots,
     };
     execute(&plan, None, &opts).expect("run succeeds")
-}
-
-/// summary.csv with the wall-clock columns removed.
-fn deterministic_csv(path: &Path) -> String {
-    let mut rd = csv::Reader::from_path(path).expect("summary.csv readable");
-    let header = rd.headers().expect("header").clone();
-    let keep: Vec<usize> = (0..header.len()).filter(|&i| !TIMING_COLUMNS.contains(&&header[i])).collect();
-    let mut out = keep.iter().map(|&i| header[i].to_string()).collect::<Vec<_>>().join(",");
-    for rec in rd.records() {
-        let rec = rec.expect("record");
-        out.push('\n');
-        out.push_str(&keep.iter().map(|&i| rec[i].to_string()).collect::<Vec<_>>().join(","));
-    }
-    out
 }
 
 #[test]
