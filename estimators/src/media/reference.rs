@@ -145,31 +145,18 @@ fn with_clamp_kinks(breaks: &[f64], u: impl Fn(f64) -> f64) -> Vec<f64> {
 /// parallel over integrals; the bound is `weight T |d tau|` (first order) per integral.
 pub fn transmittance_reference(bed: &MediumBed) -> Reference {
     let n = bed.integrals();
-    let threads = std::thread::available_parallelism().map(|t| t.get()).unwrap_or(1).min(n.max(1));
-    let chunk = n.div_ceil(threads.max(1));
-    let results: Vec<(Rgb, f64)> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads)
-            .map(|k| {
-                s.spawn(move || {
-                    (k * chunk..((k + 1) * chunk).min(n))
-                        .map(|i| {
-                            let r = crate::testbed::MediumScene::ray(bed, i);
-                            let MediumQuantity::Transmittance { weight } = r.quantity else { return (Rgb::ZERO, 0.0) };
-                            let (tau, err) = match clip_sphere(r.origin, r.dir) {
-                                None => (0.0, 0.0),
-                                Some((t0, t1)) => {
-                                    let q = optical_depth(bed, r.origin, r.dir, t0, t1.min(r.length));
-                                    (q.value, q.error)
-                                }
-                            };
-                            let t = (-tau).exp();
-                            (weight * t, weight.0.iter().fold(0.0f64, |m, w| m.max(w.abs())) * t * err)
-                        })
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        handles.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+    let results = crate::parallel::map_indices(n, 0, |i| {
+        let r = crate::testbed::MediumScene::ray(bed, i);
+        let MediumQuantity::Transmittance { weight } = r.quantity else { return (Rgb::ZERO, 0.0) };
+        let (tau, err) = match clip_sphere(r.origin, r.dir) {
+            None => (0.0, 0.0),
+            Some((t0, t1)) => {
+                let q = optical_depth(bed, r.origin, r.dir, t0, t1.min(r.length));
+                (q.value, q.error)
+            }
+        };
+        let t = (-tau).exp();
+        (weight * t, weight.0.iter().fold(0.0f64, |m, w| m.max(w.abs())) * t * err)
     });
     let bound = results.iter().fold(0.0f64, |m, r| m.max(r.1));
     let method = format!("optical depth by adaptive Gauss-Kronrod (absolute tolerance {TAU_TOL:e}), T = exp(-tau)");
@@ -241,50 +228,32 @@ pub fn compute_stored(
     let bed = MediumBed::without_reference(field, variant, &Params::new().with("resolution", res as f64))?;
     let tracker = crate::tracking::delta_tracking::DeltaTracking { sigma_samp: crate::tracking::SigmaSamp::Majorant };
     let n = bed.integrals();
-    let threads = threads.max(1).min(n);
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut out: Vec<(usize, Rgb, Rgb)> = std::thread::scope(|s| {
-        let hs: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        if i >= n {
-                            break mine;
-                        }
-                        let key = StreamKey {
-                            seed: 20_170_001,
-                            testbed: field.id(),
-                            estimator: "reference",
-                            budget: samples,
-                            rep: 0,
-                            integral: i as u64,
-                        };
-                        let mut rng = key.rng();
-                        let mut m = [Moments::default(), Moments::default(), Moments::default()];
-                        for _ in 0..samples {
-                            let task =
-                                Task::new(&bed, i, Budget { kind: crate::budget::BudgetKind::Samples, amount: 1 });
-                            let v = tracker.estimate(&task, &mut rng).unwrap_or(Rgb::splat(f64::NAN));
-                            (0..3).for_each(|c| m[c].push(v[c]));
-                        }
-                        mine.push((i, Rgb(m.each_ref().map(|x| x.mean())), Rgb(m.each_ref().map(|x| x.std_err()))));
-                    }
-                })
-            })
-            .collect();
-        hs.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+    let out = crate::parallel::map_indices(n, threads, |i| {
+        let key = StreamKey {
+            seed: 20_170_001,
+            testbed: field.id(),
+            estimator: "reference",
+            budget: samples,
+            rep: 0,
+            integral: i as u64,
+        };
+        let mut rng = key.rng();
+        let mut m = [Moments::default(), Moments::default(), Moments::default()];
+        for _ in 0..samples {
+            let task = Task::new(&bed, i, Budget { kind: crate::budget::BudgetKind::Samples, amount: 1 });
+            let v = tracker.estimate(&task, &mut rng).unwrap_or(Rgb::splat(f64::NAN));
+            (0..3).for_each(|c| m[c].push(v[c]));
+        }
+        (Rgb(m.each_ref().map(|x| x.mean())), Rgb(m.each_ref().map(|x| x.std_err())))
     });
-    out.sort_by_key(|x| x.0);
     let command = format!(
         "mcbench reference {} --variant multiple --samples {samples} (delta tracking, seed 20170001)",
         field.id()
     );
     let reference = Reference {
         kind: ReferenceKind::Stored { command, samples },
-        value: out.iter().map(|x| x.1).collect(),
-        std_err: out.iter().map(|x| x.2).collect(),
+        value: out.iter().map(|x| x.0).collect(),
+        std_err: out.iter().map(|x| x.1).collect(),
     };
     Ok((reference, (res, res)))
 }

@@ -163,34 +163,16 @@ pub fn reference(bed: &MediumBed) -> Result<Reference, ConfigError> {
 /// Computes the reference of every pixel with `s` (threads over pixels).
 pub fn compute(bed: &MediumBed, s: &Settings) -> Reference {
     let n = bed.integrals();
-    let threads = std::thread::available_parallelism().map(|t| t.get()).unwrap_or(1).min(n.max(1));
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut out: Vec<(usize, PixelQuadrature)> = std::thread::scope(|scope| {
-        let hs: Vec<_> = (0..threads)
-            .map(|_| {
-                scope.spawn(|| {
-                    let mut mine = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        if i >= n {
-                            break mine;
-                        }
-                        let ray = MediumScene::ray(bed, i);
-                        let MediumQuantity::SingleScatter { light } = ray.quantity else {
-                            mine.push((i, PixelQuadrature { value: f64::NAN, bound: f64::NAN }));
-                            continue;
-                        };
-                        mine.push((i, single_scatter(bed, &ray, &light, s)));
-                    }
-                })
-            })
-            .collect();
-        hs.into_iter().flat_map(|h| h.join().unwrap_or_default()).collect()
+    let out = crate::parallel::map_indices(n, 0, |i| {
+        let ray = MediumScene::ray(bed, i);
+        match ray.quantity {
+            MediumQuantity::SingleScatter { light } => single_scatter(bed, &ray, &light, s),
+            _ => PixelQuadrature { value: f64::NAN, bound: f64::NAN },
+        }
     });
-    out.sort_by_key(|x| x.0);
     Reference {
-        kind: ReferenceKind::Exact { method: s.method(), bound: out.iter().fold(0.0f64, |m, x| m.max(x.1.bound)) },
-        value: out.iter().map(|x| Rgb::splat(x.1.value)).collect(),
+        kind: ReferenceKind::Exact { method: s.method(), bound: out.iter().fold(0.0f64, |m, x| m.max(x.bound)) },
+        value: out.iter().map(|x| Rgb::splat(x.value)).collect(),
         std_err: vec![Rgb::ZERO; n],
     }
 }

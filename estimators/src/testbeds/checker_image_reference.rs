@@ -36,7 +36,6 @@ pub fn compute_reference(
     let bed = CheckerImage::without_reference(variant, &bed_params)?;
     let n = bed.integrals();
     let label = format!("checker-image/{variant}/reference");
-    let next = std::sync::atomic::AtomicUsize::new(0);
     let pixel = |i: usize| {
         let mut m: [Moments; 3] = Default::default();
         for batch in 0..BATCHES {
@@ -61,27 +60,7 @@ pub fn compute_reference(
         }
         (Rgb([m[0].mean(), m[1].mean(), m[2].mean()]), Rgb([m[0].std_err(), m[1].std_err(), m[2].std_err()]))
     };
-    let chunks: Vec<Vec<(usize, (Rgb, Rgb))>> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads.max(1))
-            .map(|_| {
-                s.spawn(|| {
-                    let mut out = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        if i >= n {
-                            return out;
-                        }
-                        out.push((i, pixel(i)));
-                    }
-                })
-            })
-            .collect();
-        handles.into_iter().map(|h| h.join().unwrap_or_default()).collect()
-    });
-    let mut results = vec![(Rgb([f64::NAN; 3]), Rgb::ZERO); n];
-    for (i, r) in chunks.into_iter().flatten() {
-        results[i] = r;
-    }
+    let results = crate::parallel::map_indices(n, threads, pixel);
     if results.iter().any(|(m, se)| !m.is_finite() || !se.is_finite()) {
         return Err(ConfigError::invalid("reference", variant, "a pixel's estimate was not finite"));
     }

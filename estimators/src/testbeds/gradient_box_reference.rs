@@ -47,46 +47,25 @@ pub fn compute_reference(
     let n = bed.integrals();
     let label = format!("gradient-box/{variant}/reference");
     let budget = Budget::samples(per_batch).map_err(|e| ConfigError::invalid("samples", samples, e.to_string()))?;
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let mut results = vec![(Rgb::ZERO, Rgb::ZERO); n];
-    let chunks: Vec<Vec<(usize, Rgb, Rgb)>> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads.max(1))
-            .map(|_| {
-                s.spawn(|| {
-                    let mut out = Vec::new();
-                    loop {
-                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                        if i >= n {
-                            return out;
-                        }
-                        let mut m: [Moments; 3] = Default::default();
-                        for batch in 0..BATCHES {
-                            let key = StreamKey {
-                                seed: SEED,
-                                testbed: &label,
-                                estimator: "is0_cv0",
-                                budget: per_batch,
-                                rep: batch,
-                                integral: i as u64,
-                            };
-                            let task = Task::new(&bed, i, budget);
-                            let v = PathTracer.estimate(&task, &mut key.rng()).unwrap_or(Rgb([f64::NAN; 3]));
-                            for c in 0..3 {
-                                m[c].push(v[c]);
-                            }
-                        }
-                        let mean = Rgb([m[0].mean(), m[1].mean(), m[2].mean()]);
-                        let se = Rgb([m[0].std_err(), m[1].std_err(), m[2].std_err()]);
-                        out.push((i, mean, se));
-                    }
-                })
-            })
-            .collect();
-        handles.into_iter().map(|h| h.join().unwrap_or_default()).collect()
+    let results = crate::parallel::map_indices(n, threads, |i| {
+        let mut m: [Moments; 3] = Default::default();
+        for batch in 0..BATCHES {
+            let key = StreamKey {
+                seed: SEED,
+                testbed: &label,
+                estimator: "is0_cv0",
+                budget: per_batch,
+                rep: batch,
+                integral: i as u64,
+            };
+            let task = Task::new(&bed, i, budget);
+            let v = PathTracer.estimate(&task, &mut key.rng()).unwrap_or(Rgb([f64::NAN; 3]));
+            for c in 0..3 {
+                m[c].push(v[c]);
+            }
+        }
+        (Rgb([m[0].mean(), m[1].mean(), m[2].mean()]), Rgb([m[0].std_err(), m[1].std_err(), m[2].std_err()]))
     });
-    for (i, mean, se) in chunks.into_iter().flatten() {
-        results[i] = (mean, se);
-    }
     if results.iter().any(|(m, _)| !m.is_finite()) {
         return Err(ConfigError::invalid("reference", variant, "a pixel's estimate was not finite"));
     }
