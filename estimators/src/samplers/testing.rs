@@ -95,13 +95,8 @@ pub fn sampler_chi_square(
         let d = sample(&mut rng);
         counts[grid.cell(d).unwrap_or(grid.cells())] += 1;
     }
-    let mut probs = grid.probabilities(pdf, 12);
-    let inside: f64 = probs.iter().sum();
-    probs.push((1.0 - inside).max(0.0));
-    match chi_square_gof(&counts, &probs) {
-        Ok(c) => c,
-        Err(e) => panic!("chi-square could not run: {e}"),
-    }
+    let probs = grid.probabilities(pdf, 12);
+    gof_with_outside(&counts, probs)
 }
 
 /// Asserts that `sample` follows `pdf` at the family's significance level.
@@ -113,15 +108,7 @@ pub fn assert_sampler_fits(
     sample: impl FnMut(&mut StreamRng) -> Vec3,
     pdf: impl Fn(Vec3) -> f64,
 ) {
-    let c = sampler_chi_square(grid, n, seed, sample, pdf);
-    let alpha = sampler_alpha();
-    assert!(
-        c.p_value > alpha,
-        "{name}: chi-square {} on {} dof, p = {:e} < alpha {alpha:e}",
-        c.statistic,
-        c.dof,
-        c.p_value
-    );
+    assert_fits(name, &sampler_chi_square(grid, n, seed, sample, pdf));
 }
 
 /// Draws `n` values of a one-dimensional sampler (distances along a ray) with a fixed seed, bins
@@ -144,19 +131,14 @@ pub fn interval_chi_square(
         counts[if inside { edges.partition_point(|&e| e <= t) - 1 } else { cells }] += 1;
     }
     let (x, w) = gauss_legendre(12);
-    let mut probs: Vec<f64> = edges
+    let probs: Vec<f64> = edges
         .windows(2)
         .map(|e| {
             let (c, h) = (0.5 * (e[0] + e[1]), 0.5 * (e[1] - e[0]));
             x.iter().zip(&w).map(|(xi, wi)| wi * pdf(c + h * xi)).sum::<f64>() * h
         })
         .collect();
-    let inside: f64 = probs.iter().sum();
-    probs.push((1.0 - inside).max(0.0));
-    match chi_square_gof(&counts, &probs) {
-        Ok(c) => c,
-        Err(e) => panic!("chi-square could not run: {e}"),
-    }
+    gof_with_outside(&counts, probs)
 }
 
 /// Asserts that a one-dimensional sampler follows `pdf` at the family's significance level
@@ -169,7 +151,22 @@ pub fn assert_interval_sampler_fits(
     sample: impl FnMut(&mut StreamRng) -> f64,
     pdf: impl Fn(f64) -> f64,
 ) {
-    let c = interval_chi_square(edges, n, seed, sample, pdf);
+    assert_fits(name, &interval_chi_square(edges, n, seed, sample, pdf));
+}
+
+/// The chi-square test of `counts` whose last cell holds everything outside the binned cells:
+/// its probability is what `probs` (the binned cells) leaves.
+fn gof_with_outside(counts: &[u64], mut probs: Vec<f64>) -> ChiSquare {
+    let inside: f64 = probs.iter().sum();
+    probs.push((1.0 - inside).max(0.0));
+    match chi_square_gof(counts, &probs) {
+        Ok(c) => c,
+        Err(e) => panic!("chi-square could not run: {e}"),
+    }
+}
+
+/// Asserts a sampler's chi-square passes at the family's significance level.
+fn assert_fits(name: &str, c: &ChiSquare) {
     let alpha = sampler_alpha();
     assert!(
         c.p_value > alpha,
