@@ -64,6 +64,61 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
     assert_bad_input(d, &["run", "--config", "missing.toml"], "missing.toml");
 }
 
+/// Every file under `root` with its bytes (an absent root is empty).
+fn tree(root: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else { continue };
+        for e in entries {
+            let p = e.expect("dir entry").path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                out.insert(p.clone(), std::fs::read(&p).expect("readable"));
+            }
+        }
+    }
+    out
+}
+
+/// Issue 9 item 4: bad invocations against a folder that already holds a finished run exit 2 with
+/// one line naming the flag or field, and leave every byte of `results/` and `plots/` as it was.
+#[test]
+fn bad_invocations_leave_existing_results_unchanged() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    std::fs::write(d.join("tiny.toml"), SMALL).expect("write");
+    let o = mcbench(d, &["run", "--config", "tiny.toml", "--threads", "1"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let before = (tree(&d.join("results")), tree(&d.join("plots")));
+    assert!(before.0.keys().any(|p| p.ends_with("tiny/summary.json")), "the run wrote its summary");
+    std::fs::write(d.join("bad_param.toml"), SMALL.replace("clamp = 1.5", "clamp = -1.0")).expect("write");
+    std::fs::write(d.join("bad_reps.toml"), SMALL.replace("reps = 3", "reps = 1")).expect("write");
+    std::fs::write(d.join("bad_syntax.toml"), SMALL.replace("budgets = [4, 16, 64]", "budgets = [4, 16 64]"))
+        .expect("w");
+    let cases: [(&[&str], &str); 9] = [
+        (&["run", "--config", "tiny.toml", "--reps", "0"], "--reps"),
+        (&["run", "--config", "tiny.toml", "--seed", "-3"], "--seed"),
+        (&["run", "--config", "tiny.toml", "--threads", "0"], "--threads"),
+        (&["run", "--config", "tiny.toml", "--quick", "--full"], "--full"),
+        (&["run", "--config", "bad_param.toml"], "clamp"),
+        (&["run", "--config", "bad_reps.toml"], "reps"),
+        (&["run", "--config", "bad_syntax.toml"], "(in `budgets = [4, 16 64]`)"),
+        (&["run", "no-such-experiment", "--results", "results"], "no-such-experiment"),
+        (&["plot", "results/no-such-run"], "no-such-run"),
+    ];
+    for (args, needle) in cases {
+        let o = mcbench(d, args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: not one line: {err}");
+        assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(before == (tree(&d.join("results")), tree(&d.join("plots"))), "{args:?} changed results/ or plots/");
+    }
+}
+
 #[test]
 fn list_shows_what_runs_where() {
     let dir = tempfile::tempdir().expect("tempdir");

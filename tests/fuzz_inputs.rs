@@ -1,8 +1,10 @@
 //! Property tests of bad input (SPEC §9, issue 9 item 4): random edits of a valid sweep file and
-//! of a valid `summary.json` never panic, and every rejection is one non-empty line naming what is
-//! wrong (the CLI turns these errors into exit code 2; `tests/cli.rs` checks that mapping).
+//! of a valid `summary.json` never panic, and every rejection is one non-empty line that names the
+//! field (or the file and its position) and maps to exit code 2 (`tests/cli.rs` checks that the
+//! binary exits with the mapped code).
 
 use experiments::config::{Mode, SweepFile};
+use experiments::error::HarnessError;
 use experiments::execute::{execute, prepare, ExecOptions};
 use experiments::output::read_results;
 use experiments::runner::Silent;
@@ -34,8 +36,45 @@ fn mutate(text: &str, edits: &[(usize, usize, u8)]) -> String {
     String::from_utf8_lossy(&b).to_string()
 }
 
-/// `Ok(())` when `f` neither panicked nor failed with anything but one non-empty line.
-fn one_line_or_ok<T, E: std::fmt::Display>(f: impl FnOnce() -> Result<T, E>) -> Result<(), String> {
+/// Names an error message may point at: the sweep file's fields, the ids and parameters of the
+/// small sweeps below, and the result files' columns. Matched as whole words, so `valid` is not
+/// `id`; the file name alone does not count (see [`names_a_position`]).
+const FIELDS: &[&str] = &[
+    "name",
+    "seed",
+    "reps",
+    "budget_kind",
+    "budgets",
+    "budget",
+    "baseline",
+    "testbeds",
+    "testbed",
+    "estimators",
+    "estimator",
+    "id",
+    "params",
+    "variant",
+    "resolution",
+    "clamp",
+];
+
+/// Whether `msg` names one of [`FIELDS`] as a whole word (a path counts by its file name).
+fn names_a_field(msg: &str) -> bool {
+    msg.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '.' || c == '-'))
+        .map(|w| w.rsplit('/').next().unwrap_or(w).trim_end_matches('.'))
+        .any(|w| FIELDS.contains(&w))
+}
+
+/// Whether a parse error names the file and the line where it went wrong (TOML errors also quote
+/// that line, whose key is the field; JSON errors give line and column).
+fn names_a_position(msg: &str) -> bool {
+    let file = msg.split(':').next().unwrap_or("");
+    (file.ends_with(".toml") || file.ends_with(".json")) && msg.contains("line ")
+}
+
+/// `Ok(())` when `f` neither panicked nor failed with anything but bad input (exit code 2) in one
+/// non-empty line that names the field or file.
+fn rejected_well<T>(f: impl FnOnce() -> Result<T, HarnessError>) -> Result<(), String> {
     match catch_unwind(AssertUnwindSafe(f)) {
         Err(_) => Err("panicked".into()),
         Ok(Ok(_)) => Ok(()),
@@ -43,6 +82,10 @@ fn one_line_or_ok<T, E: std::fmt::Display>(f: impl FnOnce() -> Result<T, E>) -> 
             let msg = e.to_string();
             if msg.trim().is_empty() || msg.trim_end().lines().count() != 1 {
                 Err(format!("not one line: {msg:?}"))
+            } else if e.exit_code() != 2 {
+                Err(format!("exit code {} for bad input: {msg}", e.exit_code()))
+            } else if !names_a_field(&msg) && !names_a_position(&msg) {
+                Err(format!("names no field: {msg}"))
             } else {
                 Ok(())
             }
@@ -50,10 +93,20 @@ fn one_line_or_ok<T, E: std::fmt::Display>(f: impl FnOnce() -> Result<T, E>) -> 
     }
 }
 
+#[test]
+fn the_field_check_has_teeth() {
+    assert!(names_a_field("reps = 0: at least 2 repetitions are needed"));
+    assert!(names_a_position("/tmp/x/sweep.toml: line 2, column 7: invalid array (in `reps = [`)"));
+    assert!(!names_a_field("/tmp/x/sweep.toml: invalid array"));
+    assert!(!names_a_position("/tmp/x/sweep.toml: invalid array"));
+    assert!(!names_a_field("something is invalid"));
+    assert!(!names_a_field("the value 3 is out of range"));
+}
+
 fn check_config(dir: &Path, text: &str, ext: &str) -> Result<(), String> {
     let path = dir.join(format!("sweep.{ext}"));
     std::fs::write(&path, text).map_err(|e| e.to_string())?;
-    one_line_or_ok(|| SweepFile::read(&path).and_then(|f| f.apply(None, Mode::Quick)).and_then(|s| s.validate()))
+    rejected_well(|| SweepFile::read(&path).and_then(|f| f.apply(None, Mode::Quick)).and_then(|s| s.validate()))
 }
 
 proptest! {
@@ -111,7 +164,7 @@ fn edited_result_files_never_panic_and_fail_in_one_line() {
             std::fs::create_dir_all(&copy).expect("dir");
             std::fs::copy(res.join("summary.csv"), copy.join("summary.csv")).expect("csv");
             std::fs::write(copy.join("summary.json"), mutate(&original, &edits)).expect("json");
-            prop_assert_eq!(one_line_or_ok(|| read_results(&copy)), Ok(()));
+            prop_assert_eq!(rejected_well(|| read_results(&copy)), Ok(()));
             Ok(())
         })
         .expect("no edit makes the reader panic or fail in more than one line");

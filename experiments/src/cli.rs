@@ -79,13 +79,13 @@ struct RunArgs {
     #[arg(long)]
     full: bool,
     /// Experiment seed.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
     seed: Option<u64>,
     /// Repetitions per integral (>= 2).
-    #[arg(long, value_name = "R", value_parser = clap::value_parser!(u64).range(2..=1_000_000))]
+    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(2..=1_000_000))]
     reps: Option<u64>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T", value_parser = clap::value_parser!(u64).range(1..=1024))]
+    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=1024))]
     threads: Option<u64>,
     /// Results root.
     #[arg(long, value_name = "DIR", default_value = "results")]

@@ -118,6 +118,19 @@ pub fn powers_of_four(ks: std::ops::RangeInclusive<u32>) -> Vec<Budget> {
     ks.map(|k| Budget { kind: BudgetKind::Samples, amount: 4u64.pow(k) }).collect()
 }
 
+/// A TOML error as one line: the message, the line and column where it starts, and that line's
+/// text (which holds the key, so the field is named even for a syntax error).
+fn toml_reason(text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().lines().next().unwrap_or("malformed").to_string();
+    let Some(span) = e.span() else { return msg };
+    let start = span.start.min(text.len());
+    let before = text.get(..start).unwrap_or("");
+    let line = before.matches('\n').count() + 1;
+    let column = before.chars().rev().take_while(|&c| c != '\n').count() + 1;
+    let source: String = text.lines().nth(line - 1).unwrap_or("").trim().chars().take(60).collect();
+    format!("line {line}, column {column}: {msg} (in `{source}`)")
+}
+
 /// The optional fields of a config file; present fields override the named experiment's sweep.
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -146,7 +159,7 @@ impl SweepFile {
         let text = std::fs::read_to_string(path).map_err(|e| HarnessError::bad_file(path, e))?;
         let parsed = match path.extension().and_then(|e| e.to_str()) {
             Some("json") => serde_json::from_str(&text).map_err(|e| e.to_string()),
-            Some("toml") => toml::from_str(&text).map_err(|e| e.message().to_string()),
+            Some("toml") => toml::from_str(&text).map_err(|e| toml_reason(&text, &e)),
             _ => Err("config files must end in .toml or .json".to_string()),
         };
         parsed.map_err(|reason| HarnessError::bad_file(path, reason.lines().next().unwrap_or("malformed").to_string()))
