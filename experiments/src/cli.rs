@@ -6,6 +6,7 @@ use crate::error::{HarnessError, Result};
 use crate::execute::{self, ExecOptions};
 use crate::progress::Progress;
 use crate::report::{markdown_table, sig};
+use crate::shard::ShardSpec;
 use crate::suite::{self, EXPERIMENTS};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use estimators::params::Params;
@@ -53,6 +54,25 @@ enum Command {
         #[arg(long, default_value = "results")]
         results: PathBuf,
     },
+    /// Merge the folders of `run --shard i/n` into the files a single run writes (SPEC §12).
+    Merge {
+        /// Shard folders (`<results>/<experiment>/shard-<i>-of-<n>`), or the experiment's results
+        /// folder holding them.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Results root (the experiment's folder is written below it).
+        #[arg(long, value_name = "DIR", default_value = "results")]
+        results: PathBuf,
+        /// Plots root.
+        #[arg(long, value_name = "DIR", default_value = "plots")]
+        plots: PathBuf,
+        /// Worker threads (default: all cores).
+        #[arg(long, value_name = "T", value_parser = clap::value_parser!(u64).range(1..=1024))]
+        threads: Option<u64>,
+        /// Skip plots and reports.
+        #[arg(long)]
+        no_plots: bool,
+    },
     /// Redraw the plots and report of a results folder.
     Plot {
         /// A results folder holding summary.csv and summary.json.
@@ -99,6 +119,9 @@ struct RunArgs {
     /// Skip plots and reports.
     #[arg(long)]
     no_plots: bool,
+    /// Run only shard I of N of each sweep and write its statistics for `mcbench merge`.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<ShardSpec>,
 }
 
 impl RunArgs {
@@ -152,6 +175,21 @@ fn dispatch(cli: Cli) -> Result<()> {
         }
         Some(Command::Reference { testbed, variant, samples, results }) => {
             reference(&testbed, variant, samples, &results)
+        }
+        Some(Command::Merge { dirs, results, plots, threads, no_plots }) => {
+            let progress = Progress::new();
+            let opts = ExecOptions {
+                results_root: results,
+                plots_root: plots,
+                threads: threads.map(|t| t as usize),
+                observer: &progress,
+                plots: !no_plots,
+            };
+            let t0 = Instant::now();
+            let out = crate::merge::merge(&dirs, &opts)?;
+            print_summary(&out.report, t0.elapsed().as_secs_f64());
+            println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
+            Ok(())
         }
         Some(Command::Plot { results_dir, plots }) => {
             let report = crate::output::read_results(&results_dir)?;
@@ -209,6 +247,21 @@ fn run(names: &[String], args: &RunArgs) -> Result<()> {
     let started = Instant::now();
     for (def, plan) in &prepared {
         let t0 = Instant::now();
+        if let Some(shard) = args.shard {
+            let threads = args.threads.map(|t| t as usize);
+            let out = crate::shard::run_shard(plan, *def, shard, &args.results, threads, &progress)?;
+            progress.finish();
+            println!(
+                "{} shard {shard}: {} of {} units ({} resumed) in {:.1} s, written to {}",
+                plan.sweep.experiment,
+                out.owned,
+                out.units,
+                out.resumed,
+                t0.elapsed().as_secs_f64(),
+                out.dir.display()
+            );
+            continue;
+        }
         let out = execute::execute(plan, *def, &opts)?;
         progress.finish();
         print_summary(&out.report, t0.elapsed().as_secs_f64());

@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::metrics::{summarize, SummaryRow};
 use crate::output::{self, Diagnostic, IntegralRow, Meta, RunReport};
 use crate::plan::Plan;
-use crate::runner::{self, Observer, RunOptions};
+use crate::runner::{self, Observer, RunOptions, RunResults};
 use crate::suite::ExperimentDef;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -45,13 +45,27 @@ pub fn prepare(sweep: Sweep) -> Result<Plan> {
 /// Runs a prepared plan and writes every output.
 pub fn execute(plan: &Plan, def: Option<&ExperimentDef>, opts: &ExecOptions<'_>) -> Result<Outcome> {
     let started = Instant::now();
-    let sweep = &plan.sweep;
-    let results_dir = opts.results_root.join(&sweep.experiment);
-    let plots_dir = opts.plots_root.join(&sweep.experiment);
+    let results_dir = opts.results_root.join(&plan.sweep.experiment);
     let run = runner::run(
         plan,
         &RunOptions { threads: opts.threads, cell_dir: Some(results_dir.join("cells")), observer: opts.observer },
     )?;
+    finish(plan, def, &run, opts, started)
+}
+
+/// Everything after the cells are known: metrics, fits, tests, claims, the experiment's post hook,
+/// result files, plots and report. A single run and a merge of shards
+/// ([`crate::merge`]) both end here, so equal cells give equal files.
+pub fn finish(
+    plan: &Plan,
+    def: Option<&ExperimentDef>,
+    run: &RunResults,
+    opts: &ExecOptions<'_>,
+    started: Instant,
+) -> Result<Outcome> {
+    let sweep = &plan.sweep;
+    let results_dir = opts.results_root.join(&sweep.experiment);
+    let plots_dir = opts.plots_root.join(&sweep.experiment);
     let mut rows: Vec<SummaryRow> = Vec::new();
     let mut tests: Vec<TestRow> = Vec::new();
     let mut integrals: Vec<IntegralRow> = Vec::new();
@@ -123,7 +137,7 @@ pub fn execute(plan: &Plan, def: Option<&ExperimentDef>, opts: &ExecOptions<'_>)
     }
     let mut extra_plots = Vec::new();
     if let Some(post) = def.and_then(|d| d.post) {
-        extra_plots = post(plan, &run, &mut report, &results_dir, opts.plots.then_some(plots_dir.as_path()))?;
+        extra_plots = post(plan, run, &mut report, &results_dir, opts.plots.then_some(plots_dir.as_path()))?;
     }
     report.meta.wall_seconds = started.elapsed().as_secs_f64();
     output::write_summary_csv(&results_dir.join("summary.csv"), &report.rows)?;

@@ -4,7 +4,8 @@
 //! parallel with reproducible streams, SPEC §5 metrics and slope fits, SPEC §6 tests, the SPEC §8
 //! result files, plots and reports, and the named experiments of SPEC §7. Pipeline:
 //! [`config`] -> [`plan`] -> [`runner`] -> [`metrics`] / [`analysis`] -> [`output`] / [`plot`] /
-//! [`report`]; [`execute`] ties them together and [`cli`] is the binary's front.
+//! [`report`]; [`execute`] ties them together and [`cli`] is the binary's front; [`shard`] and [`merge`] split a
+//! sweep over machines and join it again (SPEC §12).
 #![warn(missing_docs)]
 
 pub mod analysis;
@@ -13,6 +14,7 @@ pub mod cli;
 pub mod config;
 pub mod error;
 pub mod execute;
+pub mod merge;
 pub mod metrics;
 pub mod output;
 pub mod plan;
@@ -20,6 +22,7 @@ pub mod plot;
 pub mod progress;
 pub mod report;
 pub mod runner;
+pub mod shard;
 pub mod suite;
 
 /// The README's code blocks, compiled and run as doc tests.

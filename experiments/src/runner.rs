@@ -158,12 +158,34 @@ fn samples_for_fetch_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -
     Ok((n as u64).clamp(1, cap))
 }
 
-/// Runs one cell (no resume logic). Work items are whole sequences (test beds whose integrals
-/// come in frames, [`estimators::testbed::TestBed::sequence_length`]), batched to about `BATCH`
-/// integrals; each sequence draws from the stream of its first integral, so a static test bed
-/// (sequence length 1) keeps exactly the per-integral streams and batches it always had. A fetch
-/// budget first becomes a fixed sample count ([`samples_for_fetch_budget`]).
+/// Repetitions per block. A cell's repetitions are reduced block by block (Welford pushes in
+/// repetition order inside a block, [`Moments::merge`] of the blocks in block order), so the block
+/// is the unit a shard (`--shard i/n`) can own: the split is fixed by the sweep's `reps` alone,
+/// never by the thread or shard count, and a merge of shards reproduces a single run bit for bit.
+/// A cell of at most `REP_BLOCK` repetitions is one block, reduced exactly as before blocks existed.
+pub const REP_BLOCK: usize = 16;
+
+/// The number of repetition blocks of a sweep with `reps` repetitions.
+pub fn rep_blocks(reps: usize) -> usize {
+    reps.div_ceil(REP_BLOCK)
+}
+
+/// Runs one cell (no resume logic): every repetition block, merged in block order.
 pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<CellResult> {
+    let blocks: Vec<usize> = (0..rep_blocks(plan.sweep.reps)).collect();
+    let parts = run_blocks(plan, bi, ei, budget, &blocks)?;
+    Ok(merge_blocks(cell_key(plan, bi, ei, budget), &parts))
+}
+
+/// Runs the given repetition blocks of one cell and returns each block's sufficient statistics
+/// (a [`CellResult`] over that block's repetitions, keyed by the whole cell), in the order given.
+/// Work items are whole sequences (test beds whose integrals come in frames,
+/// [`estimators::testbed::TestBed::sequence_length`]), batched to about `BATCH` integrals; each
+/// sequence draws from the stream of its first integral, so a static test bed (sequence length 1)
+/// keeps exactly the per-integral streams and batches it always had. A fetch budget first becomes a
+/// fixed sample count ([`samples_for_fetch_budget`]; its pilot is deterministic, so every shard
+/// owning a block of the cell computes the same count).
+pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[usize]) -> Result<Vec<CellResult>> {
     let b = &plan.beds[bi];
     let n = b.bed.integrals();
     let frames = b.bed.sequence_length().max(1);
@@ -176,10 +198,18 @@ pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Cel
         _ => None,
     };
     let cell = CellRun { plan, bi, ei, budget, samples };
-    let items: Vec<Result<Item>> = (0..reps * batches)
-        .into_par_iter()
-        .map(|item| {
-            let (rep, batch) = (item / batches, item % batches);
+    // (position in `blocks`, repetition, batch), repetition-major inside each block.
+    let work: Vec<(usize, usize, usize)> = blocks
+        .iter()
+        .enumerate()
+        .flat_map(|(pos, &blk)| {
+            (blk * REP_BLOCK..((blk + 1) * REP_BLOCK).min(reps))
+                .flat_map(move |rep| (0..batches).map(move |batch| (pos, rep, batch)))
+        })
+        .collect();
+    let items: Vec<Result<Item>> = work
+        .par_iter()
+        .map(|&(_, rep, batch)| {
             let mut out = Item::default();
             for s in batch * per_item..((batch + 1) * per_item).min(sequences) {
                 run_sequence(&cell, rep as u64, s * frames, &mut out)?;
@@ -187,22 +217,55 @@ pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Cel
             Ok(out)
         })
         .collect();
-    let mut moments = vec![[Moments::default(), Moments::default(), Moments::default()]; n];
-    let (mut costs, mut time, mut diagnostics) = (Costs::default(), TimeStats::default(), Vec::new());
-    for (item, r) in items.into_iter().enumerate() {
-        let r = r?;
-        let batch = item % batches;
+    let key = cell_key(plan, bi, ei, budget);
+    let empty = CellResult {
+        key,
+        moments: vec![[Moments::default(), Moments::default(), Moments::default()]; n],
+        costs: Costs::default(),
+        estimates: 0,
+        time: TimeStats::default(),
+        diagnostics: Vec::new(),
+    };
+    let mut parts = vec![empty; blocks.len()];
+    for (&(pos, _, batch), r) in work.iter().zip(items) {
+        let (r, part) = (r?, &mut parts[pos]);
         for (k, v) in r.values.iter().enumerate() {
             for c in 0..3 {
-                moments[batch * per_item * frames + k][c].push(v[c]);
+                part.moments[batch * per_item * frames + k][c].push(v[c]);
             }
         }
-        add(&mut costs, &r.costs);
-        time.merge(&r.time);
-        add_diagnostics(&mut diagnostics, &r.diagnostics);
+        part.estimates += r.values.len() as u64;
+        add(&mut part.costs, &r.costs);
+        part.time.merge(&r.time);
+        add_diagnostics(&mut part.diagnostics, &r.diagnostics);
     }
-    let key = cell_key(plan, bi, ei, budget);
-    Ok(CellResult { key, moments, costs, estimates: (reps * n) as u64, time, diagnostics })
+    Ok(parts)
+}
+
+/// Merges the blocks of one cell, in the order given (block order for a bit-reproducible result),
+/// into the cell's statistics under `key`.
+pub fn merge_blocks(key: CellKey, parts: &[CellResult]) -> CellResult {
+    let n = parts.first().map_or(0, |p| p.moments.len());
+    let mut out = CellResult {
+        key,
+        moments: vec![[Moments::default(), Moments::default(), Moments::default()]; n],
+        costs: Costs::default(),
+        estimates: 0,
+        time: TimeStats::default(),
+        diagnostics: Vec::new(),
+    };
+    for p in parts {
+        for (m, pm) in out.moments.iter_mut().zip(&p.moments) {
+            for c in 0..3 {
+                m[c].merge(&pm[c]);
+            }
+        }
+        out.estimates += p.estimates;
+        add(&mut out.costs, &p.costs);
+        out.time.merge(&p.time);
+        add_diagnostics(&mut out.diagnostics, &p.diagnostics);
+    }
+    out
 }
 
 /// The key of a cell.
@@ -220,7 +283,8 @@ pub fn cell_key(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> CellKey {
     }
 }
 
-fn read_cell(path: &Path, key: &CellKey) -> Result<Option<CellResult>> {
+/// Reads a stored cell back; `None` when absent or stored under another key.
+pub(crate) fn read_cell(path: &Path, key: &CellKey) -> Result<Option<CellResult>> {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
