@@ -40,7 +40,11 @@ pub static SAMPLERS: &[SamplerEntry] = &[
     SamplerEntry { id: "rayleigh", summary: "Rayleigh phase directions", check: rayleigh_check },
     SamplerEntry { id: "rect_light", summary: "solid-angle sampling of rectangular lights", check: rect },
     SamplerEntry { id: "equiangular", summary: "equiangular distances towards a point light", check: equiangular },
-    SamplerEntry { id: "free_flight", summary: "free-flight distances (constant, piecewise, truncated)", check: flights },
+    SamplerEntry {
+        id: "free_flight",
+        summary: "free-flight distances (constant, piecewise, truncated)",
+        check: flights,
+    },
     SamplerEntry { id: "mixture", summary: "deterministic mixture sampling (DMS) of three lobes", check: dms },
     SamplerEntry { id: "brdf", summary: "the Phong BRDF's diffuse + lobe mixture", check: brdf_mixture },
     SamplerEntry { id: "phase", summary: "isotropic, Henyey-Greenstein and Rayleigh phase sampling", check: phases },
@@ -78,9 +82,13 @@ fn cone_check() -> Vec<(String, ChiSquare)> {
             let cos_max = angle.cos();
             let edges = (0..=16).map(|k| cos_max + (1.0 - cos_max) * k as f64 / 16.0).collect();
             let grid = SphereGrid::with_cos_edges(edges, phi);
-            let c = sampler_chi_square(&grid, 100_000, seed, |r| cone::sample_local(cos_max, r), |d| {
-                cone::pdf(d.z, cos_max)
-            });
+            let c = sampler_chi_square(
+                &grid,
+                100_000,
+                seed,
+                |r| cone::sample_local(cos_max, r),
+                |d| cone::pdf(d.z, cos_max),
+            );
             (name.to_string(), c)
         })
         .collect()
@@ -93,7 +101,13 @@ fn lobe() -> Vec<(String, ChiSquare)> {
     vec![
         (
             "phong lobe n=20".into(),
-            sampler_chi_square(&wide, 200_000, 3, |r| phong_lobe::sample_local(20.0, r), |d| phong_lobe::pdf(d.z, 20.0)),
+            sampler_chi_square(
+                &wide,
+                200_000,
+                3,
+                |r| phong_lobe::sample_local(20.0, r),
+                |d| phong_lobe::pdf(d.z, 20.0),
+            ),
         ),
         (
             "phong lobe n=10000".into(),
@@ -209,9 +223,13 @@ fn flights() -> Vec<(String, ChiSquare)> {
         flight(&pwl, 0.5, 9.0, "ff-pwl"),
         (
             "truncated free flight".into(),
-            interval_chi_square(&edges, 200_000, 23, |r| trunc.sample_truncated((1.0, 11.0), r.gen()), |t| {
-                trunc.pdf_truncated((1.0, 11.0), t)
-            }),
+            interval_chi_square(
+                &edges,
+                200_000,
+                23,
+                |r| trunc.sample_truncated((1.0, 11.0), r.gen()),
+                |t| trunc.pdf_truncated((1.0, 11.0), t),
+            ),
         ),
     ]
 }
@@ -271,9 +289,13 @@ fn phases() -> Vec<(String, ChiSquare)> {
         .into_iter()
         .enumerate()
         .map(|(k, phase)| {
-            let c = sampler_chi_square(&grid, 100_000, 40 + k as u64, |rng| phase.sample(dir, rng).0, |w| {
-                phase.eval(w.dot(dir))
-            });
+            let c = sampler_chi_square(
+                &grid,
+                100_000,
+                40 + k as u64,
+                |rng| phase.sample(dir, rng).0,
+                |w| phase.eval(w.dot(dir)),
+            );
             (phase.name(), c)
         })
         .collect()

@@ -106,12 +106,25 @@ fn panic_text(p: Box<dyn std::any::Any + Send>) -> String {
 }
 
 /// One repetition's estimates of every integral, or the error that stopped it.
-fn one_rep(est: &dyn estimators::estimator::Estimator, bed: &dyn TestBed, case: &Case, seed: u64, rep: u64) -> Result<Vec<[f64; 3]>, String> {
+fn one_rep(
+    est: &dyn estimators::estimator::Estimator,
+    bed: &dyn TestBed,
+    case: &Case,
+    seed: u64,
+    rep: u64,
+) -> Result<Vec<[f64; 3]>, String> {
     let budget = Budget::samples(case.samples).map_err(|e| e.to_string())?;
     let f = bed.sequence_length().max(1);
     let mut out = Vec::with_capacity(bed.integrals());
     for first in (0..bed.integrals()).step_by(f) {
-        let key = StreamKey { seed, testbed: case.id, estimator: case.estimator, budget: case.samples, rep, integral: first as u64 };
+        let key = StreamKey {
+            seed,
+            testbed: case.id,
+            estimator: case.estimator,
+            budget: case.samples,
+            rep,
+            integral: first as u64,
+        };
         let tasks: Vec<Task<'_>> = (first..first + f).map(|i| Task::new(bed, i, budget)).collect();
         match catch_unwind(AssertUnwindSafe(|| est.estimate_sequence(&tasks, &mut key.rng()))) {
             Err(p) => return Err(panic_text(p)),
@@ -185,7 +198,8 @@ fn run_inner(case: &Case, seed: u64) -> Outcome {
             variant: case.variant.into(),
             testbed_params: String::new(),
             estimator: case.estimator.into(),
-            budget: Budget::samples(case.samples).unwrap_or(Budget { kind: estimators::budget::BudgetKind::Samples, amount: 1 }),
+            budget: Budget::samples(case.samples)
+                .unwrap_or(Budget { kind: estimators::budget::BudgetKind::Samples, amount: 1 }),
             reps: case.reps as usize,
             seed,
             version: env!("CARGO_PKG_VERSION").into(),
@@ -205,7 +219,10 @@ fn run_inner(case: &Case, seed: u64) -> Outcome {
     };
     let note = format!(
         "{} p = {:.3e} ({}), bias claim {}; mean {value:.6e} vs reference {ref_value:.6e}",
-        t.test, t.p_value, t.verdict, est_entry.bias.name()
+        t.test,
+        t.p_value,
+        t.verdict,
+        est_entry.bias.name()
     );
     Outcome {
         outcome: if t.agrees { "correct" } else { "FAILED" },
@@ -244,7 +261,8 @@ fn exact_moments_test(
         var += v / (case.samples * case.reps) as f64;
     }
     let t = estimators::stats::z_test(reference + dev, var.sqrt(), reference);
-    let agrees = t.p_value >= crate::analysis::UNBIASEDNESS_ALPHA || (var == 0.0 && dev.abs() <= 1e-12 * reference.abs().max(1e-300));
+    let agrees = t.p_value >= crate::analysis::UNBIASEDNESS_ALPHA
+        || (var == 0.0 && dev.abs() <= 1e-12 * reference.abs().max(1e-300));
     Some(Outcome {
         outcome: if agrees { "correct" } else { "FAILED" },
         value: f64::NAN,

@@ -107,7 +107,10 @@ pub fn running_means(seq: Sequence, n: u64) -> (Outcome, Outcome) {
     let reference = exact.mean(n);
     let plain_rel = (plain - reference).abs() / reference;
     let note = |what: &str| {
-        format!("{what} of {n} {} values vs a double-double sum; a plain running mean drifts {plain_rel:.2e}", seq.name())
+        format!(
+            "{what} of {n} {} values vs a double-double sum; a plain running mean drifts {plain_rel:.2e}",
+            seq.name()
+        )
     };
     (
         judged(m.mean(), reference, MEAN_DRIFT_LIMIT, note("stats::Moments (compensated mean)")),
@@ -142,7 +145,10 @@ pub fn cache_cell(seq: Sequence, n: u64, limit: f64) -> Outcome {
         grid.radiance(0)[0],
         reference,
         limit,
-        format!("cell mean of {n} {} records (counter {count}, no overflow) vs a double-double sum; limit {limit:e}", seq.name()),
+        format!(
+            "cell mean of {n} {} records (counter {count}, no overflow) vs a double-double sum; limit {limit:e}",
+            seq.name()
+        ),
     )
 }
 
