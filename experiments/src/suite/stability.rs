@@ -483,7 +483,11 @@ pub fn post(
         let o = sc::run(&c, seed);
         let bed_params = params_text(&c.bed);
         let est_params = params_text(&c.params);
-        let params = if bed_params.is_empty() { est_params } else { format!("{est_params} bed[{bed_params}]") };
+        let params = match (est_params.is_empty(), bed_params.is_empty()) {
+            (_, true) => est_params,
+            (true, false) => format!("bed[{bed_params}]"),
+            (false, false) => format!("{est_params} bed[{bed_params}]"),
+        };
         push(c.id, c.spec_item, format!("{}/{}", c.testbed, c.variant), c.estimator.into(), params, c.expect, o);
     }
     for (id, item, expect, o) in numeric_cases(mode) {
