@@ -277,3 +277,52 @@ fn exact_moments_test(
         ),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use estimators::math::Rgb;
+    use estimators::rng::StreamRng;
+
+    struct Panics;
+    impl estimators::estimator::Estimator for Panics {
+        fn estimate(&self, _: &Task<'_>, _: &mut StreamRng) -> Result<Rgb, EstimateError> {
+            panic!("boom\nsecond line")
+        }
+    }
+
+    fn case(estimator: &'static str, params: Params, expect: Expect) -> Case {
+        Case {
+            id: "t",
+            spec_item: "test",
+            testbed: "canonical-1d",
+            variant: "constant-T0.5",
+            bed: Params::new().with("tau", 0.0),
+            estimator,
+            params,
+            samples: 2,
+            reps: 8,
+            expect,
+        }
+    }
+
+    #[test]
+    fn outcomes_are_correct_refused_or_failed_never_a_panic() {
+        let ok = run(&case("delta_tracking", Params::new(), Expect::Correct), 1);
+        assert_eq!(ok.outcome, "correct", "{ok:?}");
+        // Optical depth ln 2 (the default of constant-T0.5): r = 1e6 > 2/(a+1), the model refuses.
+        let terminating = Case {
+            bed: Params::new(),
+            ..case("single_particle_terminating", Params::new().with("sigma_samp_ratio", 1e-6), Expect::Refused)
+        };
+        let refused = run(&terminating, 1);
+        assert!(refused.outcome == "refused" && refused.text.contains("sigma_samp"), "{refused:?}");
+        let unknown = run(&case("no_such_estimator", Params::new(), Expect::Refused), 1);
+        assert!(unknown.outcome == "refused" && unknown.text.contains("no_such_estimator"), "{unknown:?}");
+        // A panicking estimator is caught and reported in one line.
+        let c = case("delta_tracking", Params::new(), Expect::Correct);
+        let bed = (registry::testbed("canonical-1d").unwrap().build)(c.variant, &c.bed).unwrap();
+        let err = one_rep(&Panics, bed.as_ref(), &c, 1, 0).unwrap_err();
+        assert_eq!(err, "panic: boom");
+    }
+}
