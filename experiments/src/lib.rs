@@ -12,6 +12,7 @@ pub mod analysis;
 pub mod cell;
 pub mod cli;
 pub mod config;
+pub mod conformance;
 pub mod error;
 pub mod execute;
 pub mod merge;

@@ -22,21 +22,3 @@ pub fn sample_local<R: Rng + ?Sized>(cos_max: f64, rng: &mut R) -> Vec3 {
     let cos_alpha = 1.0 - rng.gen::<f64>() * (1.0 - cos_max);
     spherical_direction(cos_alpha, 2.0 * PI * rng.gen::<f64>())
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::samplers::testing::{assert_sampler_fits, SphereGrid};
-
-    #[test]
-    fn chi_square_cone_wide_and_narrow() {
-        let cos_max = 0.3f64.cos();
-        let grid =
-            SphereGrid::with_cos_edges((0..=16).map(|k| cos_max + (1.0 - cos_max) * k as f64 / 16.0).collect(), 16);
-        assert_sampler_fits("cone 0.3 rad", &grid, 100_000, 31, |r| sample_local(cos_max, r), |d| pdf(d.z, cos_max));
-        let cos_max = 0.01f64.cos();
-        let grid =
-            SphereGrid::with_cos_edges((0..=16).map(|k| cos_max + (1.0 - cos_max) * k as f64 / 16.0).collect(), 8);
-        assert_sampler_fits("cone 0.01 rad", &grid, 100_000, 32, |r| sample_local(cos_max, r), |d| pdf(d.z, cos_max));
-    }
-}

@@ -15,15 +15,3 @@ pub fn sample_local<R: Rng + ?Sized>(rng: &mut R) -> Vec3 {
     let cos_theta = (1.0 - rng.gen::<f64>()).sqrt();
     spherical_direction(cos_theta, 2.0 * PI * rng.gen::<f64>())
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::samplers::testing::{assert_sampler_fits, SphereGrid};
-
-    #[test]
-    fn chi_square_cosine_hemisphere() {
-        let grid = SphereGrid::upper(16, 16);
-        assert_sampler_fits("cosine hemisphere", &grid, 200_000, 2, sample_local, |d| pdf(d.z));
-    }
-}

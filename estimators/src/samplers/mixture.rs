@@ -90,10 +90,7 @@ pub fn pick<R: Rng + ?Sized>(weights: &[f64], rng: &mut R) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::{Frame, Vec3};
     use crate::rng::stream;
-    use crate::samplers::testing::{assert_sampler_fits, SphereGrid};
-    use crate::samplers::{cone, cosine_hemisphere, phong_lobe};
 
     #[test]
     fn counts_are_floor_plus_residual_with_the_right_means() {
@@ -151,48 +148,5 @@ mod tests {
                 n as f64 * alphas[j]
             );
         }
-    }
-
-    /// Pooled DMS draws from a cosine + Phong lobe + cone mixture follow the full-mixture pdf.
-    #[test]
-    fn chi_square_mixture_with_deterministic_allocation() {
-        let alphas = [0.3, 0.45, 0.25];
-        let lobe_axis = Vec3::new(0.3, -0.2, 0.9).normalize();
-        // The cone about +z so its edge is a cell edge (the pdf is discontinuous there).
-        let cone_axis = Vec3::Z;
-        let cos_max = 0.25f64.cos();
-        let (lobe, cf) = (Frame::around(lobe_axis), Frame::around(cone_axis));
-        let pdf = move |d: Vec3| {
-            alphas[0] * cosine_hemisphere::pdf(d.z)
-                + alphas[1] * phong_lobe::pdf(lobe_axis.dot(d), 30.0)
-                + alphas[2] * cone::pdf(cone_axis.dot(d), cos_max)
-        };
-        let mut queue: Vec<Vec3> = Vec::new();
-        let mut edges: Vec<f64> = (0..=24).map(|k| -1.0 + 2.0 * k as f64 / 24.0).collect();
-        edges.push(cos_max);
-        edges.sort_by(f64::total_cmp);
-        let grid = SphereGrid::with_cos_edges(edges, 24);
-        assert_sampler_fits(
-            "DMS mixture",
-            &grid,
-            160_000,
-            41,
-            |r| {
-                if queue.is_empty() {
-                    let c = dms_counts(&alphas, 7, r);
-                    for _ in 0..c[0] {
-                        queue.push(cosine_hemisphere::sample_local(r));
-                    }
-                    for _ in 0..c[1] {
-                        queue.push(lobe.to_world(phong_lobe::sample_local(30.0, r)));
-                    }
-                    for _ in 0..c[2] {
-                        queue.push(cf.to_world(cone::sample_local(cos_max, r)));
-                    }
-                }
-                queue.pop().unwrap_or(Vec3::Z)
-            },
-            pdf,
-        );
     }
 }

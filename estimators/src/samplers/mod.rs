@@ -1,7 +1,10 @@
 //! Direction samplers with the densities they report (per unit solid angle).
 //!
-//! Every sampler here has a chi-square goodness-of-fit test beside it (SPEC §6), built on
-//! [`testing::assert_sampler_fits`].
+//! Every sampler here (and the Phong BRDF mixture and the phase functions) is registered in
+//! [`registry::SAMPLERS`] with its chi-square goodness-of-fit checks (SPEC §6), built on
+//! [`testing::sampler_chi_square`] / [`testing::interval_chi_square`]; a unit test runs them all and
+//! checks that every module of this folder is registered, and the conformance suite runs the
+//! checks of the samplers each estimator names.
 
 pub mod cone;
 pub mod cosine_hemisphere;
@@ -11,6 +14,7 @@ pub mod mixture;
 pub mod phong_lobe;
 pub mod rayleigh;
 pub mod rect_light;
+pub mod registry;
 pub mod testing;
 pub mod uniform_hemisphere;
 

@@ -21,22 +21,3 @@ pub fn sample_local<R: Rng + ?Sized>(n: f64, rng: &mut R) -> Vec3 {
     let cos_alpha = (1.0 - rng.gen::<f64>()).powf(1.0 / (n + 1.0));
     spherical_direction(cos_alpha, 2.0 * PI * rng.gen::<f64>())
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::samplers::testing::{assert_sampler_fits, SphereGrid};
-
-    #[test]
-    fn chi_square_phong_lobe_n20() {
-        let grid = SphereGrid::upper(24, 12);
-        assert_sampler_fits("phong lobe n=20", &grid, 200_000, 3, |r| sample_local(20.0, r), |d| pdf(d.z, 20.0));
-    }
-
-    #[test]
-    fn chi_square_phong_lobe_n10000() {
-        // Cells in cos(alpha) concentrated near the axis, where the mass of a stiff lobe sits.
-        let grid = SphereGrid::with_cos_edges((0..=24).map(|k| 1.0 - 2e-3 * (k as f64 / 24.0)).rev().collect(), 12);
-        assert_sampler_fits("phong lobe n=10000", &grid, 200_000, 4, |r| sample_local(1e4, r), |d| pdf(d.z, 1e4));
-    }
-}

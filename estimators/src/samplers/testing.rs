@@ -166,7 +166,7 @@ fn gof_with_outside(counts: &[u64], mut probs: Vec<f64>) -> ChiSquare {
 }
 
 /// Asserts a sampler's chi-square passes at the family's significance level.
-fn assert_fits(name: &str, c: &ChiSquare) {
+pub fn assert_fits(name: &str, c: &ChiSquare) {
     let alpha = sampler_alpha();
     assert!(
         c.p_value > alpha,

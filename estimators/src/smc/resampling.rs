@@ -35,9 +35,12 @@ pub fn normalise_log_weights(log_w: &[f64]) -> Option<(Vec<f64>, f64)> {
     if max == f64::NEG_INFINITY {
         return None;
     }
+    // Relative to the largest weight: `l - max` is exact (Sterbenz) for weights within a factor 2
+    // in log value, so weights of log size -1e4 normalise to full precision instead of losing
+    // |l| eps to the rounding of `lse` (SPEC §10, `stability` case smc-log-weights-underflow).
     let sum: f64 = log_w.iter().map(|l| (l - max).exp()).sum();
-    let lse = max + sum.ln();
-    Some((log_w.iter().map(|l| (l - lse).exp()).collect(), lse))
+    let ln_sum = sum.ln();
+    Some((log_w.iter().map(|l| ((l - max) - ln_sum).exp()).collect(), max + ln_sum))
 }
 
 /// `log(sum_i exp(l_i))`, `-inf` for an empty or all-zero set.
@@ -52,11 +55,14 @@ pub fn log_sum_exp(log_w: &[f64]) -> f64 {
 /// Effective sample size `1 / sum W_i^2` (Liu and Chen 1998) of log weights, computed in log space
 /// (`exp(2 lse(l) - lse(2 l))`): 0 when every weight is zero.
 pub fn effective_sample_size(log_w: &[f64]) -> f64 {
-    let a = log_sum_exp(log_w);
-    if a == f64::NEG_INFINITY {
+    let max = log_w.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if max == f64::NEG_INFINITY || max.is_nan() {
         return 0.0;
     }
-    let doubled: Vec<f64> = log_w.iter().map(|l| 2.0 * l).collect();
+    // Shifted by the largest log weight (the ESS is scale-free) so large |l| cost no precision.
+    let shifted: Vec<f64> = log_w.iter().map(|l| l - max).collect();
+    let a = log_sum_exp(&shifted);
+    let doubled: Vec<f64> = shifted.iter().map(|l| 2.0 * l).collect();
     (2.0 * a - log_sum_exp(&doubled)).exp()
 }
 

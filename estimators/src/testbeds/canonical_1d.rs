@@ -10,7 +10,9 @@
 //! Integral `k` (of `points`, default 1) is `T(s_k)`, `s_k = k / points`, along the ray from the
 //! origin in +x, one channel replicated to RGB; the reference is the closed form
 //! `exp(-tau F(s_k))`. Parameters: `points`, `albedo` (default 0.7, as paper 002's Eq. 21 medium:
-//! it only matters to the single particle models, whose scattered particle leaves the ray). The
+//! it only matters to the single particle models, whose scattered particle leaves the ray) and
+//! `tau` (the optical depth of the whole segment, overriding `-ln t`: `tau = 0` is an empty
+//! medium, `tau = 1e4` the optically thick stability case of SPEC §10). The
 //! scene has no approximate extinction, so explorer points of control variates cost full fetches.
 
 use super::canonical_profiles::Profile;
@@ -78,13 +80,13 @@ pub struct Canonical1d {
 impl Canonical1d {
     /// Builds a variant (validates the parameters; the reference is the closed form).
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown("canonical-1d", &["points", "albedo"])?;
+        params.reject_unknown("canonical-1d", &["points", "albedo", "tau"])?;
         let (profile, target) = parse_variant(variant).ok_or_else(|| {
             ConfigError::unknown("variant", &format!("canonical-1d/{variant}"), VARIANTS.iter().copied())
         })?;
         let points = params.count("points", 1, 10_000)?;
         let albedo = params.f64_in("albedo", 0.7, 0.0, 1.0)?;
-        let tau = -target.ln();
+        let tau = params.f64_in("tau", -target.ln(), 0.0, 1e6)?;
         let rays: Vec<MediumRay> = (1..=points)
             .map(|k| MediumRay {
                 origin: Vec3::default(),

@@ -77,4 +77,7 @@ impl Estimator for DoubleParticle {
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_transmittance(bed)
     }
+    fn validate(&self, bed: &dyn TestBed) -> Result<(), ConfigError> {
+        super::check_finite_variance("double_particle", self, self.sigma_samp, bed)
+    }
 }

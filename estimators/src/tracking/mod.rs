@@ -95,9 +95,62 @@ pub struct Interaction {
 /// The paper's `Transmittance` algorithm (§4.2) on `[t0, t1]` of the line `origin + s dir` for
 /// the difference extinction `sigma_t - main(s)`: free flights from `samp` (Eq. 4), `rule` at each
 /// interaction, which is reported to `seen`. Returns the weight of the transmitted particle
-/// (multiply by the main part's transmittance).
+/// (multiply by the main part's transmittance); it overflows to infinity where a product of
+/// thousands of factors `|1 - r| > 1` exceeds f64 (optical depth 1e4): [`track_scaled`] does not.
 #[allow(clippy::too_many_arguments)] // the tracker loop of paper 002 Alg. 1: probe, ray, segment, densities, weights, callbacks
 pub fn track(
+    probe: &MediumProbe<'_>,
+    line: (Vec3, Vec3),
+    seg: (f64, f64),
+    samp: &SamplingDensity,
+    main: Option<&SamplingDensity>,
+    rule: Rule,
+    rng: &mut StreamRng,
+    seen: impl FnMut(&Interaction),
+) -> Result<f64, EstimateError> {
+    track_scaled(probe, line, seg, samp, main, rule, rng, seen).map(|w| w.value())
+}
+
+/// A tracker weight `e 2^k` whose mantissa part `e` is kept within `2^-RESCALE..2^RESCALE` by exact
+/// power-of-two rescaling (so it never overflows and is bit-identical to the plain product
+/// wherever that product is finite).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScaledWeight {
+    /// The rescaled product.
+    pub e: f64,
+    /// The power of two it was divided by.
+    pub k: i32,
+}
+
+impl ScaledWeight {
+    /// Exponent step of a rescale.
+    pub const RESCALE: i32 = 512;
+    /// `e 2^k` as an f64 (infinite where it overflows).
+    pub fn value(self) -> f64 {
+        if self.k == 0 {
+            self.e
+        } else {
+            self.e * 2f64.powi(self.k)
+        }
+    }
+    /// `e 2^k exp(-tau)` without intermediate overflow or underflow: the product with a main
+    /// part's transmittance `exp(-tau)` given as its optical depth `tau`; `t_main` (= `exp(-tau)`
+    /// as the caller computed it) is used as is when nothing was rescaled, so ordinary results do
+    /// not change by a bit.
+    pub fn times_transmittance(self, t_main: f64, tau: f64) -> f64 {
+        if self.k == 0 && (t_main > 0.0 || self.e == 0.0) {
+            return self.e * t_main;
+        }
+        if self.e == 0.0 {
+            return 0.0;
+        }
+        self.e.signum() * (self.e.abs().ln() + f64::from(self.k) * std::f64::consts::LN_2 - tau).exp()
+    }
+}
+
+/// [`track`] returning the weight as a [`ScaledWeight`] (log-magnitude safe).
+#[allow(clippy::too_many_arguments)] // as track
+pub fn track_scaled(
     probe: &MediumProbe<'_>,
     (origin, dir): (Vec3, Vec3),
     (t0, t1): (f64, f64),
@@ -106,20 +159,27 @@ pub fn track(
     rule: Rule,
     rng: &mut StreamRng,
     mut seen: impl FnMut(&Interaction),
-) -> Result<f64, EstimateError> {
-    let (mut e, mut s) = (1.0, t0);
+) -> Result<ScaledWeight, EstimateError> {
+    let (mut e, mut k, mut s) = (1.0f64, 0i32, t0);
+    let (big, step) = (2f64.powi(ScaledWeight::RESCALE), 2f64.powi(-ScaledWeight::RESCALE));
     loop {
         s = samp.sample(s, rng.gen::<f64>());
         if s >= t1 {
-            return Ok(e);
+            return Ok(ScaledWeight { e, k });
         }
         let sigma_t = probe.sigma_t(origin + dir * s);
         let sigma_diff = sigma_t - main.map_or(0.0, |m| m.eval(s));
         let before = e;
         e *= interact(rule, sigma_diff / samp.eval(s), rng.gen::<f64>())?;
-        seen(&Interaction { s, sigma_t, sigma_diff, before, after: e });
+        // Observers see the unscaled weights (as the plain product, infinite past f64's range).
+        let unscale = if k == 0 { 1.0 } else { 2f64.powi(k) };
+        seen(&Interaction { s, sigma_t, sigma_diff, before: before * unscale, after: e * unscale });
         if e == 0.0 {
-            return Ok(0.0);
+            return Ok(ScaledWeight { e: 0.0, k: 0 });
+        }
+        if e.abs() > big {
+            e *= step;
+            k += ScaledWeight::RESCALE;
         }
     }
 }
@@ -176,6 +236,45 @@ pub fn ray_moments(
     let samp = sigma_samp.resolve(probe.majorant());
     let m = tracker_moments(diff, depth, samp, rule(probe.albedo()), seg, &[])?;
     Some(EstimateMoments { mean: m.mean * weight[0], ..m })
+}
+
+/// Refuses a sampling extinction under which one ray's variance is not finite in f64 on `bed`
+/// (SPEC §10, `sigma_samp = 1e-6 x sigma_t`: the double and non-terminating particle models are
+/// unbiased for any `sigma_samp`, but their second moment `exp(int sigma_samp ((1 - r)^2 - 1))`
+/// is `exp(7e5)` there, so no run of any length estimates anything). Checks the exact moments
+/// ([`Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.
+pub fn check_finite_variance(
+    id: &str,
+    est: &dyn crate::estimator::Estimator,
+    sigma_samp: SigmaSamp,
+    bed: &dyn TestBed,
+) -> Result<(), ConfigError> {
+    if bed.medium().is_none() {
+        return Ok(());
+    }
+    let budget = crate::budget::Budget::samples(1)?;
+    let n = bed.integrals();
+    let step = n.div_ceil(16).max(1);
+    for i in (0..n).step_by(step) {
+        let Some(m) = est.sample_moments(&Task::new(bed, i, budget)) else { continue };
+        if !m.rel_variance.is_finite() {
+            let (field, value) = match sigma_samp {
+                SigmaSamp::Ratio(v) => ("sigma_samp_ratio", v),
+                SigmaSamp::Absolute(v) => ("sigma_samp", v),
+                SigmaSamp::Majorant => ("sigma_samp", bed.medium().map_or(1.0, |m| m.majorant())),
+            };
+            return Err(ConfigError::invalid(
+                format!("{id}.{field}"),
+                value,
+                format!(
+                    "the variance of one ray overflows f64 on {}/{} integral {i} (paper 002 §3.4 moments): no run can estimate with it; use a sigma_samp nearer the extinction",
+                    bed.id(),
+                    bed.variant()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// A positive finite `sigma_samp` parameter (`None` when absent).

@@ -9,7 +9,7 @@
 //! needed (negative difference extinction, §3.3). The harness estimates pixels independently, so
 //! explorer data is not shared across pixels here.
 
-use super::{supports_transmittance, track, transmittance, Rule};
+use super::{supports_transmittance, track_scaled, transmittance, Rule};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::{Rgb, Vec3};
@@ -175,12 +175,14 @@ impl Estimator for ResidualRatioTracking {
             let sigma = memory.sigma();
             let mut seen = 0.0f64;
             let line = (probe.ray().origin, probe.ray().dir);
-            let e = track(probe, line, seg, &SamplingDensity::constant(sigma), Some(m), Rule::Double, rng, |i| {
-                seen = seen.max(i.sigma_diff.abs())
-            })?;
+            let e =
+                track_scaled(probe, line, seg, &SamplingDensity::constant(sigma), Some(m), Rule::Double, rng, |i| {
+                    seen = seen.max(i.sigma_diff.abs())
+                })?;
             memory.push(seen);
             task.note("sigma_samp", sigma);
-            Ok(e * *tm)
+            // In log space where the product overflows and T_main underflows (optical depth 1e4).
+            Ok(e.times_transmittance(*tm, m.integral(seg.0, seg.1)))
         })
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {

@@ -94,7 +94,9 @@ impl Estimator for SingleParticle {
         if self.terminating {
             let majorant = bed.medium().map_or(1.0, |m| m.majorant());
             check_terminating("single_particle_terminating", self.sigma_samp.resolve(majorant), bed)?;
+            Ok(())
+        } else {
+            super::check_finite_variance("single_particle_nonterminating", self, self.sigma_samp, bed)
         }
-        Ok(())
     }
 }

@@ -23,6 +23,10 @@ pub mod pmc_ip;
 pub mod pmc_ip_post;
 pub mod single_scatter;
 pub mod single_scatter_post;
+pub mod stability;
+pub mod stability_cases;
+pub mod stability_list;
+pub mod stability_numeric;
 pub mod surface_smc;
 pub mod transmittance;
 pub mod transmittance_post;
@@ -70,6 +74,7 @@ pub static EXPERIMENTS: &[&ExperimentDef] = &[
     &envmap_smc::DEF,
     &single_scatter::DEF,
     &canonical_sweep::DEF,
+    &stability::DEF,
 ];
 
 /// Looks an experiment up by name.

@@ -1,0 +1,36 @@
+//! The conformance suite (issue 9 item 2): every registered estimator goes through
+//! `experiments::conformance::conformance` (builds, finite output or a clean refusal on the SPEC
+//! §10 stability beds, determinism for a seed, chi-square of its samplers, unbiasedness at a small
+//! budget), so a new plug-in is covered without new test code.
+
+use estimators::registry::{self, ESTIMATORS};
+use experiments::analysis::UNBIASEDNESS_ALPHA;
+use experiments::conformance::{conformance, small_budget_unbiasedness, SAMPLERS_OF};
+
+#[test]
+fn every_registered_estimator_conforms() {
+    let failures: Vec<String> = ESTIMATORS.iter().flat_map(|e| conformance(e)).map(|f| f.to_string()).collect();
+    assert!(failures.is_empty(), "{} conformance failures:\n{}", failures.len(), failures.join("\n"));
+}
+
+/// Teeth: the small-budget unbiasedness check flags the known-biased control (clamping the
+/// integrand of independent MC) on the same kind of bed and budget the suite uses.
+#[test]
+fn the_small_budget_check_flags_the_biased_control() {
+    let entry = registry::estimator("clamped_is0_cv0").expect("registered");
+    let est = (entry.build)(&Default::default()).expect("builds");
+    let bed = (registry::testbed("gradient-plane").expect("registered").build)(
+        "default",
+        &estimators::params::Params::new().with("resolution", 2.0),
+    )
+    .expect("builds");
+    let row = small_budget_unbiasedness(entry, est.as_ref(), bed.as_ref()).expect("the control runs");
+    assert!(row.p_value < UNBIASEDNESS_ALPHA, "the biased control was not flagged: {} p = {}", row.test, row.p_value);
+}
+
+#[test]
+fn the_sampler_table_names_only_registered_estimators() {
+    let stale: Vec<&str> =
+        SAMPLERS_OF.iter().map(|(id, _)| *id).filter(|id| registry::estimator(id).is_err()).collect();
+    assert!(stale.is_empty(), "conformance::SAMPLERS_OF lists unregistered ids: {stale:?}");
+}
