@@ -62,7 +62,7 @@ fn numeric_cases() -> Vec<(&'static str, &'static str, Expect, Outcome)> {
         rayon::join(|| num::running_means(Sequence::Mixed, n), || num::running_means(Sequence::Trend, n));
     let (cache_mixed, cache_trend) = rayon::join(
         || num::cache_cell(Sequence::Mixed, cache_n, num::MEAN_DRIFT_LIMIT),
-        || num::cache_cell(Sequence::Trend, cache_n, 1e-9),
+        || num::cache_cell(Sequence::Trend, cache_n, num::MEAN_DRIFT_LIMIT),
     );
     let item = "1e8 samples into one running mean";
     vec![
@@ -71,12 +71,9 @@ fn numeric_cases() -> Vec<(&'static str, &'static str, Expect, Outcome)> {
         ("running-mean-1e8-trend-moments", item, Expect::Correct, trend_m),
         ("running-mean-1e8-trend-rgbmean", item, Expect::Correct, trend_r),
         ("cache-1e7-mixed", "1e7 samples into one cache", Expect::Correct, cache_mixed),
-        (
-            "cache-1e7-trend",
-            "1e7 samples into one cache (uncompensated cell mean: limit 1e-9)",
-            Expect::Correct,
-            cache_trend,
-        ),
+        // Judged at the same 1e-12 as every running mean: paper 001's uncompensated cell mean
+        // fails it on the trend sequence, and the table says so (README, "Stability").
+        ("cache-1e7-trend", "1e7 samples into one cache", Expect::Correct, cache_trend),
         ("smc-log-weights-underflow", "SMC weights that underflow", Expect::Correct, num::underflowing_weights()),
         ("smc-all-weights-zero", "every weight zero (ESS undefined)", Expect::Refused, num::all_zero_weights()),
     ]
