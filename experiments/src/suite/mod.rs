@@ -26,6 +26,9 @@ pub mod single_scatter_post;
 pub mod surface_smc;
 pub mod transmittance;
 pub mod transmittance_post;
+pub mod unbiasedness;
+pub mod unbiasedness_run;
+pub mod unbiasedness_table;
 pub mod variance_claims;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};
@@ -70,6 +73,7 @@ pub static EXPERIMENTS: &[&ExperimentDef] = &[
     &envmap_smc::DEF,
     &single_scatter::DEF,
     &canonical_sweep::DEF,
+    &unbiasedness::DEF,
 ];
 
 /// Looks an experiment up by name.

@@ -1,0 +1,428 @@
+//! The table of `unbiasedness`: one row per (estimator, test bed, variant) from the cell's SPEC §6
+//! tests, judged against what the paper claims (registry [`Bias`]); `unbiasedness.csv`, the
+//! per-row `paper` entries and the per-control claims of summary.json.
+
+use crate::analysis::{unbiasedness, TestRow, POWER, UNBIASEDNESS_ALPHA};
+use crate::cell::CellResult;
+use crate::error::Result;
+use crate::output::{write_atomic, Claim};
+use estimators::estimator::Bias;
+use estimators::stats::{detectable_shift, z_test};
+use estimators::testbed::{Reference, ReferenceKind};
+use serde::Serialize;
+use std::path::Path;
+
+/// The relative bias `--full` aims to resolve (issue 9: 0.1%).
+pub const TARGET_REL_BIAS: f64 = 1e-3;
+
+/// One row of `unbiasedness.csv`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Row {
+    /// Estimator name (id with parameters).
+    pub estimator: String,
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// What the paper claims (registry): `unbiased`, `consistent`, `biased`.
+    pub paper_bias: String,
+    /// The deciding test (`holm_t`, `holm_welch`, `pooled_z`), empty when not run.
+    pub test: String,
+    /// Its p-value (Holm-adjusted minimum for the Holm tests); NaN when nothing was tested.
+    pub p_value: f64,
+    /// `pass`, `biased`, `untested` or `not-run`.
+    pub verdict: String,
+    /// Relative bias the deciding test detects with 80% power.
+    pub detectable_rel_bias: f64,
+    /// Repetitions run.
+    pub reps: usize,
+    /// Repetitions that would resolve a 0.1% relative bias given the measured variance; empty when
+    /// the stored reference's own standard error alone exceeds that (no R suffices) or unknown.
+    #[serde(rename = "reps_for_0.1pct")]
+    pub reps_for_target: Option<f64>,
+    /// Samples per estimate.
+    pub budget: u64,
+    /// Measured relative bias: sum over integrals and channels of (mean - reference) over the sum
+    /// of |reference|.
+    pub rel_bias: f64,
+    /// Its standard error (channels taken as independent).
+    pub rel_bias_se: f64,
+    /// Whether the verdict agrees with what is expected here (empty: consistent, untested, not run).
+    pub agrees: Option<bool>,
+    /// How to read the row.
+    pub note: String,
+}
+
+/// Where a `Bias::Biased` control is unbiased by construction, and why (decided from the
+/// estimator's definition, not from a run): the self-normalised `bidirectional_is_sn` estimates
+/// `L_ns` (the `-lns` variants) with the unnormalised estimator, only its `L_r` ratio is
+/// self-normalised; ray marching's Jensen bias vanishes where the extinction is constant (the
+/// marched optical depth `h sum sigma_t` is exact: `canonical-1d` `constant-*`, and the
+/// homogeneous `gradient-box` without scattering, `albedo-0`) and is of order `tau^2` where the
+/// optical depth `tau` is 0.01 (`canonical-1d` target T 0.99: reported either way, not required);
+/// `rm_is1_cv2` takes the in-scattered
+/// radiance at the far end of each step, which is exact where that radiance is the same everywhere
+/// (the white furnace, `c0`) and the transmittance of the homogeneous box is exact.
+pub fn control_exemption(estimator: &str, testbed: &str, variant: &str) -> Option<&'static str> {
+    let id = estimator.split('[').next().unwrap_or(estimator);
+    match (id, testbed) {
+        ("bidirectional_is_sn", _) if variant.ends_with("-lns") => {
+            Some("not a control here: its L_ns estimate is the unnormalised (unbiased) one; only L_r is self-normalised")
+        }
+        ("ray_marching", "canonical-1d") if variant.starts_with("constant-") => {
+            Some("not a control here: with constant extinction the marched optical depth is exact")
+        }
+        ("ray_marching", "canonical-1d") if variant.ends_with("-T0.99") => Some(
+            "a weak control here (reported, not required): optical depth 0.01, so the Jensen bias of the marched estimate, about T Var(tau_hat) / 2, is of order 1e-5 relative",
+        ),
+        ("ray_marching" | "rm_is1_cv2", "gradient-box") if variant == "albedo-0" => {
+            Some("not a control here: homogeneous and non-scattering, the marched optical depth is exact")
+        }
+        ("rm_is1_cv2", "gradient-box") if variant == "furnace" => Some(
+            "not a control here: in the white furnace the in-scattered radiance is c0 everywhere, so taking it at the step's end is exact",
+        ),
+        _ => None,
+    }
+}
+
+/// The repetitions `R'` at which the detectable relative bias `d` (measured at `reps`) would reach
+/// [`TARGET_REL_BIAS`], when a share `est_share` of the tested variance comes from the estimates
+/// (the rest from a stored reference, which more repetitions do not shrink): `d^2 (s R / R' + 1 - s)
+/// = target^2`. `None` when the reference alone is too noisy or `d` is unknown.
+pub fn reps_for_target(d: f64, reps: usize, est_share: f64) -> Option<f64> {
+    if !d.is_finite() || d <= 0.0 {
+        return None;
+    }
+    let s = est_share.clamp(0.0, 1.0);
+    let room = TARGET_REL_BIAS * TARGET_REL_BIAS - (1.0 - s) * d * d;
+    // Rounded up, ignoring the last-bit noise of the division.
+    (room > 0.0).then(|| (reps as f64 * s * d * d / room - 1e-9).ceil().max(2.0))
+}
+
+/// The measured relative bias, its standard error, and the share of the tested variance that comes
+/// from the estimates (1 for exact references).
+fn measured(cell: &CellResult, reference: &Reference) -> (f64, f64, f64) {
+    let (mut dev, mut var, mut ref_var, mut ref_sum) = (0.0, 0.0, 0.0, 0.0);
+    for (i, m) in cell.moments.iter().enumerate() {
+        for (c, mc) in m.iter().enumerate() {
+            let (r, rse) = (reference.value[i][c], reference.std_err[i][c]);
+            dev += mc.mean() - r;
+            var += mc.std_err() * mc.std_err();
+            ref_var += rse * rse;
+            ref_sum += r.abs();
+        }
+    }
+    let share = if var + ref_var > 0.0 { var / (var + ref_var) } else { 1.0 };
+    (dev / ref_sum, (var + ref_var).sqrt() / ref_sum, share)
+}
+
+/// The SPEC §6 tests of a cell combined into one decision: the Holm test (per-integral t or Welch)
+/// where it is valid and the pooled z-test, Bonferroni over the two (`p = min(1, 2 min(p_holm,
+/// p_pooled))`, so the family-wise alpha stays 1e-3): the Holm test sees a bias in a few integrals,
+/// the pooled one a small bias spread over all of them, which at a few repetitions per integral only
+/// the pooled test resolves. The detectable bias is the smaller of the two (each at its own alpha).
+/// Returns (test name, p-value, detectable relative bias); the p-value is NaN when neither ran.
+pub fn combined(tests: &[TestRow]) -> (String, f64, f64) {
+    let holm = tests.iter().find(|t| t.test.starts_with("holm") && t.verdict != "untested" && !t.p_value.is_nan());
+    let valid = |name: &str| tests.iter().find(|t| t.test == name && !t.p_value.is_nan());
+    let pooled = valid("pooled_z_seq").or_else(|| valid("pooled_z"));
+    match (holm, pooled) {
+        (Some(h), Some(z)) => (
+            format!("{}+{}", h.test, z.test),
+            (2.0 * h.p_value.min(z.p_value)).min(1.0),
+            h.detectable_rel_bias.min(z.detectable_rel_bias),
+        ),
+        (Some(t), None) | (None, Some(t)) => (t.test.clone(), t.p_value, t.detectable_rel_bias),
+        (None, None) => (String::new(), f64::NAN, f64::NAN),
+    }
+}
+
+/// The pooled z-test for test beds whose integrals come in sequences that share adaptive state
+/// (`sequence_length > 1`: the frames of one `envmap-sequence` pixel, the whole image of
+/// `gradient-box` and `checker-image`): the harness's `pooled_z` takes integrals as independent,
+/// which the shared state breaks, so here the standard errors of one sequence's integrals are
+/// summed (taken as fully correlated, the worst case) before sequences are combined as independent.
+/// `None` when nothing varies.
+pub fn pooled_over_sequences(cell: &CellResult, reference: &Reference, sequence: usize) -> Option<TestRow> {
+    let bound = match &reference.kind {
+        ReferenceKind::Exact { bound, .. } => Some(bound.max(0.0)),
+        ReferenceKind::Stored { .. } => None,
+    };
+    let (mut dev, mut var, mut ref_sum, mut seq_se) = (0.0, 0.0, 0.0, 0.0);
+    for (i, m) in cell.moments.iter().enumerate() {
+        for (c, mc) in m.iter().enumerate() {
+            let (r, rse) = (reference.value[i][c], reference.std_err[i][c]);
+            // As the harness: an exact reference is known to within its bound.
+            let r_test = bound.map_or(r, |b| mc.mean().clamp(r - b, r + b));
+            dev += mc.mean() - r_test;
+            seq_se += (mc.std_err() * mc.std_err() + rse * rse).sqrt();
+            ref_sum += r.abs();
+        }
+        if (i + 1) % sequence.max(1) == 0 || i + 1 == cell.moments.len() {
+            var += seq_se * seq_se;
+            seq_se = 0.0;
+        }
+    }
+    if !(var > 0.0 && ref_sum > 0.0) {
+        return None;
+    }
+    let z = z_test(dev, var.sqrt(), 0.0);
+    let mut row = unbiasedness(cell, reference, Bias::Unbiased).into_iter().find(|t| t.test == "pooled_z")?;
+    row.test = "pooled_z_seq".into();
+    row.statistic = z.statistic;
+    row.p_value = z.p_value;
+    row.verdict = if z.p_value < UNBIASEDNESS_ALPHA { "biased" } else { "pass" }.into();
+    row.detectable_rel_bias = detectable_shift(var.sqrt(), UNBIASEDNESS_ALPHA, POWER) / ref_sum;
+    Some(row)
+}
+
+/// The row of one cell: its SPEC §6 tests (also returned, for summary.json) and the judgement.
+pub fn row(cell: &CellResult, reference: &Reference, bias: Bias, sequence: usize) -> (Row, Vec<TestRow>) {
+    let mut tests = unbiasedness(cell, reference, bias);
+    if sequence > 1 {
+        // The independent-integral pooled test stays in summary.json (and the note) but does not
+        // decide: `combined` prefers `pooled_z_seq`.
+        if let Some(mut t) = pooled_over_sequences(cell, reference, sequence) {
+            t.claim = bias.name().into();
+            t.agrees = match bias {
+                Bias::Unbiased => t.verdict != "biased",
+                Bias::Biased => t.verdict == "biased",
+                Bias::Consistent => true,
+            };
+            tests.push(t);
+        }
+    }
+    let (rel_bias, rel_bias_se, share) = measured(cell, reference);
+    let k = &cell.key;
+    let (test, p_value, detectable) = combined(&tests);
+    let verdict = if p_value.is_nan() {
+        "untested"
+    } else if p_value < UNBIASEDNESS_ALPHA {
+        "biased"
+    } else {
+        "pass"
+    };
+    let mut r = Row {
+        estimator: k.estimator.clone(),
+        testbed: k.testbed.clone(),
+        variant: k.variant.clone(),
+        paper_bias: bias.name().into(),
+        test,
+        p_value,
+        verdict: verdict.into(),
+        detectable_rel_bias: detectable,
+        reps: k.reps,
+        reps_for_target: None,
+        budget: k.budget.amount,
+        rel_bias,
+        rel_bias_se,
+        agrees: None,
+        note: String::new(),
+    };
+    r.reps_for_target = reps_for_target(r.detectable_rel_bias, r.reps, share);
+    judge(&mut r);
+    if let (true, Some(z)) = (r.test.contains("pooled_z_seq"), tests.iter().find(|t| t.test == "pooled_z")) {
+        r.note.push_str(&format!(
+            "; pooled z taking integrals as independent (not valid under shared state): p = {:.2e}",
+            z.p_value
+        ));
+    }
+    (r, tests)
+}
+
+fn pct(x: f64) -> String {
+    format!("{}%", crate::report::sig(100.0 * x, 2))
+}
+
+/// Fills `agrees` and `note`: unbiased ids must pass, controls must be flagged (except where
+/// [`control_exemption`] says why they are not a control), consistent ids are reported.
+pub fn judge(r: &mut Row) {
+    let measured = format!("measured relative bias {} ± {}", pct(r.rel_bias), pct(r.rel_bias_se));
+    let p = if r.p_value.is_nan() { "-".to_string() } else { format!("{:.2e}", r.p_value) };
+    let exempt = control_exemption(&r.estimator, &r.testbed, &r.variant);
+    let weak = exempt.is_some_and(|w| w.starts_with("a weak control"));
+    // Exempt controls are expected to pass (unbiased by construction there), weak ones either way.
+    let expect = match (r.paper_bias.as_str(), exempt) {
+        ("biased", None) => "biased",
+        ("biased", Some(_)) if weak => "either",
+        ("biased", Some(_)) => "unbiased",
+        (claim, _) => claim,
+    };
+    let (agrees, mut note) = match (expect, r.verdict.as_str()) {
+        (_, "not-run") => (None, r.note.clone()),
+        (_, "untested") => {
+            (None, "no valid test: every integral too skewed for a t-test and no pooled test".to_string())
+        }
+        ("consistent", "biased") => {
+            (None, format!("flagged ({} p = {p}): reported as consistent only (SPEC §6); {measured}", r.test))
+        }
+        ("consistent", _) => (None, format!("no bias detected (consistent id); {measured}")),
+        ("either", v) => (None, format!("{v} ({} p = {p}); {measured}", r.test)),
+        ("biased", "biased") => (Some(true), format!("control flagged ({} p = {p}); {measured}", r.test)),
+        ("biased", _) => (
+            Some(false),
+            format!("control NOT flagged ({} p = {p}); {measured}, detectable {}", r.test, pct(r.detectable_rel_bias)),
+        ),
+        (_, "biased") => (Some(false), format!("the claim of unbiasedness FAILS here: {} p = {p}; {measured}", r.test)),
+        _ => (Some(true), format!("no bias detected; {measured}")),
+    };
+    if let Some(why) = exempt {
+        note = format!("{why}; {note}");
+    }
+    if r.verdict != "not-run" && r.verdict != "untested" {
+        let reach = if r.detectable_rel_bias <= TARGET_REL_BIAS {
+            "0.1% resolved".to_string()
+        } else {
+            match r.reps_for_target {
+                Some(n) => format!("0.1% not resolved: needs about {} reps", crate::report::sig(n, 2)),
+                None => "0.1% not resolvable: the stored reference's own error is larger".to_string(),
+            }
+        };
+        note = format!("{note}; {reach}");
+    }
+    r.agrees = agrees;
+    r.note = note;
+}
+
+/// A row for a pair that was not run, with the reason.
+pub fn not_run(estimator: &str, testbed: &str, variant: &str, bias: Bias, reason: &str) -> Row {
+    let mut r = Row {
+        estimator: estimator.into(),
+        testbed: testbed.into(),
+        variant: variant.into(),
+        paper_bias: bias.name().into(),
+        test: String::new(),
+        p_value: f64::NAN,
+        verdict: "not-run".into(),
+        detectable_rel_bias: f64::NAN,
+        reps: 0,
+        reps_for_target: None,
+        budget: 0,
+        rel_bias: f64::NAN,
+        rel_bias_se: f64::NAN,
+        agrees: None,
+        note: format!("not run: {reason}"),
+    };
+    judge(&mut r);
+    r
+}
+
+/// Writes `unbiasedness.csv`.
+pub fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r).map_err(|e| crate::error::HarnessError::write(path, e))?;
+    }
+    let bytes = w.into_inner().map_err(|e| crate::error::HarnessError::write(path, e))?;
+    write_atomic(path, &bytes)
+}
+
+/// The `paper` entries: one per row (the paper's claim against the measured verdict), then one per
+/// control id (flagged on every test bed where it is a control) and one over all unbiased ids.
+pub fn claims(rows: &[Row]) -> Vec<Claim> {
+    let mut out: Vec<Claim> = rows
+        .iter()
+        .map(|r| Claim {
+            testbed: format!("{}/{}", r.testbed, r.variant),
+            claim: format!("{} is {} (registry / paper)", r.estimator, r.paper_bias),
+            paper_value: None,
+            our_value: (!r.p_value.is_nan()).then_some(r.p_value),
+            held: r.agrees,
+            note: format!("{} {}: {}", r.test, r.verdict, r.note),
+        })
+        .collect();
+    let mut controls: Vec<&str> = Vec::new();
+    for r in rows.iter().filter(|r| r.paper_bias == "biased") {
+        if !controls.contains(&r.estimator.as_str()) {
+            controls.push(&r.estimator);
+        }
+    }
+    for c in controls {
+        let mine: Vec<&Row> = rows
+            .iter()
+            .filter(|r| {
+                r.estimator == c && r.verdict != "not-run" && control_exemption(c, &r.testbed, &r.variant).is_none()
+            })
+            .collect();
+        let missed: Vec<String> =
+            mine.iter().filter(|r| r.agrees != Some(true)).map(|r| format!("{}/{}", r.testbed, r.variant)).collect();
+        out.push(Claim {
+            testbed: "all".into(),
+            claim: format!("harness (SPEC §6): the biased control {c} is flagged on every test bed it runs on"),
+            paper_value: None,
+            our_value: Some(mine.len() as f64 - missed.len() as f64),
+            held: (!mine.is_empty()).then_some(missed.is_empty()),
+            note: if missed.is_empty() {
+                format!("flagged on all {} test beds", mine.len())
+            } else {
+                format!("NOT flagged (or untested) on: {}", missed.join(", "))
+            },
+        });
+    }
+    let unbiased: Vec<&Row> = rows.iter().filter(|r| r.paper_bias == "unbiased" && r.verdict != "not-run").collect();
+    let failed: Vec<String> = unbiased
+        .iter()
+        .filter(|r| r.agrees == Some(false))
+        .map(|r| format!("{} on {}/{}", r.estimator, r.testbed, r.variant))
+        .collect();
+    let untested = unbiased.iter().filter(|r| r.agrees.is_none()).count();
+    out.push(Claim {
+        testbed: "all".into(),
+        claim: "papers: every estimator they call unbiased passes the SPEC §6 test on every test bed".into(),
+        paper_value: None,
+        our_value: Some((unbiased.len() - failed.len() - untested) as f64),
+        held: Some(failed.is_empty()),
+        note: format!(
+            "{} rows, {} flagged{}, {untested} without a valid test",
+            unbiased.len(),
+            failed.len(),
+            if failed.is_empty() { String::new() } else { format!(" ({})", failed.join("; ")) }
+        ),
+    });
+    out
+}
+
+/// The table as markdown (report and README).
+pub fn markdown(rows: &[Row]) -> String {
+    let body: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            let num = |x: f64| if x.is_nan() { "-".to_string() } else { crate::report::sig(x, 2) };
+            vec![
+                r.estimator.clone(),
+                format!("{}/{}", r.testbed, r.variant),
+                r.paper_bias.clone(),
+                r.test.clone(),
+                if r.p_value.is_nan() { "-".into() } else { format!("{:.1e}", r.p_value) },
+                r.verdict.clone(),
+                if r.detectable_rel_bias.is_nan() { "-".into() } else { pct(r.detectable_rel_bias) },
+                r.reps.to_string(),
+                r.reps_for_target.map_or("-".into(), num),
+                match r.agrees {
+                    Some(true) => "yes".into(),
+                    Some(false) => "NO".into(),
+                    None => "-".into(),
+                },
+                r.note.clone(),
+            ]
+        })
+        .collect();
+    let header = [
+        "estimator",
+        "test bed",
+        "paper",
+        "test",
+        "p",
+        "verdict",
+        "detectable",
+        "reps",
+        "reps for 0.1%",
+        "agrees",
+        "note",
+    ];
+    crate::report::markdown_table(&header, &body)
+}
+
+#[cfg(test)]
+#[path = "unbiasedness_tests.rs"]
+mod tests;
