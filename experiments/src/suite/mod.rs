@@ -28,6 +28,7 @@ pub mod transmittance;
 pub mod transmittance_post;
 pub mod unbiasedness;
 pub mod unbiasedness_run;
+pub mod unbiasedness_stats;
 pub mod unbiasedness_table;
 pub mod variance_claims;
 
