@@ -27,6 +27,7 @@ pub mod surface_smc;
 pub mod transmittance;
 pub mod transmittance_post;
 pub mod unbiasedness;
+pub mod unbiasedness_reps;
 pub mod unbiasedness_run;
 pub mod unbiasedness_stats;
 pub mod unbiasedness_table;

@@ -8,6 +8,7 @@
 //! first part only. `--threads` is honoured through the run's thread count (`meta.threads`).
 
 use super::unbiasedness::{parts, Row};
+use super::unbiasedness_reps::pooled_over_repetitions;
 use super::unbiasedness_table as table;
 use crate::config::Sweep;
 use crate::error::Result;
@@ -20,20 +21,29 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The rows of a finished plan's cells (and their tests, when `with_tests`: the harness already
-/// added the first part's).
-fn rows_of(plan: &Plan, run: &RunResults, report: &mut RunReport, with_tests: bool) -> Vec<Row> {
+/// added the first part's). Whole-image sequences also get `pooled_z_rep`
+/// ([`super::unbiasedness_reps`]), recomputed on `threads` threads.
+fn rows_of(plan: &Plan, run: &RunResults, report: &mut RunReport, with_tests: bool) -> Result<Vec<Row>> {
+    let threads = report.meta.threads;
     let mut rows = Vec::new();
     for (bi, ei, cell) in &run.cells {
         let bed = plan.beds[*bi].bed.as_ref();
         let reference = bed.reference();
-        let (row, tests) = table::row(cell, reference, plan.estimators[*ei].entry.bias, bed.sequence_length());
+        let bias = plan.estimators[*ei].entry.bias;
+        let mut tests = table::tests_of(cell, reference, bias, bed.sequence_length());
+        if let Some(template) = tests.iter().find(|t| t.test == "pooled_z").cloned() {
+            if let Some(mut t) = pooled_over_repetitions(plan, *bi, *ei, threads, &template)? {
+                table::set_claim(&mut t, bias);
+                tests.push(t);
+            }
+        }
+        rows.push(table::row_from_tests(cell, reference, bias, &tests));
         if with_tests {
             report.rows.push(summarize(cell, reference));
             report.tests.extend(tests);
         }
-        rows.push(row);
     }
-    rows
+    Ok(rows)
 }
 
 /// The plans of a part's sweep. A pair whose configuration is invalid on a test bed (the terminating
@@ -76,7 +86,7 @@ pub fn post(
 ) -> Result<Vec<PathBuf>> {
     let all = parts(plan.sweep.mode);
     let reps_override = (plan.sweep.reps != all[0].sweep.reps).then_some(plan.sweep.reps);
-    let mut rows = rows_of(plan, run, report, false);
+    let mut rows = rows_of(plan, run, report, false)?;
     let mut notes = vec![format!("part {} ({} reps)", all[0].name, plan.sweep.reps)];
     for part in all.into_iter().skip(1) {
         let mut sweep = part.sweep;
@@ -84,7 +94,7 @@ pub fn post(
         if let Some(r) = reps_override {
             sweep.reps = r;
         }
-        notes.push(format!("part {} ({} reps)", part.name, sweep.reps));
+        let label = format!("part {} ({} reps)", part.name, sweep.reps);
         let t0 = Instant::now();
         let (plans, invalid) = prepare_valid(sweep)?;
         rows.extend(invalid);
@@ -97,7 +107,7 @@ pub fn post(
             };
             let r = runner::run(&p, &opts)?;
             progress.finish();
-            rows.extend(rows_of(&p, &r, report, true));
+            rows.extend(rows_of(&p, &r, report, true)?);
             report.skipped.extend(p.skipped.iter().cloned());
             for e in &p.estimators {
                 if !report.labels.iter().any(|(n, _)| n == &e.name) {
@@ -105,7 +115,7 @@ pub fn post(
                 }
             }
         }
-        notes.last_mut().map(|n| n.push_str(&format!(" {:.1} s", t0.elapsed().as_secs_f64())));
+        notes.push(format!("{label} {:.1} s", t0.elapsed().as_secs_f64()));
     }
     report.meta.notes.push(format!("unbiasedness parts: {}", notes.join(", ")));
     table::write_csv(&results.join("unbiasedness.csv"), &rows)?;

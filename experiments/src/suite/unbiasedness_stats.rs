@@ -51,7 +51,7 @@ pub fn measured(cell: &CellResult, reference: &Reference) -> (f64, f64, f64) {
 pub fn combined(tests: &[TestRow]) -> (String, f64, f64) {
     let holm = tests.iter().find(|t| t.test.starts_with("holm") && t.verdict != "untested" && !t.p_value.is_nan());
     let valid = |name: &str| tests.iter().find(|t| t.test == name && !t.p_value.is_nan());
-    let pooled = valid("pooled_z_seq").or_else(|| valid("pooled_z"));
+    let pooled = valid("pooled_z_rep").or_else(|| valid("pooled_z_seq")).or_else(|| valid("pooled_z"));
     match (holm, pooled) {
         (Some(h), Some(z)) => (
             format!("{}+{}", h.test, z.test),

@@ -84,25 +84,41 @@ pub fn control_exemption(estimator: &str, testbed: &str, variant: &str) -> Optio
     }
 }
 
-/// The row of one cell: its SPEC §6 tests (also returned, for summary.json) and the judgement.
-pub fn row(cell: &CellResult, reference: &Reference, bias: Bias, sequence: usize) -> (Row, Vec<TestRow>) {
+/// Sets a test row's claim and whether its verdict agrees with it.
+pub fn set_claim(t: &mut TestRow, bias: Bias) {
+    t.claim = bias.name().into();
+    t.agrees = match bias {
+        Bias::Unbiased => t.verdict != "biased",
+        Bias::Biased => t.verdict == "biased",
+        Bias::Consistent => true,
+    };
+}
+
+/// The SPEC §6 tests of one cell: the harness's, plus `pooled_z_seq` where integrals come in
+/// sequences of `sequence > 1` (the independent-integral `pooled_z` stays in summary.json and in
+/// the note but does not decide: [`combined`] prefers the sequence-aware tests).
+pub fn tests_of(cell: &CellResult, reference: &Reference, bias: Bias, sequence: usize) -> Vec<TestRow> {
     let mut tests = unbiasedness(cell, reference, bias);
     if sequence > 1 {
-        // The independent-integral pooled test stays in summary.json (and the note) but does not
-        // decide: `combined` prefers `pooled_z_seq`.
         if let Some(mut t) = pooled_over_sequences(cell, reference, sequence) {
-            t.claim = bias.name().into();
-            t.agrees = match bias {
-                Bias::Unbiased => t.verdict != "biased",
-                Bias::Biased => t.verdict == "biased",
-                Bias::Consistent => true,
-            };
+            set_claim(&mut t, bias);
             tests.push(t);
         }
     }
+    tests
+}
+
+/// The row of one cell: its SPEC §6 tests (also returned, for summary.json) and the judgement.
+pub fn row(cell: &CellResult, reference: &Reference, bias: Bias, sequence: usize) -> (Row, Vec<TestRow>) {
+    let tests = tests_of(cell, reference, bias, sequence);
+    (row_from_tests(cell, reference, bias, &tests), tests)
+}
+
+/// The row of one cell from its tests (see [`tests_of`]; more may be added, e.g. `pooled_z_rep`).
+pub fn row_from_tests(cell: &CellResult, reference: &Reference, bias: Bias, tests: &[TestRow]) -> Row {
     let (rel_bias, rel_bias_se, share) = measured(cell, reference);
     let k = &cell.key;
-    let (test, p_value, detectable) = combined(&tests);
+    let (test, p_value, detectable) = combined(tests);
     let verdict = if p_value.is_nan() {
         "untested"
     } else if p_value < UNBIASEDNESS_ALPHA {
@@ -129,13 +145,14 @@ pub fn row(cell: &CellResult, reference: &Reference, bias: Bias, sequence: usize
     };
     r.reps_for_target = reps_for_target(r.detectable_rel_bias, r.reps, share);
     judge(&mut r);
-    if let (true, Some(z)) = (r.test.contains("pooled_z_seq"), tests.iter().find(|t| t.test == "pooled_z")) {
+    let shared = r.test.contains("pooled_z_seq") || r.test.contains("pooled_z_rep");
+    if let (true, Some(z)) = (shared, tests.iter().find(|t| t.test == "pooled_z")) {
         r.note.push_str(&format!(
             "; pooled z taking integrals as independent (not valid under shared state): p = {:.2e}",
             z.p_value
         ));
     }
-    (r, tests)
+    r
 }
 
 fn pct(x: f64) -> String {
