@@ -190,15 +190,28 @@ pub fn parts(mode: Mode) -> Vec<Part> {
     ]);
     scatter.push(marching_control());
     let multiple_beds = ["eq21-medium", "perlin-medium"].iter().map(|m| bed(m, "multiple", Params::new())).collect();
-    let mut multiple = ests(&["spm_terminating", "spm_nonterminating", "spm_adaptive", "delta_tracking"]);
+    // Every medium id on the radiance variants: the transmittance-only trackers are skipped there
+    // with their reason (summary.json `skipped`), not left out.
+    let radiance_ids = [
+        "spm_terminating",
+        "spm_nonterminating",
+        "spm_adaptive",
+        "delta_tracking",
+        "ratio_tracking",
+        "residual_ratio_tracking",
+        "double_particle",
+        "single_particle_terminating",
+        "single_particle_nonterminating",
+    ];
+    let mut multiple = ests(&radiance_ids);
     multiple.push(marching_control());
     let boxes = estimators::testbeds::gradient_box::ENTRY
         .variants
         .iter()
         .map(|v| bed("gradient-box", v, Params::new()))
         .collect();
-    let box_ests =
-        ests(&["is0_cv0", "is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1", "is1_cv2", "delta_tracking", "rm_is1_cv2"]);
+    let mut box_ests = ests(&["is0_cv0", "is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1", "is1_cv2", "rm_is1_cv2"]);
+    box_ests.extend(multiple.iter().cloned());
     vec![
         part("surface", mode, surface_beds, surface, 64, (512, 8192)),
         part(
@@ -207,14 +220,14 @@ pub fn parts(mode: Mode) -> Vec<Part> {
             ["specular", "mixed", "specular-lns", "mixed-lns"].iter().map(|v| env(v)).collect(),
             env_ests,
             4,
-            (2000, 20_000),
+            (1500, 20_000),
         ),
         part("image", mode, image, ests(&["uniform_image", "pmc_ip", "threshold_image"]), 10, (32, 256)),
         part("tracking", mode, tracking_beds, tracking_ests.clone(), 4, (1024, 32_768)),
         part("canonical", mode, canonical, tracking_ests, 4, (16_384, 65_536)),
         part("single-scatter", mode, scatter_beds, scatter, 4, (1024, 8192)),
         part("multiple", mode, multiple_beds, multiple, 4, (64, 256)),
-        part("gradient-box", mode, boxes, box_ests, 16, (64, 256)),
+        part("gradient-box", mode, boxes, box_ests, 16, (256, 1024)),
     ]
 }
 
