@@ -273,12 +273,14 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
             mine.iter().filter(|r| r.agrees != Some(true)).map(|r| format!("{}/{}", r.testbed, r.variant)).collect();
         out.push(Claim {
             testbed: "all".into(),
-            claim: format!("harness (SPEC §6): the biased control {c} is flagged on every test bed it runs on"),
+            claim: format!(
+                "harness (SPEC §6): the biased control {c} is flagged on every test bed where it is a control"
+            ),
             paper_value: None,
             our_value: Some(mine.len() as f64 - missed.len() as f64),
             held: (!mine.is_empty()).then_some(missed.is_empty()),
             note: if missed.is_empty() {
-                format!("flagged on all {} test beds", mine.len())
+                format!("flagged on all {} test beds (rows with an exemption reason excluded)", mine.len())
             } else {
                 format!("NOT flagged (or untested) on: {}", missed.join(", "))
             },
