@@ -30,6 +30,11 @@ pub mod stability_numeric;
 pub mod surface_smc;
 pub mod transmittance;
 pub mod transmittance_post;
+pub mod unbiasedness;
+pub mod unbiasedness_reps;
+pub mod unbiasedness_run;
+pub mod unbiasedness_stats;
+pub mod unbiasedness_table;
 pub mod variance_claims;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};
@@ -74,6 +79,7 @@ pub static EXPERIMENTS: &[&ExperimentDef] = &[
     &envmap_smc::DEF,
     &single_scatter::DEF,
     &canonical_sweep::DEF,
+    &unbiasedness::DEF,
     &stability::DEF,
 ];
 
