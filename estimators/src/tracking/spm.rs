@@ -1,6 +1,7 @@
 //! Particle tracing of multiple scattering under the environment light with the Single Particle
 //! Model (paper 002 §4.1, `SimulateParticle`): camera importons, constant `sigma_samp`
-//! (parameter, default 1), Rayleigh scattering, environment radiance collected on exit.
+//! (parameter, default 1), scattering by the test bed's phase function (Rayleigh in paper 002's
+//! media, isotropic or Henyey-Greenstein in `gradient-box`), environment radiance collected on exit.
 //! `spm_terminating` (Eq. 9, `q_scat = a r`, `q_tran = |1 - r|`; refuses `r > 2/(a+1)`),
 //! `spm_nonterminating` (Eq. 12), `spm_adaptive` (non-terminating when `r < 1` or
 //! `q_scat + q_tran > 1`, terminating otherwise).
@@ -11,6 +12,7 @@ use crate::accumulate::RgbMean;
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::phase::Phase;
 use crate::registry::EstimatorEntry;
 use crate::rng::StreamRng;
 use crate::samplers::rayleigh;
@@ -39,6 +41,7 @@ pub fn trace(
     let ray = *probe.ray();
     let (mut pos, mut dir, mut e) = (ray.origin, ray.dir, 1.0f64);
     let a = probe.albedo();
+    let phase = probe.phase();
     loop {
         let Some((t0, t1)) = probe.clip(pos, dir) else { return Ok(probe.environment(dir) * e) };
         let mut s = t0;
@@ -69,7 +72,12 @@ pub fn trace(
             if xi < q_scat {
                 e *= a * r / q_scat;
                 pos = p;
-                dir = rayleigh::sample(dir, rng);
+                // Importance sampling the phase function exactly, so its value cancels in the
+                // weight. Rayleigh keeps its own sampler (the paper 002 media's streams as pinned).
+                dir = match phase {
+                    Phase::Rayleigh => rayleigh::sample(dir, rng),
+                    other => other.sample(dir, rng).0,
+                };
                 break;
             } else if xi < q_scat + q_tran {
                 e *= (1.0 - r) / q_tran;
