@@ -13,13 +13,13 @@ pub mod residual_ratio_tracking;
 pub mod single_particle;
 pub mod spm;
 
-use crate::accumulate::RgbMean;
 use crate::error::{ConfigError, EstimateError};
 use crate::math::{Rgb, Vec3};
 use crate::media::moments::{tracker_moments, EstimateMoments};
 use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
+use crate::stats::NeumaierSum;
 use crate::task::{MediumProbe, Task};
 use crate::testbed::{MediumQuantity, TestBed};
 use rand::Rng;
@@ -146,12 +146,15 @@ pub fn transmittance(
         probe.start_sample();
         return Ok(weight);
     };
-    let mut mean = RgbMean::new();
+    // One compensated sum (the channels of a transmittance are equal): the same value as the
+    // first channel of an `RgbMean`, without summing three copies per ray.
+    let (mut sum, mut n) = (NeumaierSum::new(), 0u64);
     while task.more() {
         probe.start_sample();
-        mean.push(Rgb::splat(one(&probe, seg, rng)?));
+        sum.add(one(&probe, seg, rng)?);
+        n += 1;
     }
-    Ok(weight * mean.mean().0[0])
+    Ok(weight * if n == 0 { 0.0 } else { sum.value() / n as f64 })
 }
 
 /// The exact moments of one tracker ray on `task`'s transmittance integral
