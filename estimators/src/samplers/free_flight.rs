@@ -64,6 +64,7 @@ impl SamplingDensity {
         SamplingDensity { knots, interp: self.interp }
     }
     /// The density at `s`.
+    #[inline]
     pub fn eval(&self, s: f64) -> f64 {
         let (t, v) = (self.t(), self.v());
         let n = t.len();
@@ -110,14 +111,19 @@ impl SamplingDensity {
     }
     /// The free-flight end point: the `s > start` with `int_start^s sigma_samp = tau`
     /// (`tau = -ln(1 - xi)`), or `+inf` when the density never accumulates `tau`.
-    pub fn solve(&self, start: f64, mut tau: f64) -> f64 {
+    #[inline]
+    pub fn solve(&self, start: f64, tau: f64) -> f64 {
         if let Knots::One([t0], [v0]) = self.knots {
             if start >= t0 {
-                // The last (infinite) piece of the loop below, taken directly: same arithmetic.
+                // The last (infinite) piece of `solve_pieces`, taken directly: the same arithmetic.
                 let x = tau / v0;
                 return if x.is_finite() { start + x } else { f64::INFINITY };
             }
         }
+        self.solve_pieces(start, tau)
+    }
+    /// [`SamplingDensity::solve`] piece by piece.
+    fn solve_pieces(&self, start: f64, mut tau: f64) -> f64 {
         for j in 0..=self.t().len() {
             let (s0, s1, v0, k) = self.piece(j);
             if s1 <= start {
@@ -137,6 +143,7 @@ impl SamplingDensity {
         f64::INFINITY
     }
     /// Samples a free flight from `start` with one uniform number `xi` in `[0, 1)`.
+    #[inline]
     pub fn sample(&self, start: f64, xi: f64) -> f64 {
         self.solve(start, -(-xi).ln_1p())
     }
