@@ -5,8 +5,10 @@
 //!
 //! Every bench times itself through `iter_custom` and counts the fetches its estimates made, so
 //! after the criterion run the bench prints, per tracker, its fetch steps per second as a ratio to
-//! the bare fetch rate measured in the same run (target >= 0.7: the fetch is the work). Cheap
-//! (approximate-extinction) fetches are shown apart and are not counted as steps.
+//! the bare fetch rate (target >= 0.7: the fetch is the work). The floor of each ratio is the bare
+//! loop timed for 0.3 s just before and just after that tracker's bench (their mean), so a change
+//! of machine load during the run does not leak into the ratios. Cheap (approximate-extinction)
+//! fetches are shown apart and are not counted as steps.
 //! Run with `cargo bench -p estimators --bench tracking`.
 
 use criterion::{black_box, Criterion, Throughput};
@@ -58,12 +60,32 @@ fn bed(id: &str, variant: &str) -> Box<dyn TestBed> {
     (entry.build)(variant, &Params::new()).expect("builds")
 }
 
-/// Bare fetches: `sigma_t` at 1024 random points along the central ray (where the trackers step,
-/// so both see the same noise-table and branch behaviour), in a tight loop.
+/// 1024 random points along the central ray (where the trackers step, so the bare loop and the
+/// trackers see the same noise-table and branch behaviour).
+fn fetch_points() -> Vec<Vec3> {
+    let mut rng = stream(7, "bench fetch points");
+    (0..1024).map(|_| Vec3::new(0.0, 0.0, rng.gen_range(0.0..20.0))).collect()
+}
+
+/// Nanoseconds per bare fetch over about 0.3 s of the tight loop (the floor beside one tracker).
+fn floor_ns(bed: &dyn TestBed) -> f64 {
+    let (scene, points) = (bed.medium().expect("medium"), fetch_points());
+    let (t0, mut n) = (Instant::now(), 0u64);
+    while t0.elapsed() < Duration::from_millis(300) {
+        let mut s = 0.0;
+        for p in &points {
+            s += scene.sigma_t(black_box(*p));
+        }
+        black_box(s);
+        n += points.len() as u64;
+    }
+    t0.elapsed().as_nanos() as f64 / n as f64
+}
+
+/// Bare fetches: `sigma_t` at the [`fetch_points`] in a tight loop.
 fn bare_fetch(c: &mut Criterion, medium: &str, bed: &dyn TestBed, tally: &mut Tally) {
     let scene = bed.medium().expect("medium");
-    let mut rng = stream(7, "bench fetch points");
-    let points: Vec<Vec3> = (0..1024).map(|_| Vec3::new(0.0, 0.0, rng.gen_range(0.0..20.0))).collect();
+    let points = fetch_points();
     let mut group = c.benchmark_group(format!("fetch/{medium}"));
     group.throughput(Throughput::Elements(points.len() as u64));
     group.bench_function("sigma_t_x1024", |b| {
@@ -123,14 +145,17 @@ fn main() {
         let bed = bed(medium, "central-ray");
         let mut floor = Tally::default();
         bare_fetch(&mut c, medium, bed.as_ref(), &mut floor);
+        println!("{medium}: bare fetch {:.2} ns (criterion run)", floor.ns_per_fetch());
         for (label, id, params) in TRACKERS {
+            let before = floor_ns(bed.as_ref());
             let t = tracker(&mut c, medium, bed.as_ref(), label, id, params);
-            table.push((medium, *label, floor.ns_per_fetch(), t));
+            let after = floor_ns(bed.as_ref());
+            table.push((medium, *label, 0.5 * (before + after), t));
         }
     }
     c.final_summary();
     if table.iter().all(|(_, _, floor, t)| floor.is_finite() && t.fetches > 0) {
-        println!("\ntracker fetch steps per second vs bare fetches per second (same run; target >= 0.70)");
+        println!("\ntracker fetch steps per second vs bare fetches per second (floor timed beside each tracker; target >= 0.70)");
         println!(
             "{:<15} {:<32} {:>12} {:>12} {:>10} {:>8}",
             "medium", "tracker", "ns/fetch", "bare ns", "cheap/fch", "ratio"

@@ -68,6 +68,9 @@ const PILOT_SEQUENCES: usize = 64;
 /// One cell's fixed inputs: which pair, which budget, and the sample count a fetch budget became.
 struct CellRun<'a> {
     plan: &'a Plan,
+    /// The test bed's label (stream key and error messages), formatted once per cell rather than
+    /// once per sequence (it was a third of the harness's own work per estimate).
+    label: &'a str,
     bi: usize,
     ei: usize,
     budget: Budget,
@@ -77,13 +80,12 @@ struct CellRun<'a> {
 
 /// One sequence of integrals (`frames` long, from integral `first`) estimated on its own stream.
 fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> Result<()> {
-    let CellRun { plan, bi, ei, budget, samples } = *cell;
+    let CellRun { plan, label, bi, ei, budget, samples } = *cell;
     let (b, e) = (&plan.beds[bi], &plan.estimators[ei]);
-    let label = b.label();
     let frames = b.bed.sequence_length().max(1);
     let key = StreamKey {
         seed: plan.sweep.seed,
-        testbed: &label,
+        testbed: label,
         estimator: &e.name,
         budget: budget.amount,
         rep,
@@ -98,7 +100,7 @@ fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> R
     let t0 = Instant::now();
     let values = e.estimator.estimate_sequence(&tasks, &mut rng);
     let seconds = t0.elapsed().as_secs_f64() / frames as f64;
-    let wrap = |source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.clone(), source };
+    let wrap = |source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.to_string(), source };
     let values = values.map_err(wrap)?;
     if values.len() != frames {
         let msg = format!("estimate_sequence returned {} values for {frames} integrals", values.len());
@@ -132,7 +134,8 @@ fn samples_for_fetch_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -
     let frames = b.bed.sequence_length().max(1);
     let sequences = b.bed.integrals() / frames;
     let picks = sequences.min(PILOT_SEQUENCES);
-    let pilot = CellRun { plan, bi, ei, budget, samples: None };
+    let label = b.label();
+    let pilot = CellRun { plan, label: &label, bi, ei, budget, samples: None };
     let pilots: Vec<Result<Item>> = (0..picks)
         .into_par_iter()
         .map(|k| {
@@ -197,7 +200,8 @@ pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[u
         BudgetKind::Fetches => Some(samples_for_fetch_budget(plan, bi, ei, budget)?),
         _ => None,
     };
-    let cell = CellRun { plan, bi, ei, budget, samples };
+    let label = b.label();
+    let cell = CellRun { plan, label: &label, bi, ei, budget, samples };
     // (position in `blocks`, repetition, batch), repetition-major inside each block.
     let work: Vec<(usize, usize, usize)> = blocks
         .iter()

@@ -13,65 +13,93 @@ pub enum Interp {
     Linear,
 }
 
+/// The knots of a density: one knot held inline (a constant density, built once per ray by the
+/// trackers, so it must not allocate), or any number on the heap.
+#[derive(Clone, Debug, PartialEq)]
+enum Knots {
+    One([f64; 1], [f64; 1]),
+    Many(Vec<f64>, Vec<f64>),
+}
+
 /// A non-negative sampling extinction along a ray (paper 002 Eq. 4).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SamplingDensity {
-    t: Vec<f64>,
-    v: Vec<f64>,
+    knots: Knots,
     interp: Interp,
 }
 
 impl SamplingDensity {
     /// A constant density `sigma` (> 0 for a proper free flight; 0 never interacts).
     pub fn constant(sigma: f64) -> Self {
-        SamplingDensity { t: vec![0.0], v: vec![sigma.max(0.0)], interp: Interp::Constant }
+        SamplingDensity { knots: Knots::One([0.0], [sigma.max(0.0)]), interp: Interp::Constant }
     }
     /// A density through knots (`t` increasing, same length as `v`, at least one knot); negative
     /// values are clamped to zero (a sampling density is a density).
     pub fn new(t: Vec<f64>, v: Vec<f64>, interp: Interp) -> Self {
         assert!(!t.is_empty() && t.len() == v.len(), "knots and values must match");
         debug_assert!(t.windows(2).all(|w| w[0] < w[1]), "knots must increase");
-        SamplingDensity { t, v: v.into_iter().map(|x| x.max(0.0)).collect(), interp }
+        SamplingDensity { knots: Knots::Many(t, v.into_iter().map(|x| x.max(0.0)).collect()), interp }
+    }
+    /// The knot positions.
+    fn t(&self) -> &[f64] {
+        match &self.knots {
+            Knots::One(t, _) => t,
+            Knots::Many(t, _) => t,
+        }
+    }
+    /// The values at the knots.
+    fn v(&self) -> &[f64] {
+        match &self.knots {
+            Knots::One(_, v) => v,
+            Knots::Many(_, v) => v,
+        }
     }
     /// The same knots with every value raised to at least `floor` (a density that is positive
     /// wherever `floor > 0`).
     pub fn floored(&self, floor: f64) -> SamplingDensity {
-        SamplingDensity { t: self.t.clone(), v: self.v.iter().map(|v| v.max(floor)).collect(), interp: self.interp }
+        let knots = match &self.knots {
+            Knots::One(t, v) => Knots::One(*t, [v[0].max(floor)]),
+            Knots::Many(t, v) => Knots::Many(t.clone(), v.iter().map(|v| v.max(floor)).collect()),
+        };
+        SamplingDensity { knots, interp: self.interp }
     }
     /// The density at `s`.
+    #[inline]
     pub fn eval(&self, s: f64) -> f64 {
-        let n = self.t.len();
-        if s <= self.t[0] {
-            return self.v[0];
+        let (t, v) = (self.t(), self.v());
+        let n = t.len();
+        if s <= t[0] {
+            return v[0];
         }
-        if s >= self.t[n - 1] {
-            return self.v[n - 1];
+        if s >= t[n - 1] {
+            return v[n - 1];
         }
-        let j = self.t.partition_point(|&x| x <= s) - 1;
+        let j = t.partition_point(|&x| x <= s) - 1;
         match self.interp {
-            Interp::Constant => self.v[j],
+            Interp::Constant => v[j],
             Interp::Linear => {
-                let h = self.t[j + 1] - self.t[j];
-                self.v[j] + (self.v[j + 1] - self.v[j]) * (s - self.t[j]) / h
+                let h = t[j + 1] - t[j];
+                v[j] + (v[j + 1] - v[j]) * (s - t[j]) / h
             }
         }
     }
     /// Pieces as `(start, end, value at start, slope)`, the first from -inf and the last to +inf.
     fn piece(&self, j: usize) -> (f64, f64, f64, f64) {
-        let n = self.t.len();
-        let start = if j == 0 { f64::NEG_INFINITY } else { self.t[j - 1] };
-        let end = if j == n { f64::INFINITY } else { self.t[j] };
+        let (t, v) = (self.t(), self.v());
+        let n = t.len();
+        let start = if j == 0 { f64::NEG_INFINITY } else { t[j - 1] };
+        let end = if j == n { f64::INFINITY } else { t[j] };
         if j == 0 || j == n || self.interp == Interp::Constant {
-            let v = if j == 0 { self.v[0] } else { self.v[j - 1] };
-            return (start, end, v, 0.0);
+            let v0 = if j == 0 { v[0] } else { v[j - 1] };
+            return (start, end, v0, 0.0);
         }
-        let k = (self.v[j] - self.v[j - 1]) / (end - start);
-        (start, end, self.v[j - 1], k)
+        let k = (v[j] - v[j - 1]) / (end - start);
+        (start, end, v[j - 1], k)
     }
     /// `int_a^b sigma_samp` for `a <= b`.
     pub fn integral(&self, a: f64, b: f64) -> f64 {
         let mut total = 0.0;
-        for j in 0..=self.t.len() {
+        for j in 0..=self.t().len() {
             let (s0, s1, v0, k) = self.piece(j);
             let (lo, hi) = (a.max(s0), b.min(s1));
             if hi > lo {
@@ -83,8 +111,20 @@ impl SamplingDensity {
     }
     /// The free-flight end point: the `s > start` with `int_start^s sigma_samp = tau`
     /// (`tau = -ln(1 - xi)`), or `+inf` when the density never accumulates `tau`.
-    pub fn solve(&self, start: f64, mut tau: f64) -> f64 {
-        for j in 0..=self.t.len() {
+    #[inline]
+    pub fn solve(&self, start: f64, tau: f64) -> f64 {
+        if let Knots::One([t0], [v0]) = self.knots {
+            if start >= t0 {
+                // The last (infinite) piece of `solve_pieces`, taken directly: the same arithmetic.
+                let x = tau / v0;
+                return if x.is_finite() { start + x } else { f64::INFINITY };
+            }
+        }
+        self.solve_pieces(start, tau)
+    }
+    /// [`SamplingDensity::solve`] piece by piece.
+    fn solve_pieces(&self, start: f64, mut tau: f64) -> f64 {
+        for j in 0..=self.t().len() {
             let (s0, s1, v0, k) = self.piece(j);
             if s1 <= start {
                 continue;
@@ -103,6 +143,7 @@ impl SamplingDensity {
         f64::INFINITY
     }
     /// Samples a free flight from `start` with one uniform number `xi` in `[0, 1)`.
+    #[inline]
     pub fn sample(&self, start: f64, xi: f64) -> f64 {
         self.solve(start, -(-xi).ln_1p())
     }

@@ -13,13 +13,13 @@ pub mod residual_ratio_tracking;
 pub mod single_particle;
 pub mod spm;
 
-use crate::accumulate::RgbMean;
 use crate::error::{ConfigError, EstimateError};
 use crate::math::{Rgb, Vec3};
 use crate::media::moments::{tracker_moments, EstimateMoments};
 use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
+use crate::stats::NeumaierSum;
 use crate::task::{MediumProbe, Task};
 use crate::testbed::{MediumQuantity, TestBed};
 use rand::Rng;
@@ -48,23 +48,20 @@ pub enum Rule {
 }
 
 /// Applies `rule` once: the factor the transmitted weight is multiplied by (0 = the particle left).
+/// Inlined into the tracker loop; the refusals are cold paths.
+#[inline]
 pub fn interact(rule: Rule, r: f64, xi: f64) -> Result<f64, EstimateError> {
     match rule {
         Rule::Double => Ok(1.0 - r),
         Rule::Delta => {
             if !(0.0..=1.0).contains(&r) {
-                return Err(EstimateError::Refused(format!(
-                    "delta tracking needs a majorant, but sigma_t / sigma_samp = {r}"
-                )));
+                return Err(refused_delta(r));
             }
             Ok(if xi < r { 0.0 } else { 1.0 })
         }
         Rule::Terminating { a } => {
             if r < 0.0 || r > 2.0 / (a + 1.0) {
-                return Err(EstimateError::Refused(format!(
-                    "terminating single-particle model invalid at r = {r} (needs 0 <= r <= 2/(a+1) = {})",
-                    2.0 / (a + 1.0)
-                )));
+                return Err(refused_terminating(r, a));
             }
             let q_tran = (1.0 - r).abs();
             Ok(if xi < q_tran { (1.0 - r) / q_tran } else { 0.0 })
@@ -74,6 +71,19 @@ pub fn interact(rule: Rule, r: f64, xi: f64) -> Result<f64, EstimateError> {
             Ok(if q_tran > 0.0 && xi < q_tran { (1.0 - r) / q_tran } else { 0.0 })
         }
     }
+}
+
+#[cold]
+fn refused_delta(r: f64) -> EstimateError {
+    EstimateError::Refused(format!("delta tracking needs a majorant, but sigma_t / sigma_samp = {r}"))
+}
+
+#[cold]
+fn refused_terminating(r: f64, a: f64) -> EstimateError {
+    EstimateError::Refused(format!(
+        "terminating single-particle model invalid at r = {r} (needs 0 <= r <= 2/(a+1) = {})",
+        2.0 / (a + 1.0)
+    ))
 }
 
 /// One interaction of the `Transmittance` algorithm: where it happened, the extinction fetched
@@ -206,12 +216,15 @@ pub fn transmittance(
         probe.start_sample();
         return Ok(weight);
     };
-    let mut mean = RgbMean::new();
+    // One compensated sum (the channels of a transmittance are equal): the same value as the
+    // first channel of an `RgbMean`, without summing three copies per ray.
+    let (mut sum, mut n) = (NeumaierSum::new(), 0u64);
     while task.more() {
         probe.start_sample();
-        mean.push(Rgb::splat(one(&probe, seg, rng)?));
+        sum.add(one(&probe, seg, rng)?);
+        n += 1;
     }
-    Ok(weight * mean.mean().0[0])
+    Ok(weight * if n == 0 { 0.0 } else { sum.value() / n as f64 })
 }
 
 /// The exact moments of one tracker ray on `task`'s transmittance integral
