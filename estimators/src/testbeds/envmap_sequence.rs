@@ -28,7 +28,9 @@ use rayon::prelude::*;
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "envmap-sequence",
     variants: &["specular", "mixed", "specular-lns", "mixed-lns"],
-    provides: Needs::SURFACE.and(Needs::ENV_SEQUENCE),
+    // Not `SURFACE`: its integrals are per-frame environment integrals reached through
+    // `env_sequence()`, not the hemisphere probe the surface estimators need.
+    provides: Needs::ENV_SEQUENCE,
     summary:
         "Phong sphere under a rotating HDR sky, L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
     build: |variant, params| Ok(Box::new(EnvmapSequence::new(variant, params)?)),
