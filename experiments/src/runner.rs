@@ -222,15 +222,7 @@ pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[u
         })
         .collect();
     let key = cell_key(plan, bi, ei, budget);
-    let empty = CellResult {
-        key,
-        moments: vec![[Moments::default(), Moments::default(), Moments::default()]; n],
-        costs: Costs::default(),
-        estimates: 0,
-        time: TimeStats::default(),
-        diagnostics: Vec::new(),
-    };
-    let mut parts = vec![empty; blocks.len()];
+    let mut parts = vec![empty_cell(key, n); blocks.len()];
     for (&(pos, _, batch), r) in work.iter().zip(items) {
         let (r, part) = (r?, &mut parts[pos]);
         for (k, v) in r.values.iter().enumerate() {
@@ -246,18 +238,23 @@ pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[u
     Ok(parts)
 }
 
-/// Merges the blocks of one cell, in the order given (block order for a bit-reproducible result),
-/// into the cell's statistics under `key`.
-pub fn merge_blocks(key: CellKey, parts: &[CellResult]) -> CellResult {
-    let n = parts.first().map_or(0, |p| p.moments.len());
-    let mut out = CellResult {
+/// A cell of `n` integrals with no estimates yet.
+fn empty_cell(key: CellKey, n: usize) -> CellResult {
+    CellResult {
         key,
         moments: vec![[Moments::default(), Moments::default(), Moments::default()]; n],
         costs: Costs::default(),
         estimates: 0,
         time: TimeStats::default(),
         diagnostics: Vec::new(),
-    };
+    }
+}
+
+/// Merges the blocks of one cell, in the order given (block order for a bit-reproducible result),
+/// into the cell's statistics under `key`.
+pub fn merge_blocks(key: CellKey, parts: &[CellResult]) -> CellResult {
+    let n = parts.first().map_or(0, |p| p.moments.len());
+    let mut out = empty_cell(key, n);
     for p in parts {
         for (m, pm) in out.moments.iter_mut().zip(&p.moments) {
             for c in 0..3 {
