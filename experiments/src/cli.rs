@@ -5,7 +5,7 @@ use crate::config::{Mode, SweepFile};
 use crate::error::{HarnessError, Result};
 use crate::execute::{self, ExecOptions};
 use crate::progress::Progress;
-use crate::report::{markdown_table, sig};
+use crate::report::markdown_table;
 use crate::shard::ShardSpec;
 use crate::suite::{self, EXPERIMENTS};
 use clap::{Args, Parser, Subcommand, ValueEnum};
@@ -187,7 +187,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             };
             let t0 = Instant::now();
             let out = crate::merge::merge(&dirs, &opts)?;
-            print_summary(&out.report, t0.elapsed().as_secs_f64());
+            crate::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
             println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             Ok(())
         }
@@ -264,7 +264,7 @@ fn run(names: &[String], args: &RunArgs) -> Result<()> {
         }
         let out = execute::execute(plan, *def, &opts)?;
         progress.finish();
-        print_summary(&out.report, t0.elapsed().as_secs_f64());
+        crate::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
         println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
     }
     println!("\ntotal wall time {:.1} s", started.elapsed().as_secs_f64());
@@ -273,79 +273,6 @@ fn run(names: &[String], args: &RunArgs) -> Result<()> {
 
 fn valid_experiments() -> String {
     EXPERIMENTS.iter().map(|e| e.name).collect::<Vec<_>>().join(", ")
-}
-
-fn print_summary(r: &crate::output::RunReport, seconds: f64) {
-    println!(
-        "\n== {} ({} mode, seed {}, {} reps, {:.1} s) ==",
-        r.meta.experiment, r.meta.mode, r.meta.seed, r.meta.reps, seconds
-    );
-    let fits: Vec<Vec<String>> = r
-        .fits
-        .iter()
-        .map(|f| {
-            let find = |prefix: &str| {
-                r.tests.iter().find(|t| {
-                    t.testbed == f.testbed
-                        && t.variant == f.variant
-                        && t.estimator == f.estimator
-                        && t.test.starts_with(prefix)
-                })
-            };
-            let (holm, pooled) = (find("holm"), find("pooled"));
-            let p = |t: Option<&crate::analysis::TestRow>| {
-                t.filter(|t| !t.p_value.is_nan()).map(|t| sig(t.p_value, 3)).unwrap_or_else(|| "-".into())
-            };
-            vec![
-                format!("{}/{}", f.testbed, f.variant),
-                f.estimator.clone(),
-                format!("{:.3} [{:.3}, {:.3}]", f.slope, f.slope_ci_low, f.slope_ci_high),
-                p(holm),
-                holm.map(|t| format!("{} ({})", t.verdict, t.claim)).unwrap_or_else(|| "-".into()),
-                p(pooled),
-                pooled.map(|t| t.verdict.clone()).unwrap_or_else(|| "-".into()),
-            ]
-        })
-        .collect();
-    println!(
-        "{}",
-        markdown_table(
-            &[
-                "test bed",
-                "estimator",
-                "slope [95% CI]",
-                "Holm p",
-                "Holm verdict (claim)",
-                "pooled p",
-                "pooled verdict"
-            ],
-            &fits
-        )
-    );
-    let claims: Vec<Vec<String>> = r
-        .paper
-        .iter()
-        .map(|c| {
-            let held = match c.held {
-                Some(true) => "held",
-                Some(false) => "did NOT hold",
-                None => "not measured",
-            };
-            vec![
-                c.claim.clone(),
-                c.paper_value.map(|v| sig(v, 3)).unwrap_or_default(),
-                c.our_value.map(|v| sig(v, 3)).unwrap_or_else(|| "-".into()),
-                held.into(),
-            ]
-        })
-        .collect();
-    println!("{}", markdown_table(&["paper claim", "paper", "ours", "verdict"], &claims));
-    if !r.unavailable.is_empty() {
-        println!("not available yet: {}", r.unavailable.join(", "));
-    }
-    for s in &r.skipped {
-        println!("skipped {} on {}/{}: {}", s.estimator, s.testbed, s.variant, s.reason);
-    }
 }
 
 fn list(what: Option<ListWhat>) {

@@ -13,6 +13,7 @@ pub mod cell;
 pub mod cli;
 pub mod config;
 pub mod conformance;
+pub mod console;
 pub mod error;
 pub mod execute;
 pub mod merge;

@@ -1,0 +1,78 @@
+//! The console summary of a finished run (SPEC §9: the run prints a summary table): fits with
+//! their unbiasedness verdicts, the paper's claims beside ours, and what was skipped.
+
+use crate::report::{markdown_table, sig};
+
+/// Prints the summary of one experiment's run that took `seconds`.
+pub fn print_summary(r: &crate::output::RunReport, seconds: f64) {
+    println!(
+        "\n== {} ({} mode, seed {}, {} reps, {:.1} s) ==",
+        r.meta.experiment, r.meta.mode, r.meta.seed, r.meta.reps, seconds
+    );
+    let fits: Vec<Vec<String>> = r
+        .fits
+        .iter()
+        .map(|f| {
+            let find = |prefix: &str| {
+                r.tests.iter().find(|t| {
+                    t.testbed == f.testbed
+                        && t.variant == f.variant
+                        && t.estimator == f.estimator
+                        && t.test.starts_with(prefix)
+                })
+            };
+            let (holm, pooled) = (find("holm"), find("pooled"));
+            let p = |t: Option<&crate::analysis::TestRow>| {
+                t.filter(|t| !t.p_value.is_nan()).map(|t| sig(t.p_value, 3)).unwrap_or_else(|| "-".into())
+            };
+            vec![
+                format!("{}/{}", f.testbed, f.variant),
+                f.estimator.clone(),
+                format!("{:.3} [{:.3}, {:.3}]", f.slope, f.slope_ci_low, f.slope_ci_high),
+                p(holm),
+                holm.map(|t| format!("{} ({})", t.verdict, t.claim)).unwrap_or_else(|| "-".into()),
+                p(pooled),
+                pooled.map(|t| t.verdict.clone()).unwrap_or_else(|| "-".into()),
+            ]
+        })
+        .collect();
+    println!(
+        "{}",
+        markdown_table(
+            &[
+                "test bed",
+                "estimator",
+                "slope [95% CI]",
+                "Holm p",
+                "Holm verdict (claim)",
+                "pooled p",
+                "pooled verdict"
+            ],
+            &fits
+        )
+    );
+    let claims: Vec<Vec<String>> = r
+        .paper
+        .iter()
+        .map(|c| {
+            let held = match c.held {
+                Some(true) => "held",
+                Some(false) => "did NOT hold",
+                None => "not measured",
+            };
+            vec![
+                c.claim.clone(),
+                c.paper_value.map(|v| sig(v, 3)).unwrap_or_default(),
+                c.our_value.map(|v| sig(v, 3)).unwrap_or_else(|| "-".into()),
+                held.into(),
+            ]
+        })
+        .collect();
+    println!("{}", markdown_table(&["paper claim", "paper", "ours", "verdict"], &claims));
+    if !r.unavailable.is_empty() {
+        println!("not available yet: {}", r.unavailable.join(", "));
+    }
+    for s in &r.skipped {
+        println!("skipped {} on {}/{}: {}", s.estimator, s.testbed, s.variant, s.reason);
+    }
+}
