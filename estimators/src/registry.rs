@@ -24,6 +24,11 @@ pub struct EstimatorEntry {
     pub bias: Bias,
     /// What it needs from a test bed.
     pub needs: Needs,
+    /// The registered samplers it draws from (ids of `samplers::registry::SAMPLERS`): the
+    /// conformance suite runs their chi-square tests for it (SPEC §6). Adaptive samplers internal
+    /// to the estimator (cache cells, texel tables, PMC kernels, MH moves) are tested beside their
+    /// code and not listed.
+    pub samplers: &'static [&'static str],
     /// One line for `mcbench list estimators`.
     pub summary: &'static str,
     /// Builds a configured instance (validates the parameters).

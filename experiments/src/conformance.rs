@@ -8,9 +8,9 @@
 //!    dynamic range 1e6, mostly occluded lights): every estimate finite or a clean one-line
 //!    refusal, never a panic, a NaN or an infinity; a validation error must be one line;
 //! 3. **determinism**: the same stream key gives the same bits twice;
-//! 4. **chi-square of its samplers**: the samplers it names in [`SAMPLERS_OF`] (a new estimator
-//!    must add its line) are registered in [`estimators::samplers::registry`] and pass their
-//!    checks at the Sidak family level;
+//! 4. **chi-square of its samplers**: the samplers its registry entry names
+//!    ([`estimators::registry::EstimatorEntry::samplers`]) are registered in
+//!    [`estimators::samplers::registry`] and pass their checks at the Sidak family level;
 //! 5. **unbiasedness at a small budget** (estimators whose bias claim is `unbiased`): on every small
 //!    exact-reference bed it runs on ([`unbiasedness_beds`]), 4 samples per estimate, the
 //!    harness's own test ([`crate::analysis::unbiasedness`], deciding test as in the claims; about
@@ -52,48 +52,6 @@ impl std::fmt::Display for Failure {
         write!(f, "{} [{}]: {}", self.estimator, self.check, self.detail)
     }
 }
-
-/// The registered samplers each estimator draws from (ids of [`samplers::SAMPLERS`]). Adaptive,
-/// estimator-internal samplers (the radiance caches' cells, the environment-map texel tables, the
-/// PMC kernels, Metropolis-Hastings moves) are tested beside their code.
-pub const SAMPLERS_OF: &[(&str, &[&str])] = &[
-    ("is0_cv0", &["uniform_hemisphere", "phase", "free_flight"]),
-    ("brdf_is0_cv0", &["brdf"]),
-    ("clamped_is0_cv0", &["uniform_hemisphere"]),
-    ("is0_cv1", &["uniform_hemisphere", "phase", "free_flight"]),
-    ("is0_cv2", &["uniform_hemisphere", "phase", "free_flight"]),
-    ("is1_cv0", &["uniform_hemisphere", "phase", "free_flight"]),
-    ("is1_cv1", &["uniform_hemisphere", "phase", "free_flight"]),
-    ("is1_cv2", &["uniform_hemisphere", "phase", "free_flight"]),
-    ("brdf_is1_cv2", &["brdf"]),
-    ("rm_is1_cv2", &["uniform_hemisphere", "phase"]),
-    ("bidirectional_is", &[]),
-    ("bidirectional_is_sn", &[]),
-    ("smc", &[]),
-    ("smc_bridge", &[]),
-    ("smc_path", &[]),
-    ("smc_adaptive", &[]),
-    ("mis", &["brdf", "rect_light"]),
-    ("pmc_hi", &["brdf", "rect_light", "cone", "mixture"]),
-    ("pmc_hi_feedback", &["brdf", "rect_light", "cone", "mixture"]),
-    ("uniform_image", &[]),
-    ("pmc_ip", &[]),
-    ("threshold_image", &[]),
-    ("ray_marching", &[]),
-    ("delta_tracking", &["free_flight"]),
-    ("ratio_tracking", &["free_flight"]),
-    ("residual_ratio_tracking", &["free_flight"]),
-    ("double_particle", &["free_flight"]),
-    ("single_particle_terminating", &["free_flight"]),
-    ("single_particle_nonterminating", &["free_flight"]),
-    ("spm_terminating", &["free_flight", "phase"]),
-    ("spm_nonterminating", &["free_flight", "phase"]),
-    ("spm_adaptive", &["free_flight", "phase"]),
-    ("attenuation_driven", &["free_flight"]),
-    ("attenuation_driven_sir", &["free_flight"]),
-    ("source_driven", &["equiangular"]),
-    ("scattering_driven", &["free_flight"]),
-];
 
 fn p(pairs: &[(&str, f64)]) -> Params {
     pairs.iter().fold(Params::new(), |p, (k, v)| p.with(k, *v))
@@ -308,15 +266,10 @@ pub fn conformance(entry: &EstimatorEntry) -> Vec<Failure> {
         }
     }
     // 4. Samplers.
-    match SAMPLERS_OF.iter().find(|(id, _)| *id == entry.id) {
-        None => out.push(fail("samplers", "not listed in conformance::SAMPLERS_OF (name its samplers)".into())),
-        Some((_, names)) => {
-            for name in *names {
-                match sampler_results().iter().find(|(id, _)| id == name) {
-                    None => out.push(fail("samplers", format!("names `{name}`, which is not in samplers::registry"))),
-                    Some((_, bad)) => out.extend(bad.iter().map(|b| fail("samplers", format!("{name}: {b}")))),
-                }
-            }
+    for name in entry.samplers {
+        match sampler_results().iter().find(|(id, _)| id == name) {
+            None => out.push(fail("samplers", format!("names `{name}`, which is not in samplers::registry"))),
+            Some((_, bad)) => out.extend(bad.iter().map(|b| fail("samplers", format!("{name}: {b}")))),
         }
     }
     // 5. Unbiasedness at a small budget.

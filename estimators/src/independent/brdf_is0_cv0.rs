@@ -16,6 +16,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "BRDF_is0_cv0",
     bias: Bias::Unbiased,
     needs: Needs::SURFACE,
+    samplers: &["brdf"],
     summary: "BRDF importance sampling (cosine + Phong lobe mixture), no control variate",
     build: |p| {
         p.reject_unknown("brdf_is0_cv0", &[])?;

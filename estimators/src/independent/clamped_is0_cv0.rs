@@ -18,6 +18,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "clamped independent MC (biased control)",
     bias: Bias::Biased,
     needs: Needs::SURFACE,
+    samplers: &["uniform_hemisphere"],
     summary: "biased control: is0_cv0 with each sample clamped at `clamp` (default 2)",
     build: |p| {
         p.reject_unknown("clamped_is0_cv0", &["clamp"])?;

@@ -17,6 +17,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "MCMC (independent MC)",
     bias: Bias::Unbiased,
     needs: Needs::NONE,
+    samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "independent MC baseline: uniform hemisphere sampling; on a medium, the path tracer (free flights, phase sampling)",
     build: |p| {
         p.reject_unknown("is0_cv0", &[])?;

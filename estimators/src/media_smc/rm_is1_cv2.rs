@@ -22,6 +22,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "ray marching is1_cv2 (biased)",
     bias: Bias::Biased,
     needs: Needs::MEDIUM,
+    samplers: &["uniform_hemisphere", "phase"],
     summary: "ray marching over the 4 pi + 1 domain (paper 000 Eq. 8-9) with the SMC octree; biased control",
     build: |p| {
         let known: Vec<&str> = PARAMS.iter().copied().chain(["step"]).collect();

@@ -34,6 +34,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "PMC-HI",
     bias: Bias::Unbiased,
     needs: Needs::SURFACE.and(Needs::AREA_LIGHTS),
+    samplers: &["brdf", "rect_light", "cone", "mixture"],
     summary: "PMC for hemispheric integrals: BRDF + per-light + cone mixture adapted per population (Eq. 7-9)",
     build: |p| Ok(Box::new(PmcHi::from_params("pmc_hi", p, 1)?)),
 };
@@ -45,6 +46,7 @@ pub static FEEDBACK: EstimatorEntry = EstimatorEntry {
     label: "PMC-HI + feedback",
     bias: Bias::Unbiased,
     needs: Needs::SURFACE.and(Needs::AREA_LIGHTS),
+    samplers: &["brdf", "rect_light", "cone", "mixture"],
     summary: "PMC-HI whose weights start from the previous image-plane pass (paper 003 §6.1)",
     build: |p| Ok(Box::new(PmcHi::from_params("pmc_hi_feedback", p, 2)?)),
 };

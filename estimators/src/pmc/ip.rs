@@ -52,6 +52,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "PMC-IP",
     bias: Bias::Unbiased,
     needs: Needs::IMAGE_PLANE,
+    samplers: &[],
     summary: "PMC image-plane sampler: per-pixel mixture, alpha ∝ eps + sigma^2/tvi(L), DMS allocation (§4)",
     build: |p| Ok(Box::new(PmcIp::from_params(p)?)),
 };

@@ -21,6 +21,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "MIS",
     bias: Bias::Unbiased,
     needs: Needs::NONE,
+    samplers: &["brdf", "rect_light"],
     summary: "one BRDF + one light sample per round, balance heuristic (power = 2: power heuristic); on point-light single scattering (paper 002), source- + scattering-driven points, balance heuristic",
     build: |p| {
         crate::single_scatter::SingleScatterOr::build(

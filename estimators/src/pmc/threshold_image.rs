@@ -25,6 +25,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "threshold stopping (biased)",
     bias: Bias::Biased,
     needs: Needs::IMAGE_PLANE,
+    samplers: &[],
     summary: "biased control: per-pixel sampling stopped once the relative standard error <= threshold (paper 003 §2)",
     build: |p| {
         p.reject_unknown("threshold_image", &["initial", "threshold"])?;

@@ -19,6 +19,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "Uniform",
     bias: Bias::Unbiased,
     needs: Needs::IMAGE_PLANE,
+    samplers: &[],
     summary: "uniform image-plane sampling: spp samples at uniform positions in every pixel (Table 1 baseline)",
     build: |p| {
         p.reject_unknown("uniform_image", &[])?;

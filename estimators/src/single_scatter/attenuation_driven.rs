@@ -25,6 +25,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "attenuation-driven",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM.and(Needs::POINT_LIGHT),
+    samplers: &["free_flight"],
     summary: "point-light single scattering at the primary ray's residual-ratio-tracking interaction points (density sigma_samp), a shadow ray from each",
     build: |p| Ok(Box::new(AttenuationDriven { cfg: residual_params(p, "attenuation_driven", &[])? })),
 };

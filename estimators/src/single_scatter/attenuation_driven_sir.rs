@@ -26,6 +26,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "attenuation-driven SIR",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM.and(Needs::POINT_LIGHT),
+    samplers: &["free_flight"],
     summary:
         "attenuation-driven candidates, shadow rays only for `shadow_rays` (1) of them resampled by importance (SIR)",
     build: |p| {

@@ -28,6 +28,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "scattering-driven",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM.and(Needs::POINT_LIGHT),
+    samplers: &["free_flight"],
     summary: "scattering points mimicking T sigma_t through the piecewise-linear main part, continuous transmittance, residual-ratio-tracking shadow rays",
     build: |p| {
         let cfg = residual_params(p, "scattering_driven", &["points", "scatter_floor"])?;

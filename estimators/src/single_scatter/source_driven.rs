@@ -24,6 +24,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "source-driven",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM.and(Needs::POINT_LIGHT),
+    samplers: &["equiangular"],
     summary: "equiangular (Cauchy) scattering points, continuous transmittance of the primary ray, residual-ratio-tracking shadow rays",
     build: |p| {
         let cfg = residual_params(p, "source_driven", &["points"])?;

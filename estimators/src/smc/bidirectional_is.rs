@@ -14,6 +14,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "bidirectional IS",
     bias: Bias::Unbiased,
     needs: Needs::ENV_SEQUENCE,
+    samplers: &[],
     summary:
         "SIR: M environment-map candidates (`candidates`, default 128), N = budget resampled by BRDF cos, every frame",
     build: |p| Ok(Box::new(super::SmcEstimator(super::config(p, "bidirectional_is", &[], 128, None)?))),

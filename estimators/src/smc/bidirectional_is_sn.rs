@@ -20,6 +20,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "self-normalised SIR (biased control)",
     bias: Bias::Biased,
     needs: Needs::ENV_SEQUENCE,
+    samplers: &[],
     summary: "biased control: independent L_ns times the self-normalised SIR mean of V at tiny M (default 4)",
     build: |p| Ok(Box::new(BidirectionalSn(super::config(p, "bidirectional_is_sn", &[], 4, None)?))),
 };

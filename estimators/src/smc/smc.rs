@@ -17,6 +17,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "SMC (single distribution, K MH moves)",
     bias: Bias::Unbiased,
     needs: Needs::ENV_SEQUENCE,
+    samplers: &[],
     summary: "Algorithm 1: propagate, reweight p~_n/p~_{n-1}, resample at ESS < N/2, K MH moves (`moves`, default 5)",
     build: |p| {
         let moves = p.count("moves", 5, 10_000)?;

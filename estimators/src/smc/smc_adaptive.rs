@@ -17,6 +17,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "SMC, adaptive bridges (conditional ESS)",
     bias: Bias::Consistent,
     needs: Needs::ENV_SEQUENCE,
+    samplers: &[],
     summary: "bridges chosen by bisection on the conditional ESS (`cess`, default 0.9; `max_bridges`, 32), ratio L_ns",
     build: |p| {
         let cess = p.f64_in("cess", 0.9, 0.01, 0.9999)?;

@@ -15,6 +15,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "SMC, P intermediate distributions (ratio)",
     bias: Bias::Unbiased,
     needs: Needs::ENV_SEQUENCE,
+    samplers: &[],
     summary: "Algorithm 2: P bridges (`bridges`, default 5) with one MH move each, L_ns by the standard ratio (Eq. 10)",
     build: |p| {
         let bridges = p.count("bridges", 5, 10_000)?;

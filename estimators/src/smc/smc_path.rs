@@ -16,6 +16,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "SMC, P intermediate distributions (path sampling)",
     bias: Bias::Consistent,
     needs: Needs::ENV_SEQUENCE,
+    samplers: &[],
     summary: "Algorithm 2 with L_ns by path sampling (Eq. 15-16): P bridges (`bridges`, default 5), exponentiated log estimate",
     build: |p| {
         let bridges = p.count("bridges", 5, 10_000)?;

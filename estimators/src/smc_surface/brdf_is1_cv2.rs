@@ -16,6 +16,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "BRDF_is1_cv2",
     bias: Bias::Unbiased,
     needs: Needs::SURFACE,
+    samplers: &["brdf"],
     summary: "variance tracker choosing BRDF importance sampling or is1_cv2 per sample",
     build: |p| SmcSurface::build("brdf_is1_cv2", Sampling::BrdfTracked, ControlVariate::Bilinear, p),
 };

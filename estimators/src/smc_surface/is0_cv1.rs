@@ -15,6 +15,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "is0_cv1",
     bias: Bias::Unbiased,
     needs: Needs::NONE,
+    samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: uniform sampling, piecewise-constant control variate (cv1); on a medium, the octree of spherical caches (paper 000)",
     build: |p| {
         crate::media_smc::SurfaceOrMedium::build(

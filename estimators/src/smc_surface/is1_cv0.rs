@@ -15,6 +15,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "is1_cv0",
     bias: Bias::Unbiased,
     needs: Needs::NONE,
+    samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: cache-PDF importance sampling, no control variate; on a medium, the octree of spherical caches (paper 000)",
     build: |p| {
         crate::media_smc::SurfaceOrMedium::build(

@@ -15,6 +15,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "is1_cv2",
     bias: Bias::Unbiased,
     needs: Needs::NONE,
+    samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: cache-PDF importance sampling, bilinear control variate (the paper's SMC); on a medium, the octree of spherical caches (paper 000)",
     build: |p| {
         crate::media_smc::SurfaceOrMedium::build(

@@ -27,6 +27,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "Woodcock (delta) tracking",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM,
+    samplers: &["free_flight"],
     summary:
         "Woodcock tracking with the majorant: transmittance, analog particle tracing, or point-light single scattering",
     build: |p| {

@@ -25,6 +25,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "double particle model",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM,
+    samplers: &["free_flight"],
     summary:
         "double particle model (Eq. 8) with any sigma_samp (default 1), optional control variate (1 linear, 2 mean)",
     build: |p| {

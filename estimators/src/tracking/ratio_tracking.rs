@@ -21,6 +21,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "ratio tracking",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM,
+    samplers: &["free_flight"],
     summary: "ratio tracking with the constant majorant (paper 002 Eq. 8, [NSJ14])",
     build: |p| {
         p.reject_unknown("ratio_tracking", &["sigma_samp", "sigma_samp_ratio"])?;

@@ -28,6 +28,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "ray marching (biased control)",
     bias: Bias::Biased,
     needs: Needs::MEDIUM,
+    samplers: &[],
     summary: "biased control: fixed-step ray marching of the optical depth (step 0.9; one ray = the fetch budget); on single scattering, of the primary and shadow rays",
     build: |p| {
         crate::single_scatter::SingleScatterOr::build(

@@ -28,6 +28,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     label: "residual ratio tracking (new method)",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM,
+    samplers: &["free_flight"],
     summary: "control variate through explorer points + constant sigma_samp ~ max |sigma_diff| of the last rays",
     build: |p| {
         p.reject_unknown("residual_ratio_tracking", ResidualRatioTracking::PARAMS)?;

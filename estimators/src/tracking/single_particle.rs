@@ -25,6 +25,7 @@ pub static TERMINATING: EstimatorEntry = EstimatorEntry {
     label: "single particle, terminating",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM,
+    samplers: &["free_flight"],
     summary: "single particle model, terminating (Eq. 9, 19): refuses r > 2/(a+1) or r < 0",
     build: |p| build(p, "single_particle_terminating", true),
 };
@@ -36,6 +37,7 @@ pub static NONTERMINATING: EstimatorEntry = EstimatorEntry {
     label: "single particle, non-terminating",
     bias: Bias::Unbiased,
     needs: Needs::MEDIUM,
+    samplers: &["free_flight"],
     summary: "single particle model, non-terminating (Eq. 12, 20), any r",
     build: |p| build(p, "single_particle_nonterminating", false),
 };

@@ -97,6 +97,7 @@ macro_rules! spm_entry {
             label: $label,
             bias: Bias::Unbiased,
             needs: Needs::MEDIUM,
+            samplers: &["free_flight", "phase"],
             summary: $summary,
             build: |p| {
                 p.reject_unknown($id, &["sigma_samp"])?;
