@@ -121,6 +121,24 @@ fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> R
     Ok(())
 }
 
+/// The estimates of repetition `rep` for the sequence starting at integral `first`, exactly as a
+/// run of a sample-budget cell computes them (same stream, same tasks): for analyses that need
+/// per-repetition values the cells do not keep (`suite::unbiasedness_reps`).
+pub fn sequence_estimates(
+    plan: &Plan,
+    bi: usize,
+    ei: usize,
+    budget: Budget,
+    rep: u64,
+    first: usize,
+) -> Result<Vec<Rgb>> {
+    let label = plan.beds[bi].label();
+    let cell = CellRun { plan, label: &label, bi, ei, budget, samples: None };
+    let mut out = Item::default();
+    run_sequence(&cell, rep, first, &mut out)?;
+    Ok(out.values)
+}
+
 /// The fixed number of samples per estimate that a fetch budget buys (paper 002 compares
 /// estimators at equal fetches per pixel). Stopping each estimate when its fetches run out would
 /// bias it ([`Task::with_samples`]), so a pilot pass on its own stream (repetition [`PILOT_REP`],

@@ -7,47 +7,33 @@
 //! the repetitions that includes every correlation inside an image, so
 //! `z = mean(D) / sqrt(var(D) / R + var(reference))` is valid whatever the estimator shares.
 //!
-//! The cells keep per-integral moments only, so the estimates are recomputed here on exactly the
-//! runner's streams (same [`StreamKey`], same tasks: the values are those of the cell) to get the
-//! per-repetition sums; this costs one more pass over these small parts.
+//! The cells keep per-integral moments only, so the estimates are recomputed here through the
+//! runner's own [`sequence_estimates`] (same streams, same tasks: the values are those of the
+//! cell) to get the per-repetition sums; this costs one more pass over these small parts.
 
 use crate::analysis::{TestRow, POWER, UNBIASEDNESS_ALPHA};
 use crate::error::{HarnessError, Result};
 use crate::plan::Plan;
+use crate::runner::sequence_estimates;
 use estimators::budget::BudgetKind;
-use estimators::rng::StreamKey;
 use estimators::stats::{detectable_shift, z_test, Moments};
-use estimators::task::Task;
 use estimators::testbed::{Reference, ReferenceKind};
 use rayon::prelude::*;
 
 /// The per-repetition summed deviations of one (test bed, estimator) pair of a one-budget sample
 /// sweep, in repetition order; `None` for other budget kinds (a fetch budget's pilot is not redone).
 pub fn deviations(plan: &Plan, bi: usize, ei: usize, threads: usize) -> Result<Option<Vec<f64>>> {
-    let (b, e) = (&plan.beds[bi], &plan.estimators[ei]);
     let budget = plan.sweep.budgets[0];
     if budget.kind != BudgetKind::Samples {
         return Ok(None);
     }
-    let label = b.label();
-    let bed = b.bed.as_ref();
+    let bed = plan.beds[bi].bed.as_ref();
     let frames = bed.sequence_length().max(1);
     let reference = &bed.reference().value;
     let one_rep = |rep: usize| -> Result<f64> {
         let mut d = 0.0;
         for first in (0..bed.integrals()).step_by(frames) {
-            let key = StreamKey {
-                seed: plan.sweep.seed,
-                testbed: &label,
-                estimator: &e.name,
-                budget: budget.amount,
-                rep: rep as u64,
-                integral: first as u64,
-            };
-            let tasks: Vec<Task<'_>> = (first..first + frames).map(|i| Task::new(bed, i, budget)).collect();
-            let values = e.estimator.estimate_sequence(&tasks, &mut key.rng()).map_err(|source| {
-                HarnessError::Estimate { estimator: e.name.clone(), testbed: label.clone(), source }
-            })?;
+            let values = sequence_estimates(plan, bi, ei, budget, rep as u64, first)?;
             for (k, v) in values.iter().enumerate() {
                 d += (0..3).map(|c| v[c] - reference[first + k][c]).sum::<f64>();
             }
