@@ -19,7 +19,7 @@
 //!    (`tests/conformance.rs` asserts that), so it has teeth.
 
 use crate::analysis::{unbiasedness, TestRow};
-use crate::cell::{CellKey, CellResult};
+use crate::guarded::{self, Stopped};
 use crate::suite::claims::decisive_test;
 use estimators::budget::Budget;
 use estimators::error::EstimateError;
@@ -29,11 +29,8 @@ use estimators::registry::{self, EstimatorEntry};
 use estimators::rng::StreamKey;
 use estimators::samplers::registry as samplers;
 use estimators::samplers::testing::sampler_alpha;
-use estimators::stats::Moments;
-use estimators::task::Task;
 use estimators::testbed::TestBed;
 use rayon::prelude::*;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::OnceLock;
 
 /// One failed conformance check.
@@ -150,7 +147,8 @@ fn runs_on(entry: &EstimatorEntry, est: &dyn Estimator, bed: &dyn TestBed) -> Re
     }
 }
 
-/// Estimates of the sequences holding integrals `first..first + frames`, one stream key each.
+/// Estimates of the sequence holding integrals `first..first + frames`, on its own stream key
+/// ([`guarded::sequence`]); a one-line refusal gives no estimates.
 fn estimate(
     est: &dyn Estimator,
     bed: &dyn TestBed,
@@ -161,15 +159,13 @@ fn estimate(
     rep: u64,
 ) -> Result<Vec<[f64; 3]>, String> {
     let budget = Budget::samples(samples).map_err(|e| e.to_string())?;
-    let f = bed.sequence_length().max(1);
-    let tasks: Vec<Task<'_>> = (first..first + f).map(|i| Task::new(bed, i, budget)).collect();
     let key = StreamKey { seed: 9, testbed: label, estimator: id, budget: samples, rep, integral: first as u64 };
-    match catch_unwind(AssertUnwindSafe(|| est.estimate_sequence(&tasks, &mut key.rng()))) {
-        Err(_) => Err(format!("panicked on {label} integral {first}")),
-        Ok(Err(EstimateError::Refused(t))) if t.lines().count() == 1 => Ok(Vec::new()),
-        Ok(Err(e)) => Err(format!("{label} integral {first}: {e}")),
-        Ok(Ok(v)) if v.iter().all(|x| x.0.iter().all(|c| c.is_finite())) => Ok(v.into_iter().map(|x| x.0).collect()),
-        Ok(Ok(v)) => Err(format!("{label} integral {first}: non-finite estimate {:?}", v.first().map(|x| x.0))),
+    match guarded::sequence(est, bed, &key, budget, first) {
+        Err(Stopped::Panicked(_)) => Err(format!("panicked on {label} integral {first}")),
+        Err(Stopped::Error(EstimateError::Refused(t))) if t.lines().count() == 1 => Ok(Vec::new()),
+        Err(Stopped::Error(e)) => Err(format!("{label} integral {first}: {e}")),
+        Ok(v) if v.iter().all(|x| x.iter().all(|c| c.is_finite())) => Ok(v),
+        Ok(v) => Err(format!("{label} integral {first}: non-finite estimate {:?}", v.first())),
     }
 }
 
@@ -198,32 +194,8 @@ pub fn small_budget_unbiasedness(entry: &EstimatorEntry, est: &dyn Estimator, be
             Ok(out)
         })
         .collect();
-    let mut moments = vec![[Moments::new(), Moments::new(), Moments::new()]; n];
-    for r in &per_rep {
-        let v = r.as_ref().ok()?;
-        for (m, x) in moments.iter_mut().zip(v) {
-            for c in 0..3 {
-                m[c].push(x[c]);
-            }
-        }
-    }
-    let cell = CellResult {
-        key: CellKey {
-            testbed: bed.id().into(),
-            variant: bed.variant().into(),
-            testbed_params: String::new(),
-            estimator: entry.id.into(),
-            budget: Budget::samples(4).ok()?,
-            reps: reps as usize,
-            seed: 9,
-            version: env!("CARGO_PKG_VERSION").into(),
-        },
-        moments,
-        costs: Default::default(),
-        estimates: reps * n as u64,
-        time: Default::default(),
-        diagnostics: Vec::new(),
-    };
+    let per_rep: Vec<Vec<[f64; 3]>> = per_rep.into_iter().collect::<Result<_, _>>().ok()?;
+    let cell = guarded::cell_of(bed, entry.id, Budget::samples(4).ok()?, 9, &per_rep);
     let rows = unbiasedness(&cell, bed.reference(), entry.bias);
     decisive_test(&rows, bed.variant(), entry.id, "").cloned()
 }

@@ -16,6 +16,7 @@ pub mod conformance;
 pub mod console;
 pub mod error;
 pub mod execute;
+pub mod guarded;
 pub mod merge;
 pub mod metrics;
 pub mod output;

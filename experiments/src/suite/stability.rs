@@ -8,12 +8,13 @@
 //! [`super::stability_numeric`], writes `stability.csv` and `pdf_zero.csv`, and adds one claim
 //! per case: held when the outcome is what theory expects ([`Expect`]).
 
-use super::stability_cases::{self as sc, one_line, Expect, Outcome};
+use super::stability_cases::{self as sc, Expect, Outcome};
 use super::stability_list::{cases, PDF_ZERO};
 use super::stability_numeric::{self as num, Sequence};
 use super::{available, ExperimentDef};
 use crate::config::{powers_of_four, Mode, Sweep, TestBedSpec};
 use crate::error::Result;
+use crate::guarded::one_line;
 use crate::output::{write_atomic, Claim, RunReport};
 use crate::plan::Plan;
 use crate::runner::RunResults;

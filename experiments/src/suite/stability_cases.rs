@@ -13,7 +13,7 @@
 
 use super::claims::decisive_test;
 use crate::analysis::unbiasedness;
-use crate::cell::{CellKey, CellResult};
+use crate::guarded::{self, one_line, Stopped};
 use estimators::budget::Budget;
 use estimators::error::EstimateError;
 use estimators::params::Params;
@@ -91,20 +91,6 @@ impl Outcome {
     }
 }
 
-/// The first line of a message, without commas' CSV trouble left to the writer.
-pub fn one_line(s: &str) -> String {
-    s.lines().next().unwrap_or("").trim().to_string()
-}
-
-fn panic_text(p: Box<dyn std::any::Any + Send>) -> String {
-    let msg = p
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| p.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "non-string payload".into());
-    format!("panic: {}", one_line(&msg))
-}
-
 /// One repetition's estimates of every integral, or the error that stopped it.
 fn one_rep(
     est: &dyn estimators::estimator::Estimator,
@@ -125,12 +111,11 @@ fn one_rep(
             rep,
             integral: first as u64,
         };
-        let tasks: Vec<Task<'_>> = (first..first + f).map(|i| Task::new(bed, i, budget)).collect();
-        match catch_unwind(AssertUnwindSafe(|| est.estimate_sequence(&tasks, &mut key.rng()))) {
-            Err(p) => return Err(panic_text(p)),
-            Ok(Err(EstimateError::Refused(t))) => return Err(format!("refused: {t}")),
-            Ok(Err(e)) => return Err(format!("failed: {e}")),
-            Ok(Ok(v)) => out.extend(v.into_iter().map(|x| x.0)),
+        match guarded::sequence(est, bed, &key, budget, first) {
+            Err(Stopped::Panicked(m)) => return Err(format!("panic: {m}")),
+            Err(Stopped::Error(EstimateError::Refused(t))) => return Err(format!("refused: {t}")),
+            Err(Stopped::Error(e)) => return Err(format!("failed: {e}")),
+            Ok(v) => out.extend(v),
         }
     }
     Ok(out)
@@ -138,7 +123,8 @@ fn one_rep(
 
 /// Runs one case (never panics: panics inside estimators are caught and reported).
 pub fn run(case: &Case, seed: u64) -> Outcome {
-    catch_unwind(AssertUnwindSafe(|| run_inner(case, seed))).unwrap_or_else(|p| Outcome::failed(panic_text(p)))
+    catch_unwind(AssertUnwindSafe(|| run_inner(case, seed)))
+        .unwrap_or_else(|p| Outcome::failed(format!("panic: {}", guarded::panic_message(p))))
 }
 
 fn run_inner(case: &Case, seed: u64) -> Outcome {
@@ -178,38 +164,17 @@ fn run_inner(case: &Case, seed: u64) -> Outcome {
         return Outcome::refused(format!("{text} ({n} of {} repetitions)", case.reps));
     }
     let n = bed.integrals();
-    let mut moments = vec![[Moments::new(), Moments::new(), Moments::new()]; n];
-    for v in reps.iter().flatten() {
-        for (m, x) in moments.iter_mut().zip(v) {
-            for c in 0..3 {
-                m[c].push(x[c]);
-            }
-        }
-    }
+    let per_rep: Vec<Vec<[f64; 3]>> = reps.into_iter().flatten().collect();
+    let budget =
+        Budget::samples(case.samples).unwrap_or(Budget { kind: estimators::budget::BudgetKind::Samples, amount: 1 });
+    let cell = guarded::cell_of(bed.as_ref(), case.estimator, budget, seed, &per_rep);
+    let moments = &cell.moments;
     if moments.iter().flatten().any(|m| !m.mean().is_finite()) {
         return Outcome::failed("non-finite estimate");
     }
     let reference = bed.reference();
     let value = moments.iter().map(|m| m[0].mean()).sum::<f64>() / n as f64;
     let ref_value = reference.value.iter().map(|r| r[0]).sum::<f64>() / n as f64;
-    let cell = CellResult {
-        key: CellKey {
-            testbed: case.testbed.into(),
-            variant: case.variant.into(),
-            testbed_params: String::new(),
-            estimator: case.estimator.into(),
-            budget: Budget::samples(case.samples)
-                .unwrap_or(Budget { kind: estimators::budget::BudgetKind::Samples, amount: 1 }),
-            reps: case.reps as usize,
-            seed,
-            version: env!("CARGO_PKG_VERSION").into(),
-        },
-        moments,
-        costs: Default::default(),
-        estimates: case.reps * n as u64,
-        time: Default::default(),
-        diagnostics: Vec::new(),
-    };
     if let Some(o) = exact_moments_test(est.as_ref(), bed.as_ref(), case, &cell.moments) {
         return Outcome { value, reference: ref_value, ..o };
     }
