@@ -103,6 +103,42 @@ impl Reference {
     pub fn is_exact(&self) -> bool {
         matches!(self.kind, ReferenceKind::Exact { .. })
     }
+
+    /// Checks a reference read back from a file against the test bed it is for: `integrals`
+    /// values and as many standard errors, every number finite, standard errors non-negative
+    /// (and zero for an exact reference, whose bound must be finite and non-negative), a stored
+    /// reference made of at least two samples. `Err` says what is wrong.
+    pub fn check(&self, integrals: usize) -> Result<(), String> {
+        if self.value.len() != integrals || self.std_err.len() != integrals {
+            return Err(format!(
+                "{} values and {} standard errors for a test bed of {integrals} integrals",
+                self.value.len(),
+                self.std_err.len()
+            ));
+        }
+        if let Some(i) = self.value.iter().position(|v| !v.is_finite()) {
+            return Err(format!("value {i} is not finite"));
+        }
+        if let Some(i) = self.std_err.iter().position(|s| !s.is_finite() || s.0.iter().any(|&x| x < 0.0)) {
+            return Err(format!("standard error {i} is negative or not finite"));
+        }
+        match &self.kind {
+            ReferenceKind::Exact { bound, .. } => {
+                if !(bound.is_finite() && *bound >= 0.0) {
+                    return Err(format!("exact bound {bound} is negative or not finite"));
+                }
+                if self.std_err.iter().any(|s| s.0 != [0.0; 3]) {
+                    return Err("an exact reference with non-zero standard errors".into());
+                }
+            }
+            ReferenceKind::Stored { samples, .. } => {
+                if *samples < 2 {
+                    return Err(format!("stored from {samples} samples (at least 2 are needed for a standard error)"));
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The local shading setup of one surface integral.

@@ -197,13 +197,16 @@ pub fn load_stored(field: Field, resolution: usize, scale: f64, albedo: f64) -> 
             format!("the stored multiple-scattering reference is {stored_res}x{stored_res} at scale 1 and the default albedo; other settings need `{cmd}` with them"),
         ));
     }
-    serde_json::from_value(doc["reference"].clone()).map_err(|e| {
+    let bad = |e: String| {
         ConfigError::invalid(
             format!("{}/multiple reference", field.id()),
             path.display(),
             format!("malformed reference ({e})"),
         )
-    })
+    };
+    let r: Reference = serde_json::from_value(doc["reference"].clone()).map_err(|e| bad(e.to_string()))?;
+    r.check(resolution * resolution).map_err(bad)?;
+    Ok(r)
 }
 
 /// Computes the stored multiple-scattering reference by long-run delta tracking (parameter

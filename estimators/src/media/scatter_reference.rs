@@ -205,7 +205,11 @@ fn load_stored(bed: &MediumBed) -> Result<Option<Reference>, ConfigError> {
     let r: Reference = serde_json::from_value(doc["reference"].clone()).map_err(|e| bad(format!("malformed ({e})")))?;
     let same_method =
         matches!(&r.kind, ReferenceKind::Exact { method, .. } if *method == Settings::of(Field::Perlin).method());
-    Ok((same_method && r.value.len() == bed.integrals()).then_some(r))
+    if !same_method {
+        return Ok(None);
+    }
+    r.check(bed.integrals()).map_err(|e| bad(format!("malformed ({e})")))?;
+    Ok(Some(r))
 }
 
 #[cfg(test)]

@@ -161,6 +161,23 @@ impl Moments {
         self.n
     }
 
+    /// Whether the state could have come from pushes and merges of finite values: finite mean and
+    /// moments, a non-negative sum of squares (to rounding), and nothing but zeros when empty.
+    /// For state read back from files.
+    pub fn check(&self) -> Result<(), String> {
+        let parts = [self.mean, self.m2, self.m3, self.mean_comp];
+        if parts.iter().any(|x| !x.is_finite()) {
+            return Err("non-finite moments".into());
+        }
+        if self.n == 0 && parts.iter().any(|&x| x != 0.0) {
+            return Err("moments of an empty sample".into());
+        }
+        if self.m2 < -1e-9 * (1.0 + self.mean * self.mean) * self.n as f64 {
+            return Err(format!("negative sum of squares {}", self.m2));
+        }
+        Ok(())
+    }
+
     /// Sample mean; `NaN` for an empty sample.
     pub fn mean(&self) -> f64 {
         if self.n == 0 {

@@ -112,6 +112,9 @@ impl CheckerImage {
             let msg = format!("the stored reference is for {:?} pixels; use that resolution", file.resolution);
             return Err(ConfigError::invalid("resolution", self.size, msg));
         }
+        file.reference
+            .check(n)
+            .map_err(|e| ConfigError::invalid("reference", path.display(), format!("malformed ({e}); {hint}")))?;
         Ok(file.reference)
     }
 

@@ -159,6 +159,9 @@ impl GradientBox {
             );
             return Err(ConfigError::invalid("reference", path.display(), msg));
         }
+        file.reference
+            .check(self.size * self.size)
+            .map_err(|e| ConfigError::invalid("reference", path.display(), format!("malformed ({e}); {hint}")))?;
         Ok(file.reference)
     }
 
