@@ -205,7 +205,7 @@ fn a_killed_run_resumes_to_the_same_results() {
             serde_json::from_str::<serde_json::Value>(&text).unwrap_or_else(|err| panic!("{p:?} corrupt: {err}"));
         }
     }
-    let resumed = mcbench(killed.path(), &args);
+    let resumed = mcbench(killed.path(), &[&args[..], &["--progress"]].concat());
     assert!(resumed.status.success(), "{}", stderr(&resumed));
     let log = String::from_utf8_lossy(&resumed.stdout).to_string() + &stderr(&resumed);
     assert_eq!(log.matches("(resumed)").count(), stored, "{log}");

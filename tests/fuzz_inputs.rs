@@ -1,12 +1,13 @@
-//! Property tests of bad input (SPEC §9, issue 9 item 4): random edits of a valid sweep file and
-//! of a valid `summary.json` never panic, and every rejection is one non-empty line that names the
-//! field (or the file and its position) and maps to exit code 2 (`tests/cli.rs` checks that the
-//! binary exits with the mapped code).
+//! Property tests of bad input (SPEC §9): random edits of every kind of file the harness reads (a
+//! sweep file in TOML or JSON, `summary.json`, a stored cell, a shard manifest, a stored
+//! reference) never panic, and every rejection is one non-empty line that names the field (or the
+//! file, and for parse errors its position) and maps to exit code 2 (`tests/cli.rs` and
+//! `tests/promises.rs` check that the binary exits with the mapped code).
 
 use experiments::config::{Mode, SweepFile};
 use experiments::error::HarnessError;
 use experiments::execute::{execute, prepare, ExecOptions};
-use experiments::output::read_results;
+use experiments::output::{read_results, read_results_unverified};
 use experiments::runner::Silent;
 use proptest::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -72,6 +73,31 @@ fn names_a_position(msg: &str) -> bool {
     (file.ends_with(".toml") || file.ends_with(".json")) && msg.contains("line ")
 }
 
+/// Whether a refusal of a file's content names that file (`<path>.json: why`).
+fn names_the_file(msg: &str, file: &str) -> bool {
+    msg.split(':').next().is_some_and(|p| p.ends_with(file))
+}
+
+/// As [`rejected_well`], for a file read back: the refusal may name the file instead of a field.
+fn file_rejected_well<T>(file: &str, f: impl FnOnce() -> Result<T, HarnessError>) -> Result<(), String> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Err(_) => Err("panicked".into()),
+        Ok(Ok(_)) => Ok(()),
+        Ok(Err(e)) => {
+            let msg = e.to_string();
+            if msg.trim().is_empty() || msg.trim_end().lines().count() != 1 {
+                Err(format!("not one line: {msg:?}"))
+            } else if e.exit_code() != 2 {
+                Err(format!("exit code {} for bad input: {msg}", e.exit_code()))
+            } else if !names_the_file(&msg, file) && !names_a_field(&msg) {
+                Err(format!("names neither {file} nor a field: {msg}"))
+            } else {
+                Ok(())
+            }
+        }
+    }
+}
+
 /// `Ok(())` when `f` neither panicked nor failed with anything but bad input (exit code 2) in one
 /// non-empty line that names the field or file.
 fn rejected_well<T>(f: impl FnOnce() -> Result<T, HarnessError>) -> Result<(), String> {
@@ -132,40 +158,134 @@ proptest! {
     }
 }
 
-/// A tiny real run, then random edits of its summary.json: `read_results` (what `mcbench plot`
-/// reads) never panics and rejects in one line.
-#[test]
-fn edited_result_files_never_panic_and_fail_in_one_line() {
+/// A tiny finished run of [`SMALL`] in a temp folder: (folder, plan, options' roots).
+fn tiny_run() -> (tempfile::TempDir, experiments::plan::Plan) {
     let dir = tempfile::tempdir().expect("tempdir");
     let config = dir.path().join("tiny.toml");
     std::fs::write(&config, SMALL).expect("write");
     let sweep = SweepFile::read(&config).and_then(|f| f.apply(None, Mode::Quick)).expect("valid sweep");
     let plan = prepare(sweep).expect("plan");
-    let opts = ExecOptions {
-        results_root: dir.path().join("results"),
-        plots_root: dir.path().join("plots"),
+    execute(&plan, None, &options(dir.path())).expect("runs");
+    (dir, plan)
+}
+
+fn options(root: &Path) -> ExecOptions<'static> {
+    ExecOptions {
+        results_root: root.join("results"),
+        plots_root: root.join("plots"),
         threads: Some(1),
         observer: &Silent,
         plots: false,
-    };
-    execute(&plan, None, &opts).expect("runs");
+        wait: false,
+    }
+}
+
+fn runner(cases: u32) -> proptest::test_runner::TestRunner {
+    proptest::test_runner::TestRunner::new(ProptestConfig {
+        cases,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })
+}
+
+fn edits() -> impl Strategy<Value = Vec<(usize, usize, u8)>> {
+    prop::collection::vec((0usize..1_000_000, 0usize..64, 0u8..3), 1..6)
+}
+
+/// Random edits of a finished run's summary.json: what `mcbench plot` reads never panics and
+/// rejects in one line; the reader's own checks are exercised with the folder's commit bypassed,
+/// and with the commit in place every edit that changed the file is refused as a mixed folder.
+#[test]
+fn edited_result_files_never_panic_and_fail_in_one_line() {
+    let (dir, _) = tiny_run();
     let res = dir.path().join("results/tiny");
     let original = std::fs::read_to_string(res.join("summary.json")).expect("summary.json");
     read_results(&res).expect("the untouched files read back");
-    let mut runner = proptest::test_runner::TestRunner::new(ProptestConfig {
-        cases: 300,
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    });
-    let strategy = prop::collection::vec((0usize..1_000_000, 0usize..64, 0u8..3), 1..6);
-    runner
-        .run(&strategy, |edits| {
+    runner(300)
+        .run(&edits(), |edits| {
             let copy = dir.path().join("copy");
             std::fs::create_dir_all(&copy).expect("dir");
-            std::fs::copy(res.join("summary.csv"), copy.join("summary.csv")).expect("csv");
-            std::fs::write(copy.join("summary.json"), mutate(&original, &edits)).expect("json");
-            prop_assert_eq!(rejected_well(|| read_results(&copy)), Ok(()));
+            for f in ["summary.csv", "integrals.csv", "commit.json"] {
+                std::fs::copy(res.join(f), copy.join(f)).expect("copy");
+            }
+            let edited = mutate(&original, &edits);
+            std::fs::write(copy.join("summary.json"), &edited).expect("json");
+            prop_assert_eq!(rejected_well(|| read_results_unverified(&copy)), Ok(()));
+            let verified = read_results(&copy);
+            prop_assert!(edited == original || verified.is_err(), "an edited summary.json passed its commit");
+            prop_assert_eq!(file_rejected_well("summary.json", || verified), Ok(()));
             Ok(())
         })
         .expect("no edit makes the reader panic or fail in more than one line");
+}
+
+/// Random edits of a stored cell: the resume's check ([`experiments::runner::preload`]) never
+/// panics, and refuses in one line naming the cell file.
+#[test]
+fn edited_cells_never_panic_and_fail_in_one_line() {
+    let (dir, plan) = tiny_run();
+    let cells = dir.path().join("results/tiny/cells");
+    let cell = std::fs::read_dir(&cells).expect("cells").next().expect("a cell").expect("entry").path();
+    let name = cell.file_name().and_then(|n| n.to_str()).expect("name").to_string();
+    let original = std::fs::read_to_string(&cell).expect("cell");
+    runner(300)
+        .run(&edits(), |edits| {
+            std::fs::write(&cell, mutate(&original, &edits)).expect("write");
+            prop_assert_eq!(file_rejected_well(&name, || experiments::runner::preload(&plan, Some(&cells))), Ok(()));
+            Ok(())
+        })
+        .expect("no edit makes the resume panic or fail in more than one line");
+}
+
+/// Random edits of a shard manifest: `merge` never panics and refuses in one line naming the
+/// manifest or the field.
+#[test]
+fn edited_manifests_never_panic_and_fail_in_one_line() {
+    let (dir, plan) = tiny_run();
+    let root = dir.path().join("results");
+    let shard = "1/1".parse().expect("spec");
+    let pre = experiments::shard::preflight(&plan, shard, &root).expect("preflight");
+    experiments::shard::run_shard(&plan, None, pre, Some(1), false, &Silent).expect("shard");
+    let folder = root.join("tiny/shard-1-of-1");
+    let manifest = folder.join("manifest.json");
+    let original = std::fs::read_to_string(&manifest).expect("manifest");
+    let out = dir.path().join("merged");
+    runner(150)
+        .run(&edits(), |edits| {
+            std::fs::write(&manifest, mutate(&original, &edits)).expect("write");
+            let opts = options(&out);
+            let merged = experiments::merge::merge(std::slice::from_ref(&folder), &opts);
+            prop_assert_eq!(file_rejected_well("manifest.json", || merged), Ok(()));
+            Ok(())
+        })
+        .expect("no edit makes the merge panic or fail in more than one line");
+}
+
+/// Random edits of a stored reference (the gradient-box file of the repository): parsing and
+/// checking it against its test bed never panics, and every reference that passes has the test
+/// bed's shape, finite values and non-negative standard errors.
+#[test]
+fn edited_references_never_panic_and_pass_only_when_well_formed() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/references/gradient-box_albedo-0.8.json");
+    let original = std::fs::read_to_string(path).expect("stored reference");
+    runner(300)
+        .run(&edits(), |edits| {
+            let text = mutate(&original, &edits);
+            let outcome = catch_unwind(AssertUnwindSafe(|| {
+                let doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
+                let r: estimators::testbed::Reference =
+                    serde_json::from_value(doc["reference"].clone()).map_err(|e| e.to_string())?;
+                r.check(256).map(|()| r)
+            }));
+            match outcome {
+                Err(_) => prop_assert!(false, "panicked"),
+                Ok(Ok(r)) => {
+                    prop_assert!(r.value.len() == 256 && r.std_err.len() == 256);
+                    prop_assert!(r.std_err.iter().all(|s| s.0.iter().all(|&x| x >= 0.0 && x.is_finite())));
+                }
+                Ok(Err(why)) => prop_assert!(!why.is_empty() && why.lines().count() == 1, "{why}"),
+            }
+            Ok(())
+        })
+        .expect("no edit makes the reference check panic");
 }

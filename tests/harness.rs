@@ -36,6 +36,7 @@ fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> experiment
         threads: Some(threads),
         observer: &Silent,
         plots,
+        wait: false,
     };
     execute(&plan, None, &opts).expect("run succeeds")
 }
@@ -156,11 +157,14 @@ fn independent_mc_error_falls_as_the_inverse_square_root() {
 
 #[test]
 fn incompatible_pairs_are_skipped_with_a_reason_and_bad_sweeps_refused() {
+    let plan = prepare(sweep(&["is0_cv0", "delta_tracking"], 3)).expect("valid");
+    assert_eq!(plan.pairs.len(), 1);
+    assert!(plan.skipped[0].reason.contains("medium"), "{}", plan.skipped[0].reason);
+    // A sweep in which no pair can run is refused (it would only overwrite results with nothing).
     let mut s = sweep(&["is0_cv0"], 3);
     s.budgets = vec![estimators::budget::Budget { kind: estimators::budget::BudgetKind::Fetches, amount: 10 }];
-    let plan = prepare(s).expect("valid");
-    assert!(plan.pairs.is_empty());
-    assert!(plan.skipped[0].reason.contains("medium"), "{}", plan.skipped[0].reason);
+    let err = prepare(s).err().expect("refused");
+    assert!(err.to_string().contains("medium") && err.exit_code() == 2, "{err}");
     let mut s = sweep(&["no_such_estimator"], 3);
     assert!(prepare(s.clone()).err().map(|e| e.to_string()).unwrap_or_default().contains("is0_cv0"));
     s.estimators = vec![EstimatorSpec::new("is0_cv0")];

@@ -37,7 +37,7 @@ fn deterministic_json(path: &Path) -> serde_json::Value {
             serde_json::Value::Object(m) => {
                 m.retain(|k, _| {
                     !TIMING_COLUMNS.contains(&k.as_str())
-                        && !["wall_seconds", "overhead", "speedup"].contains(&k.as_str())
+                        && !["wall_seconds", "overhead", "speedup", "run_id"].contains(&k.as_str())
                 });
                 m.values_mut().for_each(strip);
             }
@@ -77,7 +77,7 @@ fn three_shard_processes_merged_equal_a_single_run() {
         assert!(read(p("sh")) == read(p("single")), "{f} differs");
     }
     // The merged cells are a single run's resume store: a run over them recomputes nothing.
-    let o = mcbench(d, &run_args("sh/results", "sh/plots", "40", &["--no-plots"]));
+    let o = mcbench(d, &run_args("sh/results", "sh/plots", "40", &["--no-plots", "--progress"]));
     let log = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && !log.is_empty(), "{log}");
     assert!(log.lines().filter(|l| l.starts_with('[')).all(|l| l.ends_with("(resumed)")), "{log}");
@@ -133,7 +133,9 @@ fn bad_shard_values_and_bad_shard_sets_are_refused() {
         let mut v: Vec<PathBuf> = std::fs::read_dir(d.join(p))
             .expect("read_dir")
             .map(|e| e.expect("entry").path())
-            .filter(|p| p.file_name().is_some_and(|n| n != "manifest.json"))
+            .filter(|p| {
+                p.extension().is_some_and(|x| x == "json") && p.file_name().is_some_and(|n| n != "manifest.json")
+            })
             .collect();
         v.sort();
         v

@@ -29,11 +29,13 @@ pub struct CellKey {
 }
 
 impl CellKey {
-    /// A file name for the cell: readable prefix plus a digest of the whole key.
+    /// A file name for the cell: a short readable prefix (test bed, variant, estimator and budget,
+    /// each cut to 32 characters) and a digest of the whole key, so that no parameter value can
+    /// make the name long (the key itself is inside the file and checked on reading).
     pub fn file_name(&self) -> String {
         let text = serde_json::to_string(self).unwrap_or_default();
         let clean = |s: &str| {
-            s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect::<String>()
+            s.chars().take(32).map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect::<String>()
         };
         format!(
             "{}_{}_{}_{}{}_{:016x}.json",
@@ -115,6 +117,41 @@ pub struct CellResult {
     /// Sums over estimates of each diagnostic the estimator noted (name, sum).
     #[serde(default)]
     pub diagnostics: Vec<(String, f64)>,
+}
+
+impl CellResult {
+    /// Checks a cell read back from a file against what the plan expects of it: `integrals`
+    /// integrals with `reps` repetitions each, `reps x integrals` estimates, finite statistics.
+    /// `Err` says what is wrong, for a one-line refusal naming the file.
+    pub fn check_shape(&self, integrals: usize, reps: usize) -> Result<(), String> {
+        if self.moments.len() != integrals {
+            return Err(format!("{} integrals, the test bed has {integrals}", self.moments.len()));
+        }
+        let expected = (integrals as u64).saturating_mul(reps as u64);
+        if self.estimates != expected {
+            return Err(format!(
+                "{} estimates, {reps} repetitions of {integrals} integrals are {expected}",
+                self.estimates
+            ));
+        }
+        for (i, m) in self.moments.iter().enumerate() {
+            for (c, mc) in m.iter().enumerate() {
+                if mc.count() != reps as u64 {
+                    return Err(format!("integral {i} channel {c} has {} repetitions, not {reps}", mc.count()));
+                }
+                if let Err(e) = mc.check() {
+                    return Err(format!("integral {i} channel {c}: {e}"));
+                }
+            }
+        }
+        if self.time.count != self.estimates || !self.time.total.is_finite() || self.time.total < 0.0 {
+            return Err("its estimate times do not match its estimates".into());
+        }
+        if let Some((name, _)) = self.diagnostics.iter().find(|(_, v)| !v.is_finite()) {
+            return Err(format!("diagnostic `{name}` is not finite"));
+        }
+        Ok(())
+    }
 }
 
 /// Adds `(name, value)` pairs into running sums, keeping first-appearance order.

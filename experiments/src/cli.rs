@@ -1,5 +1,7 @@
-//! The `mcbench` command line (SPEC §9): `list`, `run`, `reference`, `plot`, and the default quick
-//! suite. Bad input is one line on stderr naming the field, exit code 2, and nothing written.
+//! The `mcbench` command line (SPEC §9): `list`, `run`, `reference`, `merge`, `plot`, and the
+//! default quick suite. Every subcommand exits by the one table of [`crate::error`]: bad input is
+//! one line on stderr naming the field or file, exit code 2, and nothing written; a results folder
+//! that another run holds is exit code 3 (or a wait, with `--wait`).
 
 use crate::config::{Mode, SweepFile};
 use crate::error::{HarnessError, Result};
@@ -53,6 +55,9 @@ enum Command {
         /// Results root.
         #[arg(long, default_value = "results")]
         results: PathBuf,
+        /// Wait for another run writing the references folder instead of refusing.
+        #[arg(long)]
+        wait: bool,
     },
     /// Merge the folders of `run --shard i/n` into the files a single run writes (SPEC §12).
     Merge {
@@ -72,14 +77,23 @@ enum Command {
         /// Skip plots and reports.
         #[arg(long)]
         no_plots: bool,
+        /// Wait for another run holding the output folders instead of refusing.
+        #[arg(long)]
+        wait: bool,
+        /// Plain progress lines on stderr even when it is not a terminal.
+        #[arg(long)]
+        progress: bool,
     },
     /// Redraw the plots and report of a results folder.
     Plot {
-        /// A results folder holding summary.csv and summary.json.
+        /// A results folder holding summary.csv and summary.json of a finished run.
         results_dir: PathBuf,
-        /// Plots root (the experiment's folder is created below it).
+        /// Plots root (the folder `<plots>/<name of results_dir>` is written).
         #[arg(long, default_value = "plots")]
         plots: PathBuf,
+        /// Wait for a run writing the folders instead of refusing.
+        #[arg(long)]
+        wait: bool,
     },
 }
 
@@ -101,11 +115,11 @@ struct RunArgs {
     /// Experiment seed.
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     seed: Option<u64>,
-    /// Repetitions per integral (>= 2).
-    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(2..=1_000_000))]
+    /// Repetitions per integral (2 to 1000000).
+    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(2..=crate::limits::MAX_REPS as u64))]
     reps: Option<u64>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=crate::limits::MAX_THREADS))]
     threads: Option<u64>,
     /// Results root.
     #[arg(long, value_name = "DIR", default_value = "results")]
@@ -122,6 +136,12 @@ struct RunArgs {
     /// Run only shard I of N of each sweep and write its statistics for `mcbench merge`.
     #[arg(long, value_name = "I/N")]
     shard: Option<ShardSpec>,
+    /// Wait for another run holding the output folders instead of refusing (exit 3).
+    #[arg(long)]
+    wait: bool,
+    /// Plain progress lines on stderr even when it is not a terminal.
+    #[arg(long)]
+    progress: bool,
 }
 
 impl RunArgs {
@@ -156,7 +176,8 @@ pub fn main_with_args(args: impl IntoIterator<Item = impl Into<OsString> + Clone
     match dispatch(cli) {
         Ok(()) => 0,
         Err(e) => {
-            eprintln!("error: {e}");
+            let text = e.to_string();
+            eprintln!("error: {}", text.lines().next().unwrap_or("failed"));
             e.exit_code()
         }
     }
@@ -173,17 +194,18 @@ fn dispatch(cli: Cli) -> Result<()> {
             list(what);
             Ok(())
         }
-        Some(Command::Reference { testbed, variant, samples, results }) => {
-            reference(&testbed, variant, samples, &results)
+        Some(Command::Reference { testbed, variant, samples, results, wait }) => {
+            reference(&testbed, variant, samples, &results, wait)
         }
-        Some(Command::Merge { dirs, results, plots, threads, no_plots }) => {
-            let progress = Progress::new();
+        Some(Command::Merge { dirs, results, plots, threads, no_plots, wait, progress }) => {
+            let progress = Progress::new(progress);
             let opts = ExecOptions {
                 results_root: results,
                 plots_root: plots,
                 threads: threads.map(|t| t as usize),
                 observer: &progress,
                 plots: !no_plots,
+                wait,
             };
             let t0 = Instant::now();
             let out = crate::merge::merge(&dirs, &opts)?;
@@ -191,13 +213,7 @@ fn dispatch(cli: Cli) -> Result<()> {
             println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             Ok(())
         }
-        Some(Command::Plot { results_dir, plots }) => {
-            let report = crate::output::read_results(&results_dir)?;
-            let dir = plots.join(&report.meta.experiment);
-            execute::draw(&report, &dir, &results_dir)?;
-            println!("plots and report.md written to {}", dir.display());
-            Ok(())
-        }
+        Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait),
     }
 }
 
@@ -236,24 +252,34 @@ fn run(names: &[String], args: &RunArgs) -> Result<()> {
         }
         prepared.push((def, execute::prepare(sweep)?));
     }
-    let progress = Progress::new();
+    let progress = Progress::new(args.progress);
     let opts = ExecOptions {
         results_root: args.results.clone(),
         plots_root: args.plots.clone(),
         threads: args.threads.map(|t| t as usize),
         observer: &progress,
         plots: !args.no_plots,
+        wait: args.wait,
     };
+    // Everything every experiment of the call will read is checked before the first one writes.
+    let mut checked = Vec::new();
+    for (_, plan) in &prepared {
+        checked.push(match args.shard {
+            Some(shard) => Checked::Shard(crate::shard::preflight(plan, shard, &args.results)?),
+            None => Checked::Run(execute::preflight(plan, &opts)?),
+        });
+    }
     let started = Instant::now();
-    for (def, plan) in &prepared {
+    for ((def, plan), checked) in prepared.iter().zip(checked) {
         let t0 = Instant::now();
-        if let Some(shard) = args.shard {
+        if let Checked::Shard(pre) = checked {
             let threads = args.threads.map(|t| t as usize);
-            let out = crate::shard::run_shard(plan, *def, shard, &args.results, threads, &progress)?;
+            let out = crate::shard::run_shard(plan, *def, pre, threads, args.wait, &progress)?;
             progress.finish();
             println!(
-                "{} shard {shard}: {} of {} units ({} resumed) in {:.1} s, written to {}",
+                "{} shard {}: {} of {} units ({} resumed) in {:.1} s, written to {}",
                 plan.sweep.experiment,
+                args.shard.map(|s| s.to_string()).unwrap_or_default(),
                 out.owned,
                 out.units,
                 out.resumed,
@@ -262,12 +288,36 @@ fn run(names: &[String], args: &RunArgs) -> Result<()> {
             );
             continue;
         }
-        let out = execute::execute(plan, *def, &opts)?;
+        let Checked::Run(pre) = checked else { continue };
+        let out = execute::execute_checked(plan, *def, &opts, pre)?;
         progress.finish();
         crate::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
         println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
     }
     println!("\ntotal wall time {:.1} s", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// What was checked for one experiment of a `run` before anything was written.
+enum Checked {
+    Run(execute::Preflight),
+    Shard(crate::shard::ShardPreflight),
+}
+
+/// `mcbench plot`: redraws a finished run's plots into `<plots>/<results folder's name>` (the
+/// folder name comes from the command line, never from the files read).
+fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool) -> Result<()> {
+    let name = std::fs::canonicalize(results_dir)
+        .ok()
+        .and_then(|p| p.file_name().and_then(|n| n.to_str()).map(String::from))
+        .ok_or_else(|| HarnessError::bad_file(results_dir, "not a results folder"))?;
+    let _read = crate::folder::read_lock(results_dir, wait)?;
+    let report = crate::output::read_results(results_dir)?;
+    let dir = plots.join(&name);
+    crate::folder::check_output_dir("--plots", &dir)?;
+    let _lock = crate::folder::FolderLock::acquire(&dir, wait, &[])?;
+    execute::draw(&report, &dir, results_dir)?;
+    println!("plots and report.md written to {}", dir.display());
     Ok(())
 }
 
@@ -309,10 +359,18 @@ fn list(what: Option<ListWhat>) {
     }
 }
 
-fn reference(testbed: &str, variant: Option<String>, samples: Option<u64>, results: &std::path::Path) -> Result<()> {
+fn reference(
+    testbed: &str,
+    variant: Option<String>,
+    samples: Option<u64>,
+    results: &std::path::Path,
+    wait: bool,
+) -> Result<()> {
     let entry = estimators::registry::testbed(testbed)?;
     let variant = variant.unwrap_or_else(|| entry.variants[0].to_string());
     entry.check_variant(&variant)?;
+    let folder = results.join("references");
+    crate::folder::check_output_dir("--results", &folder)?;
     let t0 = Instant::now();
     // Exact variants compute their reference when built; stored ones run the test bed's hook.
     let built = (entry.build)(&variant, &Params::new());
@@ -344,6 +402,7 @@ fn reference(testbed: &str, variant: Option<String>, samples: Option<u64>, resul
         "reference": r,
     });
     let text = serde_json::to_string(&doc).map_err(|e| HarnessError::write(&path, e))?;
+    let _lock = crate::folder::FolderLock::acquire(&folder, wait, &[])?;
     crate::output::write_atomic(&path, text.as_bytes())?;
     let kind = match &r.kind {
         estimators::testbed::ReferenceKind::Exact { method, bound } => {

@@ -64,11 +64,22 @@ impl EstimatorSpec {
             .0
             .iter()
             .map(|(k, v)| match v {
-                ParamValue::Number(x) => format!("{k}={x}"),
+                ParamValue::Number(x) => format!("{k}={}", compact_number(*x)),
                 ParamValue::Text(t) => format!("{k}={t}"),
             })
             .collect();
         format!("{}[{}]", self.id, kv.join(","))
+    }
+}
+
+/// A number as it appears in names: plain decimal (`0.4`, `1`, `20000`) where that is short, and
+/// exponent form (`1e200`, `1e-9`) where plain decimal would run to dozens of digits.
+pub fn compact_number(x: f64) -> String {
+    let plain = format!("{x}");
+    if plain.len() <= 24 {
+        plain
+    } else {
+        format!("{x:e}")
     }
 }
 
@@ -213,17 +224,25 @@ impl SweepFile {
 }
 
 impl Sweep {
-    /// Checks what can be checked without building anything.
+    /// Checks what can be checked without building anything: the name, every count against
+    /// [`crate::limits`], duplicate entries, and that a `baseline` names one of the estimators.
     pub fn validate(&self) -> Result<()> {
+        use crate::limits::{max_budget, MAX_BUDGETS, MAX_ENTRIES, MAX_REPS};
         let name_ok = !self.experiment.is_empty()
+            && self.experiment.len() <= 64
             && self.experiment.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
         if !name_ok {
-            return Err(ConfigError::invalid("name", &self.experiment, "use letters, digits, '-' and '_'").into());
+            return Err(
+                ConfigError::invalid("name", &self.experiment, "use 1 to 64 letters, digits, '-' and '_'").into()
+            );
         }
         if self.reps < 2 {
             return Err(
                 ConfigError::invalid("reps", self.reps, "at least 2 repetitions are needed for variances").into()
             );
+        }
+        if self.reps > MAX_REPS {
+            return Err(ConfigError::invalid("reps", self.reps, format!("at most {MAX_REPS} repetitions")).into());
         }
         if self.budgets.is_empty() || self.testbeds.is_empty() || self.estimators.is_empty() {
             return Err(ConfigError::invalid(
@@ -233,8 +252,29 @@ impl Sweep {
             )
             .into());
         }
+        if self.budgets.len() > MAX_BUDGETS {
+            return Err(
+                ConfigError::invalid("budgets", self.budgets.len(), format!("at most {MAX_BUDGETS} budgets")).into()
+            );
+        }
+        if self.testbeds.len() > MAX_ENTRIES || self.estimators.len() > MAX_ENTRIES {
+            let (field, n) = if self.testbeds.len() > MAX_ENTRIES {
+                ("testbeds", self.testbeds.len())
+            } else {
+                ("estimators", self.estimators.len())
+            };
+            return Err(ConfigError::invalid(field, n, format!("at most {MAX_ENTRIES} entries")).into());
+        }
         if let Some(b) = self.budgets.iter().find(|b| b.amount == 0) {
             return Err(ConfigError::invalid("budgets", b.amount, "budgets must be >= 1").into());
+        }
+        if let Some(b) = self.budgets.iter().find(|b| b.amount > max_budget(b.kind)) {
+            return Err(ConfigError::invalid(
+                "budgets",
+                b.amount,
+                format!("a {} budget is at most {} per estimate", b.kind.name(), max_budget(b.kind)),
+            )
+            .into());
         }
         if self.budgets.windows(2).any(|w| w[0].amount >= w[1].amount || w[0].kind != w[1].kind) {
             return Err(ConfigError::invalid(
@@ -243,6 +283,28 @@ impl Sweep {
                 "must be increasing and of one kind",
             )
             .into());
+        }
+        for (i, t) in self.testbeds.iter().enumerate() {
+            if self.testbeds[..i].contains(t) {
+                let v = t.variant.as_deref().unwrap_or("(default)");
+                return Err(ConfigError::invalid("testbeds", format!("{}/{v}", t.id), "listed twice").into());
+            }
+        }
+        let names: Vec<String> = self.estimators.iter().map(EstimatorSpec::name).collect();
+        for (i, n) in names.iter().enumerate() {
+            if names[..i].contains(n) {
+                return Err(ConfigError::invalid("estimators", n, "listed twice").into());
+            }
+        }
+        if let Some(b) = &self.baseline {
+            if !names.contains(b) {
+                return Err(ConfigError::invalid(
+                    "baseline",
+                    b,
+                    format!("names no estimator of the sweep (valid: {})", names.join(", ")),
+                )
+                .into());
+            }
         }
         Ok(())
     }

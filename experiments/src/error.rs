@@ -1,8 +1,25 @@
-//! Harness errors and their exit codes (SPEC §9: 0 success, 2 bad input, 1 internal failure).
+//! Harness errors and the one exit-code table every subcommand uses (SPEC §9 names 0, 1 and 2;
+//! 3 extends it).
+//!
+//! | code | meaning | examples |
+//! |---|---|---|
+//! | 0 | success | |
+//! | 1 | internal failure while running or writing | an estimator failed, the disk filled up |
+//! | 2 | bad input: nothing was run or written | unknown names, values out of bounds, a config, stored cell, reference, manifest or summary file that is malformed or inconsistent, an output path that is not a writable folder |
+//! | 3 | busy: another mcbench holds the results folder | a second run into the same folder (`--wait` waits instead) |
 
 use estimators::error::ConfigError;
 use std::path::PathBuf;
 use thiserror::Error;
+
+/// Exit code of a successful run.
+pub const EXIT_OK: i32 = 0;
+/// Exit code of an internal failure (an estimator failed, a write failed).
+pub const EXIT_FAILURE: i32 = 1;
+/// Exit code of bad input (nothing was run or written).
+pub const EXIT_BAD_INPUT: i32 = 2;
+/// Exit code when another process holds the results folder's lock.
+pub const EXIT_BUSY: i32 = 3;
 
 /// Everything the harness can fail with.
 #[derive(Debug, Error)]
@@ -11,13 +28,31 @@ pub enum HarnessError {
     /// A bad name, value or combination in flags or config (exit 2).
     #[error(transparent)]
     Config(#[from] ConfigError),
-    /// A config or result file that cannot be read or parsed (exit 2).
+    /// A config or result file that cannot be read, parsed or trusted (exit 2).
     #[error("{path}: {reason}")]
     BadFile {
         /// The file.
         path: PathBuf,
         /// What is wrong with it.
         reason: String,
+    },
+    /// An output path that cannot be used: not a folder, or not writable (exit 2).
+    #[error("{field} {path}: {reason}")]
+    BadOutput {
+        /// The flag or field that named it (`--results`, `--plots`).
+        field: &'static str,
+        /// The path.
+        path: PathBuf,
+        /// Why it cannot be used.
+        reason: String,
+    },
+    /// Another process holds the folder's lock (exit 3).
+    #[error("{path} is in use by another mcbench run (pid {holder}); wait for it, or pass --wait")]
+    Busy {
+        /// The locked folder.
+        path: PathBuf,
+        /// What the lock file says of its holder.
+        holder: String,
     },
     /// An estimator failed while running (exit 1).
     #[error("estimator {estimator} on {testbed}: {source}")]
@@ -40,11 +75,12 @@ pub enum HarnessError {
 }
 
 impl HarnessError {
-    /// The process exit code for this error.
+    /// The process exit code for this error (the table in the module docs).
     pub fn exit_code(&self) -> i32 {
         match self {
-            HarnessError::Config(_) | HarnessError::BadFile { .. } => 2,
-            HarnessError::Estimate { .. } | HarnessError::Write { .. } => 1,
+            HarnessError::Config(_) | HarnessError::BadFile { .. } | HarnessError::BadOutput { .. } => EXIT_BAD_INPUT,
+            HarnessError::Busy { .. } => EXIT_BUSY,
+            HarnessError::Estimate { .. } | HarnessError::Write { .. } => EXIT_FAILURE,
         }
     }
     /// A bad-file error.
@@ -54,6 +90,10 @@ impl HarnessError {
     /// A write error.
     pub fn write(path: impl Into<PathBuf>, reason: impl ToString) -> Self {
         HarnessError::Write { path: path.into(), reason: reason.to_string() }
+    }
+    /// A bad-output-path error.
+    pub fn bad_output(field: &'static str, path: impl Into<PathBuf>, reason: impl ToString) -> Self {
+        HarnessError::BadOutput { field, path: path.into(), reason: reason.to_string() }
     }
 }
 

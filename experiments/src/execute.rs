@@ -5,11 +5,13 @@ use crate::analysis::{self, TestRow};
 use crate::cell::CellResult;
 use crate::config::Sweep;
 use crate::error::Result;
+use crate::folder::{check_output_dir, FolderLock, OutputDir};
 use crate::metrics::{summarize, SummaryRow};
 use crate::output::{self, Diagnostic, IntegralRow, Meta, RunReport};
 use crate::plan::Plan;
 use crate::runner::{self, Observer, RunOptions, RunResults};
 use crate::suite::ExperimentDef;
+use estimators::budget::BudgetKind;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -25,6 +27,8 @@ pub struct ExecOptions<'a> {
     pub observer: &'a dyn Observer,
     /// Draw plots and the report.
     pub plots: bool,
+    /// Wait for another run's lock on the folders instead of refusing (exit 3).
+    pub wait: bool,
 }
 
 /// What a finished experiment produced.
@@ -42,20 +46,61 @@ pub fn prepare(sweep: Sweep) -> Result<Plan> {
     Plan::prepare(sweep)
 }
 
-/// Runs a prepared plan and writes every output.
-pub fn execute(plan: &Plan, def: Option<&ExperimentDef>, opts: &ExecOptions<'_>) -> Result<Outcome> {
-    let started = Instant::now();
+/// What a run reads before it writes anything: the stored cells it will resume from, checked.
+pub struct Preflight {
+    stored: Vec<Option<CellResult>>,
+}
+
+/// Everything a run checks before it writes anything (after [`prepare`] checked the plan): the
+/// output folders are folders or can be made, and every stored cell it will read is well formed.
+pub fn preflight(plan: &Plan, opts: &ExecOptions<'_>) -> Result<Preflight> {
     let results_dir = opts.results_root.join(&plan.sweep.experiment);
-    let run = runner::run(
+    check_output_dir("--results", &results_dir)?;
+    if opts.plots {
+        check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
+    }
+    let stored = runner::preload(plan, Some(&results_dir.join("cells")))?;
+    Ok(Preflight { stored })
+}
+
+/// Runs a prepared plan and writes every output ([`preflight`], then [`execute_checked`]).
+pub fn execute(plan: &Plan, def: Option<&ExperimentDef>, opts: &ExecOptions<'_>) -> Result<Outcome> {
+    let checked = preflight(plan, opts)?;
+    execute_checked(plan, def, opts, checked)
+}
+
+/// The folders' locks of a run: results (with its `cells`) and, when plots are drawn, plots.
+pub fn lock_folders(experiment: &str, opts: &ExecOptions<'_>) -> Result<Vec<FolderLock>> {
+    let mut locks = vec![FolderLock::acquire(&opts.results_root.join(experiment), opts.wait, &["cells"])?];
+    if opts.plots {
+        locks.push(FolderLock::acquire(&opts.plots_root.join(experiment), opts.wait, &[])?);
+    }
+    Ok(locks)
+}
+
+/// Runs a plan whose [`preflight`] passed: takes the folders' locks (refusing, exit 3, or waiting
+/// when another run holds them), runs the missing cells, and writes every output.
+pub fn execute_checked(
+    plan: &Plan,
+    def: Option<&ExperimentDef>,
+    opts: &ExecOptions<'_>,
+    checked: Preflight,
+) -> Result<Outcome> {
+    let started = Instant::now();
+    let _locks = lock_folders(&plan.sweep.experiment, opts)?;
+    let results_dir = opts.results_root.join(&plan.sweep.experiment);
+    let run = runner::run_preloaded(
         plan,
         &RunOptions { threads: opts.threads, cell_dir: Some(results_dir.join("cells")), observer: opts.observer },
+        checked.stored,
     )?;
     finish(plan, def, &run, opts, started)
 }
 
 /// Everything after the cells are known: metrics, fits, tests, claims, the experiment's post hook,
 /// result files, plots and report. A single run and a merge of shards
-/// ([`crate::merge`]) both end here, so equal cells give equal files.
+/// ([`crate::merge`]) both end here, so equal cells give equal files. The caller holds the
+/// folders' locks ([`lock_folders`]); the files of each folder are committed last.
 pub fn finish(
     plan: &Plan,
     def: Option<&ExperimentDef>,
@@ -66,6 +111,8 @@ pub fn finish(
     let sweep = &plan.sweep;
     let results_dir = opts.results_root.join(&sweep.experiment);
     let plots_dir = opts.plots_root.join(&sweep.experiment);
+    let results = OutputDir::new(&results_dir);
+    let run_id = crate::folder::run_id(&sweep.experiment);
     let mut rows: Vec<SummaryRow> = Vec::new();
     let mut tests: Vec<TestRow> = Vec::new();
     let mut integrals: Vec<IntegralRow> = Vec::new();
@@ -104,6 +151,12 @@ pub fn finish(
             ),
         });
     }
+    let reproducible = sweep.budgets.iter().all(|b| b.kind != BudgetKind::Micros);
+    if !reproducible {
+        notes.push(
+            "time budgets (micros) become a sample count calibrated by a CPU-time pilot on this machine: results are not bit-reproducible across runs or machines".into(),
+        );
+    }
     let threads = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
         .build()
@@ -121,6 +174,8 @@ pub fn finish(
             reps: sweep.reps,
             wall_seconds: 0.0,
             notes,
+            run_id: run_id.clone(),
+            reproducible,
         },
         fits,
         tests,
@@ -137,25 +192,34 @@ pub fn finish(
     }
     let mut extra_plots = Vec::new();
     if let Some(post) = def.and_then(|d| d.post) {
-        extra_plots = post(plan, run, &mut report, &results_dir, opts.plots.then_some(plots_dir.as_path()))?;
+        extra_plots = post(plan, run, &mut report, &results, opts.plots.then_some(plots_dir.as_path()))?;
     }
     report.meta.wall_seconds = started.elapsed().as_secs_f64();
-    output::write_summary_csv(&results_dir.join("summary.csv"), &report.rows)?;
-    output::write_integrals_csv(&results_dir.join("integrals.csv"), &integrals)?;
-    output::write_summary_json(&results_dir.join("summary.json"), &report)?;
+    output::write_summary_csv(&results, &report.rows)?;
+    output::write_integrals_csv(&results, &integrals)?;
+    output::write_summary_json(&results, &report)?;
+    results.commit(&run_id, None)?;
     if opts.plots {
-        let mut files = crate::plot::write_plots(&report, &plots_dir)?;
-        files.extend(extra_plots);
-        crate::report::write_report(&report, &files, &plots_dir, &results_dir)?;
+        draw_with(&report, &plots_dir, &results_dir, extra_plots)?;
     }
     Ok(Outcome { report, results_dir, plots_dir })
 }
 
-/// Draws the plots and the report of a finished run.
+/// Draws the plots and the report of a finished run into `plots_dir` and commits them.
 pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path) -> Result<()> {
-    let files = crate::plot::write_plots(report, plots_dir)?;
-    crate::report::write_report(report, &files, plots_dir, results_dir)?;
-    Ok(())
+    draw_with(report, plots_dir, results_dir, Vec::new())
+}
+
+fn draw_with(report: &RunReport, plots_dir: &Path, results_dir: &Path, extra: Vec<PathBuf>) -> Result<()> {
+    let plots = OutputDir::new(plots_dir);
+    let mut files = crate::plot::write_plots(report, plots_dir)?;
+    files.extend(extra);
+    for f in &files {
+        plots.record(f)?;
+    }
+    let md = crate::report::render_report(report, &files, plots_dir, results_dir);
+    plots.write("report.md", md.as_bytes())?;
+    plots.commit(&crate::folder::run_id(&report.meta.experiment), Some(&report.meta.run_id))
 }
 
 fn integral_rows(cell: &CellResult, bed: &dyn estimators::testbed::TestBed) -> Vec<IntegralRow> {

@@ -133,34 +133,29 @@ pub fn merge(dirs: &[PathBuf], opts: &ExecOptions<'_>) -> Result<Outcome> {
     }
     let blocks = runner::rep_blocks(plan.sweep.reps);
     let results_dir = opts.results_root.join(&plan.sweep.experiment);
+    crate::folder::check_output_dir("--results", &results_dir)?;
+    if opts.plots {
+        crate::folder::check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
+    }
     let mut cells = Vec::with_capacity(plan.pairs.len() * plan.sweep.budgets.len());
     for (c, cell_units) in units.chunks(blocks).enumerate() {
         let (bi, ei) = plan.pairs[cell_units[0].pair];
         let budget = plan.sweep.budgets[cell_units[0].budget];
         let key = runner::cell_key(&plan, bi, ei, budget);
+        let integrals = plan.beds[bi].bed.integrals();
         let mut parts = Vec::with_capacity(blocks);
         for (k, u) in cell_units.iter().enumerate() {
             let (dir, m) = &shards[(c * blocks + k) % first.shard.count];
             let path = dir.join(shard::block_file_name(&key, u.block));
-            let file = shard::read_block(&path)?.ok_or_else(|| {
+            let file = shard::read_checked_block(&path, &key, u.block, blocks, integrals)?.ok_or_else(|| {
                 HarnessError::bad_file(&path, format!("missing: shard {} is incomplete or damaged", m.shard))
             })?;
-            let integrals = plan.beds[bi].bed.integrals();
-            if file.stats.key != key || file.block != u.block || file.blocks != blocks {
-                return Err(HarnessError::bad_file(&path, "corrupt shard block (it holds another cell or block)"));
-            }
-            if file.stats.moments.len() != integrals {
-                let got = file.stats.moments.len();
-                return Err(HarnessError::bad_file(
-                    &path,
-                    format!("corrupt shard block ({got} integrals, {integrals} expected)"),
-                ));
-            }
             parts.push(file.stats);
         }
         cells.push((bi, ei, runner::merge_blocks(key, &parts)));
     }
     // Only a complete, consistent set gets here: nothing is written before.
+    let _locks = execute::lock_folders(&plan.sweep.experiment, opts)?;
     for (_, _, cell) in &cells {
         // Stored like a single run's cells, so `mcbench run` on these results resumes from them.
         let path = results_dir.join("cells").join(cell.key.file_name());

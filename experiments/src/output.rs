@@ -3,6 +3,7 @@
 
 use crate::analysis::{Fit, SpeedUp, TestRow};
 use crate::error::{HarnessError, Result};
+use crate::folder::OutputDir;
 use crate::metrics::SummaryRow;
 use crate::plan::Skipped;
 use serde::{Deserialize, Serialize};
@@ -51,6 +52,17 @@ pub struct Meta {
     pub wall_seconds: f64,
     /// Free-form notes (noise corrections applied, references used, ...).
     pub notes: Vec<String>,
+    /// This run's id, also in the folder's `commit.json` (empty in files written before it).
+    #[serde(default)]
+    pub run_id: String,
+    /// Whether the same seed reproduces these results bit for bit (false when a time budget was
+    /// calibrated on this machine).
+    #[serde(default = "yes")]
+    pub reproducible: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// A paper claim beside our measurement (`paper` in summary.json).
@@ -150,15 +162,15 @@ fn csv_bytes<F: FnOnce(&mut csv::Writer<Vec<u8>>) -> csv::Result<()>>(f: F) -> R
     w.into_inner().map_err(|e| HarnessError::write("csv", e))
 }
 
-/// Writes `summary.csv`.
-pub fn write_summary_csv(path: &Path, rows: &[SummaryRow]) -> Result<()> {
+/// Writes `summary.csv` into a run's results folder.
+pub fn write_summary_csv(dir: &OutputDir, rows: &[SummaryRow]) -> Result<()> {
     let bytes = csv_bytes(|w| {
         if rows.is_empty() {
             w.write_record(SUMMARY_HEADER)?;
         }
         rows.iter().try_for_each(|r| w.serialize(r))
     })?;
-    write_atomic(path, &bytes)
+    dir.write("summary.csv", &bytes).map(|_| ())
 }
 
 /// The header of summary.csv (used when there are no rows).
@@ -191,7 +203,7 @@ pub const SUMMARY_HEADER: &[&str] = &[
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).
-pub fn write_integrals_csv(path: &Path, rows: &[IntegralRow]) -> Result<()> {
+pub fn write_integrals_csv(dir: &OutputDir, rows: &[IntegralRow]) -> Result<()> {
     let mut geo: Vec<&'static str> = Vec::new();
     for r in rows {
         for (name, _) in &r.geometry {
@@ -237,13 +249,13 @@ pub fn write_integrals_csv(path: &Path, rows: &[IntegralRow]) -> Result<()> {
         }
         Ok(())
     })?;
-    write_atomic(path, &bytes)
+    dir.write("integrals.csv", &bytes).map(|_| ())
 }
 
 /// Writes `summary.json`.
-pub fn write_summary_json(path: &Path, report: &RunReport) -> Result<()> {
-    let text = serde_json::to_string_pretty(report).map_err(|e| HarnessError::write(path, e))?;
-    write_atomic(path, text.as_bytes())
+pub fn write_summary_json(dir: &OutputDir, report: &RunReport) -> Result<()> {
+    let text = serde_json::to_string_pretty(report).map_err(|e| HarnessError::write(dir.join("summary.json"), e))?;
+    dir.write("summary.json", text.as_bytes()).map(|_| ())
 }
 
 /// Reads back a number of summary.json that serde_json wrote as `null` (it writes NaN and the
@@ -253,18 +265,36 @@ pub fn f64_or_nan<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
-/// Reads a results folder back (`summary.json` and `summary.csv`), for `mcbench plot`.
+/// Reads a results folder back (`summary.json` and `summary.csv`), for `mcbench plot`: the folder
+/// must be one finished run ([`crate::folder::verify`]: its files are those its `commit.json` lists),
+/// and what is read is checked (the experiment name is a plain name, every row parses).
 pub fn read_results(dir: &Path) -> Result<RunReport> {
+    crate::folder::verify(dir, &["summary.json", "summary.csv"])?;
+    read_results_unverified(dir)
+}
+
+/// [`read_results`] without the commit check (for tests of the readers' own checks).
+pub fn read_results_unverified(dir: &Path) -> Result<RunReport> {
     let json = dir.join("summary.json");
     let text = std::fs::read_to_string(&json).map_err(|e| HarnessError::bad_file(&json, e))?;
     let mut report: RunReport = serde_json::from_str(&text).map_err(|e| HarnessError::bad_file(&json, e))?;
+    let name = &report.meta.experiment;
+    let plain =
+        !name.is_empty() && name.len() <= 64 && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
+    if !plain {
+        return Err(HarnessError::bad_file(&json, format!("meta.experiment {name:?} is not a plain experiment name")));
+    }
     let csv_path = dir.join("summary.csv");
     let mut rd = csv::Reader::from_path(&csv_path).map_err(|e| HarnessError::bad_file(&csv_path, e))?;
     report.rows = rd
         .deserialize()
         .collect::<std::result::Result<Vec<SummaryRow>, _>>()
-        .map_err(|e| HarnessError::bad_file(&csv_path, e))?;
+        .map_err(|e| HarnessError::bad_file(&csv_path, one_line(&e.to_string())))?;
     Ok(report)
+}
+
+fn one_line(s: &str) -> String {
+    s.lines().next().unwrap_or("malformed").to_string()
 }
 
 #[cfg(test)]

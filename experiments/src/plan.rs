@@ -5,6 +5,7 @@
 use crate::config::{EstimatorSpec, Sweep, TestBedSpec};
 use crate::error::Result;
 use estimators::budget::BudgetKind;
+use estimators::error::ConfigError;
 use estimators::estimator::Estimator;
 use estimators::registry::{self, EstimatorEntry};
 use estimators::testbed::{Needs, TestBed};
@@ -75,6 +76,12 @@ impl Plan {
             let entry = registry::testbed(&spec.id)?;
             let variant = spec.variant.clone().unwrap_or_else(|| entry.variants[0].to_string());
             entry.check_variant(&variant)?;
+            if beds
+                .iter()
+                .any(|b: &PreparedBed| b.spec.id == spec.id && b.variant == variant && b.spec.params == spec.params)
+            {
+                return Err(ConfigError::invalid("testbeds", format!("{}/{variant}", spec.id), "listed twice").into());
+            }
             let bed = (entry.build)(&variant, &spec.params)?;
             beds.push(PreparedBed { spec: spec.clone(), variant, bed });
         }
@@ -109,6 +116,27 @@ impl Plan {
                         reason,
                     }),
                 }
+            }
+        }
+        // A sweep in which nothing can run would only overwrite earlier results with empty files.
+        if pairs.is_empty() {
+            let why = skipped
+                .first()
+                .map(|s| format!(" (e.g. {} on {}/{}: {})", s.estimator, s.testbed, s.variant, s.reason));
+            return Err(ConfigError::invalid(
+                "estimators",
+                &sweep.experiment,
+                format!("no estimator of the sweep can run on any of its test beds{}", why.unwrap_or_default()),
+            )
+            .into());
+        }
+        if let Some(b) = &sweep.baseline {
+            let runs = pairs.iter().any(|&(_, ei)| &estimators[ei].name == b);
+            if !runs {
+                let why = skipped.iter().find(|s| &s.estimator == b).map(|s| s.reason.clone()).unwrap_or_default();
+                return Err(
+                    ConfigError::invalid("baseline", b, format!("runs on no test bed of the sweep: {why}")).into()
+                );
             }
         }
         Ok(Plan { sweep, beds, estimators, pairs, skipped })

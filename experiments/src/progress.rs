@@ -1,4 +1,6 @@
-//! Progress for long runs: a bar with ETA on a terminal, plain lines otherwise (SPEC §9).
+//! Progress for long runs (SPEC §9): a bar with ETA when stderr is a terminal; otherwise nothing,
+//! unless `--progress` asks for plain lines (so that in a log or a pipe an error is the only line
+//! on stderr).
 
 use crate::runner::Observer;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -9,12 +11,14 @@ use std::sync::Mutex;
 pub struct Progress {
     bar: Mutex<Option<ProgressBar>>,
     terminal: bool,
+    lines: bool,
 }
 
 impl Progress {
-    /// A progress reporter for stderr.
-    pub fn new() -> Self {
-        Progress { bar: Mutex::new(None), terminal: std::io::stderr().is_terminal() }
+    /// A progress reporter for stderr: a bar on a terminal; plain lines elsewhere only when
+    /// `lines` is set (`--progress`).
+    pub fn new(lines: bool) -> Self {
+        Progress { bar: Mutex::new(None), terminal: std::io::stderr().is_terminal(), lines }
     }
     /// Clears the bar at the end of an experiment.
     pub fn finish(&self) {
@@ -28,7 +32,7 @@ impl Progress {
 
 impl Default for Progress {
     fn default() -> Self {
-        Self::new()
+        Self::new(false)
     }
 }
 
@@ -36,7 +40,9 @@ impl Observer for Progress {
     fn cell_done(&self, done: usize, total: usize, label: &str, resumed: bool) {
         let tag = if resumed { " (resumed)" } else { "" };
         if !self.terminal {
-            eprintln!("[{done}/{total}] {label}{tag}");
+            if self.lines {
+                eprintln!("[{done}/{total}] {label}{tag}");
+            }
             return;
         }
         let Ok(mut slot) = self.bar.lock() else { return };

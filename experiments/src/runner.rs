@@ -179,6 +179,39 @@ fn samples_for_fetch_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -
     Ok((n as u64).clamp(1, cap))
 }
 
+/// The fixed number of samples per estimate that a time budget buys: a pilot on its own stream
+/// (as for fetch budgets) runs the estimator until each pilot estimate's time is up, and
+/// `n = budget x pilot samples / pilot CPU microseconds`. Stopping each real estimate when its time
+/// runs out would make its sample count depend on the values drawn (slow paths and their values go
+/// together); a count fixed in advance does not. The count depends on the machine, so a time budget
+/// is the one setting whose results are not bit-reproducible (`meta.reproducible` says so).
+fn samples_for_time_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<u64> {
+    let b = &plan.beds[bi];
+    let frames = b.bed.sequence_length().max(1);
+    let sequences = b.bed.integrals() / frames;
+    let picks = sequences.min(PILOT_SEQUENCES);
+    let label = b.label();
+    let pilot = CellRun { plan, label: &label, bi, ei, budget, samples: None };
+    let pilots: Vec<Result<(u64, f64)>> = (0..picks)
+        .into_par_iter()
+        .map(|k| {
+            let mut out = Item::default();
+            let t0 = crate::cputime::thread_seconds();
+            run_sequence(&pilot, PILOT_REP, k * sequences / picks * frames, &mut out)?;
+            Ok((out.costs.samples, crate::cputime::thread_seconds() - t0))
+        })
+        .collect();
+    let (mut samples, mut seconds) = (0u64, 0.0f64);
+    for p in pilots {
+        let (n, s) = p?;
+        samples += n;
+        seconds += s;
+    }
+    let micros = (seconds * 1e6).max(1.0);
+    let n = (budget.amount as f64 * samples as f64 / micros).round();
+    Ok((n as u64).clamp(1, crate::limits::MAX_SAMPLES))
+}
+
 /// Repetitions per block. A cell's repetitions are reduced block by block (Welford pushes in
 /// repetition order inside a block, [`Moments::merge`] of the blocks in block order), so the block
 /// is the unit a shard (`--shard i/n`) can own: the split is fixed by the sweep's `reps` alone,
@@ -186,27 +219,67 @@ fn samples_for_fetch_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -
 /// A cell of at most `REP_BLOCK` repetitions is one block, reduced exactly as before blocks existed.
 pub const REP_BLOCK: usize = 16;
 
+/// At most this many work items (one repetition of one batch of integrals) are in flight at once:
+/// blocks run a chunk at a time, so memory does not grow with the repetition count.
+const MAX_ITEMS: usize = 8192;
+
 /// The number of repetition blocks of a sweep with `reps` repetitions.
 pub fn rep_blocks(reps: usize) -> usize {
     reps.div_ceil(REP_BLOCK)
 }
 
-/// Runs one cell (no resume logic): every repetition block, merged in block order.
+/// Runs one cell (no resume logic): every repetition block, merged in block order as it finishes.
 pub fn run_cell(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<CellResult> {
     let blocks: Vec<usize> = (0..rep_blocks(plan.sweep.reps)).collect();
-    let parts = run_blocks(plan, bi, ei, budget, &blocks)?;
-    Ok(merge_blocks(cell_key(plan, bi, ei, budget), &parts))
+    let key = cell_key(plan, bi, ei, budget);
+    let mut out = empty_cell(key, plan.beds[bi].bed.integrals());
+    run_blocks_with(plan, bi, ei, budget, &blocks, |_, part| {
+        merge_into(&mut out, &part);
+        Ok(())
+    })?;
+    Ok(out)
 }
 
 /// Runs the given repetition blocks of one cell and returns each block's sufficient statistics
-/// (a [`CellResult`] over that block's repetitions, keyed by the whole cell), in the order given.
+/// (see [`run_blocks_with`]), in the order given.
+pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[usize]) -> Result<Vec<CellResult>> {
+    let mut parts = Vec::with_capacity(blocks.len());
+    run_blocks_with(plan, bi, ei, budget, blocks, |_, part| {
+        parts.push(part);
+        Ok(())
+    })?;
+    Ok(parts)
+}
+
+/// The sample count a budget becomes before a cell runs: a fetch or time budget is calibrated
+/// by a pilot ([`samples_for_fetch_budget`], [`samples_for_time_budget`]); a sample budget is used
+/// as it is (`None`).
+fn calibrated_samples(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Option<u64>> {
+    Ok(match budget.kind {
+        BudgetKind::Fetches => Some(samples_for_fetch_budget(plan, bi, ei, budget)?),
+        BudgetKind::Micros => Some(samples_for_time_budget(plan, bi, ei, budget)?),
+        BudgetKind::Samples => None,
+    })
+}
+
+/// Runs the given repetition blocks of one cell and hands each block's sufficient statistics
+/// (a [`CellResult`] over that block's repetitions, keyed by the whole cell) to `sink` with its
+/// position in `blocks`, in that order, as soon as it is reduced; blocks run a chunk at a time so
+/// that memory stays bounded whatever the repetition count.
 /// Work items are whole sequences (test beds whose integrals come in frames,
 /// [`estimators::testbed::TestBed::sequence_length`]), batched to about `BATCH` integrals; each
 /// sequence draws from the stream of its first integral, so a static test bed (sequence length 1)
 /// keeps exactly the per-integral streams and batches it always had. A fetch budget first becomes a
 /// fixed sample count ([`samples_for_fetch_budget`]; its pilot is deterministic, so every shard
 /// owning a block of the cell computes the same count).
-pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[usize]) -> Result<Vec<CellResult>> {
+pub fn run_blocks_with(
+    plan: &Plan,
+    bi: usize,
+    ei: usize,
+    budget: Budget,
+    blocks: &[usize],
+    mut sink: impl FnMut(usize, CellResult) -> Result<()>,
+) -> Result<()> {
     let b = &plan.beds[bi];
     let n = b.bed.integrals();
     let frames = b.bed.sequence_length().max(1);
@@ -214,46 +287,52 @@ pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[u
     let per_item = BATCH.div_ceil(frames);
     let reps = plan.sweep.reps;
     let batches = sequences.div_ceil(per_item);
-    let samples = match budget.kind {
-        BudgetKind::Fetches => Some(samples_for_fetch_budget(plan, bi, ei, budget)?),
-        _ => None,
-    };
+    if blocks.is_empty() {
+        return Ok(());
+    }
+    let samples = calibrated_samples(plan, bi, ei, budget)?;
     let label = b.label();
     let cell = CellRun { plan, label: &label, bi, ei, budget, samples };
-    // (position in `blocks`, repetition, batch), repetition-major inside each block.
-    let work: Vec<(usize, usize, usize)> = blocks
-        .iter()
-        .enumerate()
-        .flat_map(|(pos, &blk)| {
-            (blk * REP_BLOCK..((blk + 1) * REP_BLOCK).min(reps))
-                .flat_map(move |rep| (0..batches).map(move |batch| (pos, rep, batch)))
-        })
-        .collect();
-    let items: Vec<Result<Item>> = work
-        .par_iter()
-        .map(|&(_, rep, batch)| {
-            let mut out = Item::default();
-            for s in batch * per_item..((batch + 1) * per_item).min(sequences) {
-                run_sequence(&cell, rep as u64, s * frames, &mut out)?;
-            }
-            Ok(out)
-        })
-        .collect();
     let key = cell_key(plan, bi, ei, budget);
-    let mut parts = vec![empty_cell(key, n); blocks.len()];
-    for (&(pos, _, batch), r) in work.iter().zip(items) {
-        let (r, part) = (r?, &mut parts[pos]);
-        for (k, v) in r.values.iter().enumerate() {
-            for c in 0..3 {
-                part.moments[batch * per_item * frames + k][c].push(v[c]);
+    let per_chunk = (MAX_ITEMS / (REP_BLOCK * batches).max(1)).max(1);
+    for (c, chunk) in blocks.chunks(per_chunk).enumerate() {
+        // (position in `chunk`, repetition, batch), repetition-major inside each block.
+        let work: Vec<(usize, usize, usize)> = chunk
+            .iter()
+            .enumerate()
+            .flat_map(|(pos, &blk)| {
+                (blk * REP_BLOCK..((blk + 1) * REP_BLOCK).min(reps))
+                    .flat_map(move |rep| (0..batches).map(move |batch| (pos, rep, batch)))
+            })
+            .collect();
+        let items: Vec<Result<Item>> = work
+            .par_iter()
+            .map(|&(_, rep, batch)| {
+                let mut out = Item::default();
+                for s in batch * per_item..((batch + 1) * per_item).min(sequences) {
+                    run_sequence(&cell, rep as u64, s * frames, &mut out)?;
+                }
+                Ok(out)
+            })
+            .collect();
+        let mut parts = vec![empty_cell(key.clone(), n); chunk.len()];
+        for (&(pos, _, batch), r) in work.iter().zip(items) {
+            let (r, part) = (r?, &mut parts[pos]);
+            for (k, v) in r.values.iter().enumerate() {
+                for c in 0..3 {
+                    part.moments[batch * per_item * frames + k][c].push(v[c]);
+                }
             }
+            part.estimates += r.values.len() as u64;
+            add(&mut part.costs, &r.costs);
+            part.time.merge(&r.time);
+            add_diagnostics(&mut part.diagnostics, &r.diagnostics);
         }
-        part.estimates += r.values.len() as u64;
-        add(&mut part.costs, &r.costs);
-        part.time.merge(&r.time);
-        add_diagnostics(&mut part.diagnostics, &r.diagnostics);
+        for (k, part) in parts.into_iter().enumerate() {
+            sink(c * per_chunk + k, part)?;
+        }
     }
-    Ok(parts)
+    Ok(())
 }
 
 /// A cell of `n` integrals with no estimates yet.
@@ -268,21 +347,30 @@ fn empty_cell(key: CellKey, n: usize) -> CellResult {
     }
 }
 
+/// Adds one block's statistics into a cell's (blocks must come in block order for a
+/// bit-reproducible result).
+fn merge_into(out: &mut CellResult, p: &CellResult) {
+    if out.moments.is_empty() {
+        out.moments = p.moments.iter().map(|_| Default::default()).collect();
+    }
+    for (m, pm) in out.moments.iter_mut().zip(&p.moments) {
+        for c in 0..3 {
+            m[c].merge(&pm[c]);
+        }
+    }
+    out.estimates += p.estimates;
+    add(&mut out.costs, &p.costs);
+    out.time.merge(&p.time);
+    add_diagnostics(&mut out.diagnostics, &p.diagnostics);
+}
+
 /// Merges the blocks of one cell, in the order given (block order for a bit-reproducible result),
 /// into the cell's statistics under `key`.
 pub fn merge_blocks(key: CellKey, parts: &[CellResult]) -> CellResult {
     let n = parts.first().map_or(0, |p| p.moments.len());
     let mut out = empty_cell(key, n);
     for p in parts {
-        for (m, pm) in out.moments.iter_mut().zip(&p.moments) {
-            for c in 0..3 {
-                m[c].merge(&pm[c]);
-            }
-        }
-        out.estimates += p.estimates;
-        add(&mut out.costs, &p.costs);
-        out.time.merge(&p.time);
-        add_diagnostics(&mut out.diagnostics, &p.diagnostics);
+        merge_into(&mut out, p);
     }
     out
 }
@@ -302,36 +390,63 @@ pub fn cell_key(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> CellKey {
     }
 }
 
-/// Reads a stored cell back; `None` when absent or stored under another key.
-pub(crate) fn read_cell(path: &Path, key: &CellKey) -> Result<Option<CellResult>> {
+/// Reads a stored cell back: `None` when absent; a file that does not parse, holds another cell
+/// or does not fit the plan (integrals, repetitions, finite statistics) is bad input naming the file.
+pub(crate) fn read_cell(path: &Path, key: &CellKey, integrals: usize) -> Result<Option<CellResult>> {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(HarnessError::bad_file(path, e)),
     };
-    let cell: CellResult = serde_json::from_str(&text)
-        .map_err(|e| HarnessError::bad_file(path, format!("corrupt stored cell ({e}); delete it to recompute")))?;
-    Ok((cell.key == *key).then_some(cell))
+    let refuse =
+        |why: String| HarnessError::bad_file(path, format!("corrupt stored cell ({why}); delete it to recompute"));
+    let cell: CellResult = serde_json::from_str(&text).map_err(|e| refuse(e.to_string()))?;
+    if cell.key != *key {
+        return Err(refuse("it holds another cell than its name says".into()));
+    }
+    cell.check_shape(integrals, key.reps).map_err(refuse)?;
+    Ok(Some(cell))
 }
 
-/// Runs every cell of the plan, reading back stored cells and storing new ones.
+/// The stored cells of a plan, in (pair, budget) order, read and checked before anything runs:
+/// a corrupt cell is refused before any other cell is recomputed or written.
+pub fn preload(plan: &Plan, cell_dir: Option<&Path>) -> Result<Vec<Option<CellResult>>> {
+    let mut out = Vec::with_capacity(plan.pairs.len() * plan.sweep.budgets.len());
+    for &(bi, ei) in &plan.pairs {
+        for &budget in &plan.sweep.budgets {
+            let key = cell_key(plan, bi, ei, budget);
+            out.push(match cell_dir {
+                Some(d) => read_cell(&d.join(key.file_name()), &key, plan.beds[bi].bed.integrals())?,
+                None => None,
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// Runs every cell of the plan, reading back stored cells (checked first, [`preload`]) and
+/// storing new ones.
 pub fn run(plan: &Plan, opts: &RunOptions<'_>) -> Result<RunResults> {
+    let stored = preload(plan, opts.cell_dir.as_deref())?;
+    run_preloaded(plan, opts, stored)
+}
+
+/// [`run`] with the stored cells already read by [`preload`].
+pub fn run_preloaded(plan: &Plan, opts: &RunOptions<'_>, stored: Vec<Option<CellResult>>) -> Result<RunResults> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
         .build()
         .map_err(|e| HarnessError::write("thread pool", e))?;
     let total = plan.pairs.len() * plan.sweep.budgets.len();
     let mut cells = Vec::with_capacity(total);
+    let mut stored = stored.into_iter();
     for &(bi, ei) in &plan.pairs {
         for &budget in &plan.sweep.budgets {
             let key = cell_key(plan, bi, ei, budget);
             let path = opts.cell_dir.as_ref().map(|d| d.join(key.file_name()));
-            let stored = match &path {
-                Some(p) => read_cell(p, &key)?,
-                None => None,
-            };
-            let resumed = stored.is_some();
-            let cell = match stored {
+            let found = stored.next().flatten();
+            let resumed = found.is_some();
+            let cell = match found {
                 Some(c) => c,
                 None => {
                     let c = pool.install(|| run_cell(plan, bi, ei, budget))?;

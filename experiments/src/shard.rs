@@ -151,6 +151,78 @@ pub fn read_block(path: &Path) -> Result<Option<BlockFile>> {
         .map_err(|e| HarnessError::bad_file(path, format!("corrupt shard block ({e})")))
 }
 
+/// Repetitions in block `block` of a sweep with `reps` repetitions.
+pub fn block_reps(reps: usize, block: usize) -> usize {
+    ((block + 1) * runner::REP_BLOCK).min(reps).saturating_sub(block * runner::REP_BLOCK)
+}
+
+/// Reads a block file and checks it against the plan: the cell `key`, block `block` of `blocks`,
+/// `integrals` integrals with the block's repetitions each. `None` when absent.
+pub fn read_checked_block(
+    path: &Path,
+    key: &CellKey,
+    block: usize,
+    blocks: usize,
+    integrals: usize,
+) -> Result<Option<BlockFile>> {
+    let Some(f) = read_block(path)? else { return Ok(None) };
+    if f.stats.key != *key || f.block != block || f.blocks != blocks {
+        return Err(HarnessError::bad_file(path, "corrupt shard block (it holds another cell or block)"));
+    }
+    f.stats
+        .check_shape(integrals, block_reps(key.reps, block))
+        .map_err(|e| HarnessError::bad_file(path, format!("corrupt shard block ({e})")))?;
+    Ok(Some(f))
+}
+
+/// What a shard checked before writing anything: its folder, and which of its units an earlier,
+/// interrupted run of the same shard already finished.
+pub struct ShardPreflight {
+    dir: PathBuf,
+    shard: ShardSpec,
+    /// Per owned cell (in plan order): its units' blocks still to run.
+    todo: Vec<(usize, usize, Vec<usize>)>,
+    owned: usize,
+    resumed: usize,
+    units: usize,
+}
+
+/// Checks a shard run before anything is written: the sweep can be split (a time budget is
+/// calibrated per machine, so its blocks could not be merged exactly), the shard folder can be
+/// written, and every block file already there is well formed.
+pub fn preflight(plan: &Plan, shard: ShardSpec, results_root: &Path) -> Result<ShardPreflight> {
+    if plan.sweep.budgets.iter().any(|b| b.kind == estimators::budget::BudgetKind::Micros) {
+        return Err(estimators::error::ConfigError::invalid(
+            "budget_kind",
+            "micros",
+            "time budgets are calibrated on each machine, so their shards could not be merged exactly; use samples or fetches",
+        )
+        .into());
+    }
+    let dir = results_root.join(&plan.sweep.experiment).join(shard.dir_name());
+    crate::folder::check_output_dir("--results", &dir)?;
+    let all = units(plan);
+    let blocks = runner::rep_blocks(plan.sweep.reps);
+    let owned: Vec<&Unit> = all.iter().enumerate().filter(|(u, _)| shard.owns(*u)).map(|(_, unit)| unit).collect();
+    let mut resumed = 0;
+    let mut todo = Vec::new();
+    for cell in owned.chunk_by(|a, b| (a.pair, a.budget) == (b.pair, b.budget)) {
+        let (bi, ei) = plan.pairs[cell[0].pair];
+        let budget = plan.sweep.budgets[cell[0].budget];
+        let key = runner::cell_key(plan, bi, ei, budget);
+        let integrals = plan.beds[bi].bed.integrals();
+        let mut missing = Vec::new();
+        for u in cell {
+            match read_checked_block(&dir.join(block_file_name(&key, u.block)), &key, u.block, blocks, integrals)? {
+                Some(_) => resumed += 1,
+                None => missing.push(u.block),
+            }
+        }
+        todo.push((cell[0].pair, cell[0].budget, missing));
+    }
+    Ok(ShardPreflight { dir, shard, todo, owned: owned.len(), resumed, units: all.len() })
+}
+
 /// What a finished shard did.
 pub struct ShardOutcome {
     /// The shard folder.
@@ -163,49 +235,41 @@ pub struct ShardOutcome {
     pub units: usize,
 }
 
-/// Runs shard `shard` of a prepared plan into `<results_root>/<experiment>/shard-<i>-of-<n>/`:
-/// one block file per owned unit (read back instead of recomputed when already there), then the
-/// manifest, last, so a folder without one is an unfinished shard.
+/// Runs a shard of a prepared plan whose [`preflight`] passed into
+/// `<results_root>/<experiment>/shard-<i>-of-<n>/`: takes the shard folder's lock, writes one
+/// block file per owned unit as soon as it is reduced (units an interrupted run finished are kept),
+/// then the manifest, last, so a folder without one is an unfinished shard.
 pub fn run_shard(
     plan: &Plan,
     def: Option<&ExperimentDef>,
-    shard: ShardSpec,
-    results_root: &Path,
+    pre: ShardPreflight,
     threads: Option<usize>,
+    wait: bool,
     observer: &dyn Observer,
 ) -> Result<ShardOutcome> {
-    let dir = results_root.join(&plan.sweep.experiment).join(shard.dir_name());
+    let ShardPreflight { dir, shard, todo, owned, resumed, units } = pre;
+    let _lock = crate::folder::FolderLock::acquire(&dir, wait, &[])?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(|e| HarnessError::write("thread pool", e))?;
-    let all = units(plan);
     let blocks = runner::rep_blocks(plan.sweep.reps);
-    let owned: Vec<&Unit> = all.iter().enumerate().filter(|(u, _)| shard.owns(*u)).map(|(_, unit)| unit).collect();
-    let mut resumed = 0;
-    // The owned blocks of one cell run together, so a fetch budget's pilot runs once per cell.
-    let cells: Vec<&[&Unit]> = owned.chunk_by(|a, b| (a.pair, a.budget) == (b.pair, b.budget)).collect();
-    for (done, cell) in cells.iter().enumerate() {
-        let (bi, ei) = plan.pairs[cell[0].pair];
-        let budget = plan.sweep.budgets[cell[0].budget];
+    for (done, (pair, budget, missing)) in todo.iter().enumerate() {
+        let (bi, ei) = plan.pairs[*pair];
+        let budget = plan.sweep.budgets[*budget];
         let key = runner::cell_key(plan, bi, ei, budget);
-        let mut todo = Vec::new();
-        for u in cell.iter() {
-            let path = dir.join(block_file_name(&key, u.block));
-            match read_block(&path)? {
-                Some(f) if f.stats.key == key && f.block == u.block && f.blocks == blocks => resumed += 1,
-                _ => todo.push(u.block),
-            }
-        }
-        let parts = pool.install(|| runner::run_blocks(plan, bi, ei, budget, &todo))?;
-        for (block, stats) in todo.iter().zip(parts) {
-            let path = dir.join(block_file_name(&key, *block));
-            let file = BlockFile { block: *block, blocks, stats };
-            let text = serde_json::to_string(&file).map_err(|e| HarnessError::write(&path, e))?;
-            write_atomic(&path, text.as_bytes())?;
-        }
+        // The owned blocks of one cell run together, so a fetch budget's pilot runs once per cell.
+        pool.install(|| {
+            runner::run_blocks_with(plan, bi, ei, budget, missing, |pos, stats| {
+                let block = missing[pos];
+                let path = dir.join(block_file_name(&key, block));
+                let file = BlockFile { block, blocks, stats };
+                let text = serde_json::to_string(&file).map_err(|e| HarnessError::write(&path, e))?;
+                write_atomic(&path, text.as_bytes())
+            })
+        })?;
         let label = format!("{} {} {}={}", plan.beds[bi].label(), key.estimator, budget.kind.name(), budget.amount);
-        observer.cell_done(done + 1, cells.len(), &label, todo.is_empty());
+        observer.cell_done(done + 1, todo.len(), &label, missing.is_empty());
     }
     let manifest = Manifest {
         format: FORMAT,
@@ -215,14 +279,14 @@ pub fn run_shard(
         reps: plan.sweep.reps,
         rep_block: runner::REP_BLOCK,
         shard,
-        units: all.len(),
+        units,
         sweep_digest: sweep_digest(&plan.sweep),
         sweep: plan.sweep.clone(),
     };
     let path = dir.join(MANIFEST);
     let text = serde_json::to_string_pretty(&manifest).map_err(|e| HarnessError::write(&path, e))?;
     write_atomic(&path, text.as_bytes())?;
-    Ok(ShardOutcome { dir, owned: owned.len(), resumed, units: all.len() })
+    Ok(ShardOutcome { dir, owned, resumed, units })
 }
 
 #[cfg(test)]

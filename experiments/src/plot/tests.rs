@@ -70,6 +70,8 @@ pub(crate) fn synthetic_report() -> RunReport {
             reps: 16,
             wall_seconds: 12.5,
             notes: vec!["exact reference".into()],
+            run_id: "r1".into(),
+            reproducible: true,
         },
         fits,
         tests: vec![test("is0_cv0", 0.42, "pass"), test("is1_cv2", 3.1e-7, "biased")],

@@ -6,7 +6,8 @@
 use super::canonical_cells::{cell_rows, refused_terminating, z_crit, Agreement, CellRow};
 use super::canonical_sweep::FAMILIES;
 use crate::error::Result;
-use crate::output::{write_atomic, RunReport};
+use crate::folder::OutputDir;
+use crate::output::RunReport;
 use crate::plan::Plan;
 use crate::runner::RunResults;
 use estimators::budget::BudgetKind;
@@ -92,16 +93,16 @@ pub fn post(
     plan: &Plan,
     run: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
     report.skipped.extend(refused_terminating(plan));
     let equal_cost = plan.sweep.budgets.iter().any(|b| b.kind == BudgetKind::Fetches);
     let analysis = Analysis::new(cell_rows(plan, run, report), equal_cost);
-    write_atomic(&results.join("cells.csv"), csv_text(&analysis).as_bytes())?;
+    results.write("cells.csv", csv_text(&analysis).as_bytes())?;
     let (csv, md) = super::canonical_winners::tables(&analysis);
-    write_atomic(&results.join("winners.csv"), csv.as_bytes())?;
-    write_atomic(&results.join("winners.md"), md.as_bytes())?;
+    results.write("winners.csv", csv.as_bytes())?;
+    results.write("winners.md", md.as_bytes())?;
     report.paper.extend(super::canonical_sweep_claims::claims(&analysis));
     match plots {
         Some(dir) => super::canonical_sweep_plots::heat_maps(&analysis, dir),

@@ -145,6 +145,7 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
         threads: Some(1),
         observer: &Silent,
         plots: true,
+        wait: false,
     };
     let out = execute(&prepare(sweep).unwrap(), Some(&super::canonical_sweep::DEF), &opts).unwrap();
     let claim = |start: &str| out.report.paper.iter().find(|c| c.claim.starts_with(start)).unwrap().clone();

@@ -5,7 +5,8 @@
 
 use super::envmap_smc::{m_values, p_values};
 use crate::error::{HarnessError, Result};
-use crate::output::{write_atomic, Claim, RunReport};
+use crate::folder::OutputDir;
+use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
 use crate::plot::{write_figure, Figure, Series};
 use crate::runner::RunResults;
@@ -79,7 +80,7 @@ pub fn post(
     plan: &Plan,
     run: &RunResults,
     report: &mut RunReport,
-    results_dir: &Path,
+    results_dir: &OutputDir,
     plots_dir: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
     let mode = plan.sweep.mode;
@@ -90,11 +91,11 @@ pub fn post(
             csv.push_str(&format!("envmap-sequence,{},\"{}\",{},{},{}\n", e.variant, e.estimator, f + 1, r, e.seconds));
         }
     }
-    write_atomic(&results_dir.join("frames.csv"), csv.as_bytes())?;
+    results_dir.write("frames.csv", csv.as_bytes())?;
     let mut figures: Vec<(String, Figure)> = Vec::new();
     let frames = plan.beds.first().map(|b| b.bed.sequence_length()).unwrap_or(1);
     if frames < 2 {
-        return Err(HarnessError::write(results_dir, "envmap-smc needs at least 2 frames"));
+        return Err(HarnessError::write(results_dir.path(), "envmap-smc needs at least 2 frames"));
     }
 
     // (a) RMSE of L_ns at the first propagated frame (paper Fig. 3: one 1.5 degree rotation) vs P.

@@ -5,7 +5,8 @@
 //! largest budget must be at least 3x the reference's RMS standard error (SPEC §2, issue 4).
 
 use crate::error::Result;
-use crate::output::{write_atomic, Claim, RunReport};
+use crate::folder::OutputDir;
+use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
 use crate::runner::RunResults;
 use std::path::{Path, PathBuf};
@@ -25,7 +26,7 @@ pub fn post(
     plan: &Plan,
     _run: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     _plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
     let last = plan.sweep.budgets.last().map_or(0, |b| b.amount);
@@ -43,7 +44,7 @@ pub fn post(
             .collect();
         csv.push_str(&format!("{},{},{last},{CRITERION},{}\n", d.variant, d.estimator, v.join(",")));
     }
-    write_atomic(&results.join("structure.csv"), csv.as_bytes())?;
+    results.write("structure.csv", csv.as_bytes())?;
     // Paper 000 Table 1 (Fig. 5 column: criterion 256, depth 7, 2489 nodes, 2178 leaves, 3887712
     // cells, 163.5 MB at 512 x 512 pixels): ours is the same structure at 16 x 16 pixels.
     let table1 = [("depth", 7.0), ("nodes", 2489.0), ("leaves", 2178.0), ("cells", 3_887_712.0), ("bytes", 163.5e6)];

@@ -38,6 +38,7 @@ pub mod unbiasedness_table;
 pub mod variance_claims;
 
 use crate::config::{EstimatorSpec, Mode, Sweep};
+use crate::folder::OutputDir;
 use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
 use crate::runner::RunResults;
@@ -64,9 +65,11 @@ pub struct ExperimentDef {
     pub post: Option<PostFn>,
 }
 
-/// An experiment's own analysis: (plan, finished cells, report to extend, results folder, plots
-/// folder when plots are drawn) -> extra plot files.
-pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &Path, Option<&Path>) -> crate::error::Result<Vec<PathBuf>>;
+/// An experiment's own analysis: (plan, finished cells, report to extend, results folder (its
+/// files are written through it and committed with the run's), plots folder when plots are
+/// drawn) -> extra plot files.
+pub type PostFn =
+    fn(&Plan, &RunResults, &mut RunReport, &OutputDir, Option<&Path>) -> crate::error::Result<Vec<PathBuf>>;
 
 /// Every experiment, in the order the default suite runs them.
 pub static EXPERIMENTS: &[&ExperimentDef] = &[

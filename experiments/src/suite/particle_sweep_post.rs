@@ -6,8 +6,9 @@
 
 use super::particle_sweep::{IDS, SIGMAS};
 use crate::error::Result;
+use crate::folder::OutputDir;
 use crate::metrics::SummaryRow;
-use crate::output::{write_atomic, RunReport};
+use crate::output::RunReport;
 use crate::plan::Plan;
 use crate::plot::{write_figure, Figure, Series};
 use crate::runner::RunResults;
@@ -27,7 +28,7 @@ pub fn post(
     _: &Plan,
     _: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
     let mut csv = String::from("testbed,model,sigma_samp,budget,fetches,samples,rmse,fom\n");
@@ -44,7 +45,7 @@ pub fn post(
             r.rmse
         ));
     }
-    write_atomic(&results.join("fom.csv"), csv.as_bytes())?;
+    results.write("fom.csv", csv.as_bytes())?;
     let Some(dir) = plots else { return Ok(Vec::new()) };
     let budget = report.rows.iter().map(|r| r.budget).max().unwrap_or(0);
     let mut files = Vec::new();

@@ -6,7 +6,8 @@
 //! weight) and in `alpha_maps.csv`.
 
 use crate::error::{HarnessError, Result};
-use crate::output::{write_atomic, RunReport};
+use crate::folder::OutputDir;
+use crate::output::RunReport;
 use crate::plan::Plan;
 use crate::plot::maps::{write_maps, Map, Scale};
 use crate::runner::RunResults;
@@ -63,10 +64,10 @@ pub fn post(
     plan: &Plan,
     _run: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
-    write_atomic(&results.join("table2.csv"), table2(report).as_bytes())?;
+    results.write("table2.csv", table2(report).as_bytes())?;
     let Some(est) = plan.estimators.iter().find(|e| e.name == "pmc_hi") else { return Ok(Vec::new()) };
     let budget = Budget::samples(FIG7_SPP).map_err(|e| HarnessError::write("fig7", e))?;
     let mut csv = String::from("variant,px,py,alpha_light0,alpha_light1,alpha_brdf,alpha_cone\n");
@@ -112,6 +113,6 @@ pub fn post(
             files.extend(write_maps(dir, &format!("fig7_{}", bed.variant), &title, &panels)?);
         }
     }
-    write_atomic(&results.join("alpha_maps.csv"), csv.as_bytes())?;
+    results.write("alpha_maps.csv", csv.as_bytes())?;
     Ok(files)
 }

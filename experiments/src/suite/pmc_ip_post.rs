@@ -8,7 +8,8 @@
 
 use super::pmc_ip::{row, PMC_IP_4};
 use crate::error::{HarnessError, Result};
-use crate::output::{write_atomic, RunReport};
+use crate::folder::OutputDir;
+use crate::output::RunReport;
 use crate::plan::{Plan, PreparedBed};
 use crate::plot::maps::{write_maps, Map, Scale};
 use crate::runner::RunResults;
@@ -117,10 +118,10 @@ pub fn post(
     plan: &Plan,
     run: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
-    write_atomic(&results.join("table1.csv"), table1(plan, report).as_bytes())?;
+    results.write("table1.csv", table1(plan, report).as_bytes())?;
     report.paper.extend(super::claims::reference_precision(plan, report));
     let budget = 10;
     let Some(ip) = pmc_ip_of(plan, "pmc_ip") else { return Ok(Vec::new()) };
@@ -181,6 +182,6 @@ pub fn post(
         );
         files.extend(write_maps(dir, &format!("fig4_{}", bed.variant), &title, &maps)?);
     }
-    write_atomic(&results.join("pixels.csv"), csv.as_bytes())?;
+    results.write("pixels.csv", csv.as_bytes())?;
     Ok(files)
 }

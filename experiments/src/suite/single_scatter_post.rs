@@ -6,7 +6,8 @@
 
 use super::single_scatter::{ranking, IDS, NOISE_FREE, PAPER_BUDGETS};
 use crate::error::Result;
-use crate::output::{write_atomic, Claim, RunReport};
+use crate::folder::OutputDir;
+use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
 use crate::runner::RunResults;
 use std::path::{Path, PathBuf};
@@ -27,7 +28,7 @@ pub fn post(
     plan: &Plan,
     _run: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     _plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
     let mut csv = String::from(
@@ -119,6 +120,6 @@ pub fn post(
         }
     }
     report.paper.extend(claims);
-    write_atomic(&results.join("equal_fetch.csv"), csv.as_bytes())?;
+    results.write("equal_fetch.csv", csv.as_bytes())?;
     Ok(Vec::new())
 }

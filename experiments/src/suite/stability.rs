@@ -14,8 +14,9 @@ use super::stability_numeric::{self as num, Sequence};
 use super::{available, ExperimentDef};
 use crate::config::{powers_of_four, Mode, Sweep, TestBedSpec};
 use crate::error::Result;
+use crate::folder::OutputDir;
 use crate::guarded::one_line;
-use crate::output::{write_atomic, Claim, RunReport};
+use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
 use crate::runner::RunResults;
 use estimators::params::Params;
@@ -112,7 +113,7 @@ pub fn post(
     plan: &Plan,
     _run: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     _plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
     let mode = plan.sweep.mode;
@@ -168,11 +169,11 @@ pub fn post(
         csv.push_str(&fields.join(","));
         csv.push('\n');
     }
-    write_atomic(&results.join("stability.csv"), csv.as_bytes())?;
+    results.write("stability.csv", csv.as_bytes())?;
     let mut pz = String::from("site,guard,cases\n");
     for (site, guard, cases) in PDF_ZERO {
         pz.push_str(&format!("{},{},{}\n", csv_field(site), csv_field(guard), csv_field(cases)));
     }
-    write_atomic(&results.join("pdf_zero.csv"), pz.as_bytes())?;
+    results.write("pdf_zero.csv", pz.as_bytes())?;
     Ok(Vec::new())
 }

@@ -7,7 +7,8 @@
 
 use super::variance_claims::{build, central_ray, measure, Measured, CASES};
 use crate::error::Result;
-use crate::output::{write_atomic, Claim, RunReport};
+use crate::folder::OutputDir;
+use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
 use crate::plot::{write_figure, Figure, Series};
 use crate::runner::RunResults;
@@ -25,7 +26,7 @@ pub fn post(
     _: &Plan,
     _: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
     let Some((bed, grid)) = central_ray(POINTS) else { return Ok(Vec::new()) };
@@ -65,7 +66,7 @@ pub fn post(
             note: format!("points s = 1..20 whose measured variance lies within 4 SE of Eq. 16 ({RAYS} one-ray estimates each; SE from the sample fourth moment, itself unreliable for heavy tails); worst |z| {worst:.2}; data in fig8_bands.csv"),
         });
     }
-    write_atomic(&results.join("fig8_bands.csv"), csv.as_bytes())?;
+    results.write("fig8_bands.csv", csv.as_bytes())?;
     let Some(dir) = plots else { return Ok(Vec::new()) };
     let fig = Figure {
         title: "transmittance: paper 002 Fig. 8 — relative std sd[T̂(s)] / T(s), eq21 central ray".into(),

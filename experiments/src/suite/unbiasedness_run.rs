@@ -12,8 +12,9 @@ use super::unbiasedness_reps::pooled_over_repetitions;
 use super::unbiasedness_table as table;
 use crate::config::Sweep;
 use crate::error::Result;
+use crate::folder::OutputDir;
 use crate::metrics::summarize;
-use crate::output::{write_atomic, RunReport};
+use crate::output::RunReport;
 use crate::plan::Plan;
 use crate::progress::Progress;
 use crate::runner::{self, RunOptions, RunResults};
@@ -81,7 +82,7 @@ pub fn post(
     plan: &Plan,
     run: &RunResults,
     report: &mut RunReport,
-    results: &Path,
+    results: &OutputDir,
     _plots: Option<&Path>,
 ) -> Result<Vec<PathBuf>> {
     let all = parts(plan.sweep.mode);
@@ -99,7 +100,7 @@ pub fn post(
         let (plans, invalid) = prepare_valid(sweep)?;
         rows.extend(invalid);
         for p in plans {
-            let progress = Progress::new();
+            let progress = Progress::default();
             let opts = RunOptions {
                 threads: Some(report.meta.threads),
                 cell_dir: Some(results.join("cells")),
@@ -118,9 +119,9 @@ pub fn post(
         notes.push(format!("{label} {:.1} s", t0.elapsed().as_secs_f64()));
     }
     report.meta.notes.push(format!("unbiasedness parts: {}", notes.join(", ")));
-    table::write_csv(&results.join("unbiasedness.csv"), &rows)?;
+    table::write_csv(results, "unbiasedness.csv", &rows)?;
     let md = table::markdown(&rows);
-    write_atomic(&results.join("unbiasedness.md"), md.as_bytes())?;
+    results.write("unbiasedness.md", md.as_bytes())?;
     report.paper.extend(table::claims(&rows));
     Ok(Vec::new())
 }

@@ -5,14 +5,14 @@
 use crate::analysis::{unbiasedness, TestRow, UNBIASEDNESS_ALPHA};
 use crate::cell::CellResult;
 use crate::error::Result;
-use crate::output::{write_atomic, Claim};
+use crate::folder::OutputDir;
+use crate::output::Claim;
 pub use crate::suite::unbiasedness_stats::{
     combined, measured, pooled_over_sequences, reps_for_target, TARGET_REL_BIAS,
 };
 use estimators::estimator::Bias;
 use estimators::testbed::Reference;
 use serde::Serialize;
-use std::path::Path;
 
 /// One row of `unbiasedness.csv`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -232,14 +232,15 @@ pub fn not_run(estimator: &str, testbed: &str, variant: &str, bias: Bias, reason
     r
 }
 
-/// Writes `unbiasedness.csv`.
-pub fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
+/// Writes `name` (`unbiasedness.csv`) into the results folder.
+pub fn write_csv(dir: &OutputDir, name: &str, rows: &[Row]) -> Result<()> {
+    let path = dir.join(name);
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {
-        w.serialize(r).map_err(|e| crate::error::HarnessError::write(path, e))?;
+        w.serialize(r).map_err(|e| crate::error::HarnessError::write(&path, e))?;
     }
-    let bytes = w.into_inner().map_err(|e| crate::error::HarnessError::write(path, e))?;
-    write_atomic(path, &bytes)
+    let bytes = w.into_inner().map_err(|e| crate::error::HarnessError::write(&path, e))?;
+    dir.write(name, &bytes).map(|_| ())
 }
 
 /// The `paper` entries: one per row (the paper's claim against the measured verdict), then one per

@@ -1,0 +1,331 @@
+//! Result and plot folders as a whole (SPEC §8): output paths checked before a run starts, one
+//! writer per folder at a time (a lock), stale temporary files of killed writers removed, and a
+//! folder-level commit so that a reader never mixes the files of two runs.
+//!
+//! Every file a run writes goes through an [`OutputDir`], which writes it atomically (temp file +
+//! rename) and records its size and digest. When the run has written everything it writes
+//! `commit.json` (atomically, last): the list of its files. A reader ([`verify`]) refuses a folder
+//! whose files do not match its commit: two runs interleaved, or a run killed between two of its
+//! writes, leave such a folder, and the next run of the experiment rewrites it whole.
+
+use crate::error::{HarnessError, Result};
+use serde::{Deserialize, Serialize};
+use std::fs::{File, OpenOptions, TryLockError};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// The commit file of a folder.
+pub const COMMIT: &str = "commit.json";
+/// The lock file of a folder.
+pub const LOCK: &str = ".lock";
+/// The format of [`Commit`].
+pub const COMMIT_FORMAT: u32 = 1;
+
+/// FNV-1a over bytes, as 16 hex digits (a consistency digest, not a cryptographic one).
+pub fn digest(bytes: &[u8]) -> String {
+    let h = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01B3));
+    format!("{h:016x}")
+}
+
+/// Checks, without creating anything, that `path` is or can become a writable folder: it is a
+/// folder, or it does not exist and its nearest existing ancestor is a folder. `field` names the
+/// flag in the error (`--results`, `--plots`).
+pub fn check_output_dir(field: &'static str, path: &Path) -> Result<()> {
+    let mut p = path.to_path_buf();
+    loop {
+        match std::fs::metadata(&p) {
+            Ok(m) if m.is_dir() => {
+                if m.permissions().readonly() {
+                    return Err(HarnessError::bad_output(field, path, format!("{} is read-only", p.display())));
+                }
+                return Ok(());
+            }
+            Ok(_) if p == path => return Err(HarnessError::bad_output(field, path, "is a file, not a folder")),
+            Ok(_) => {
+                return Err(HarnessError::bad_output(field, path, format!("{} is a file, not a folder", p.display())))
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(HarnessError::bad_output(field, path, e)),
+        }
+        match p.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => p = parent.to_path_buf(),
+            _ => return Ok(()),
+        }
+    }
+}
+
+/// An exclusive hold on a folder: only one mcbench writes a folder at a time. Released when
+/// dropped, and by the system when the process dies (an advisory `flock` on `<dir>/.lock`).
+#[derive(Debug)]
+pub struct FolderLock {
+    _file: File,
+    dir: PathBuf,
+}
+
+impl FolderLock {
+    /// Creates `dir` if needed and takes its lock; with `wait`, blocks until the holder is done,
+    /// else refuses with [`HarnessError::Busy`] (exit 3). Then removes stale temporary files
+    /// (`.<name>.tmp-<pid>...`) that killed writers left in `dir` and in `subdirs` of it.
+    pub fn acquire(dir: &Path, wait: bool, subdirs: &[&str]) -> Result<FolderLock> {
+        std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
+        let path = dir.join(LOCK);
+        let mut file = OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .read(true)
+            .write(true)
+            .open(&path)
+            .map_err(|e| HarnessError::write(&path, e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(TryLockError::WouldBlock) if wait => file.lock().map_err(|e| HarnessError::write(&path, e))?,
+            Err(TryLockError::WouldBlock) => {
+                let holder = std::fs::read_to_string(&path).unwrap_or_default().trim().to_string();
+                let holder = if holder.is_empty() { "unknown".to_string() } else { holder };
+                return Err(HarnessError::Busy { path: dir.to_path_buf(), holder });
+            }
+            Err(TryLockError::Error(e)) => return Err(HarnessError::write(&path, e)),
+        }
+        // The holder's pid, for the message of a refused second run.
+        let _ = file.set_len(0).and_then(|()| write!(file, "{}", std::process::id()));
+        remove_stale_temps(dir);
+        for s in subdirs {
+            remove_stale_temps(&dir.join(s));
+        }
+        Ok(FolderLock { _file: file, dir: dir.to_path_buf() })
+    }
+
+    /// The locked folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+}
+
+/// A shared hold on a folder for reading: no writer can hold it meanwhile. A folder that no
+/// mcbench ever wrote (no lock file) is read without one; nothing is created.
+pub fn read_lock(dir: &Path, wait: bool) -> Result<Option<File>> {
+    let path = dir.join(LOCK);
+    let Ok(file) = File::open(&path) else { return Ok(None) };
+    match file.try_lock_shared() {
+        Ok(()) => Ok(Some(file)),
+        Err(TryLockError::WouldBlock) if wait => {
+            file.lock_shared().map_err(|e| HarnessError::bad_file(&path, e))?;
+            Ok(Some(file))
+        }
+        Err(TryLockError::WouldBlock) => {
+            let holder = std::fs::read_to_string(&path).unwrap_or_default().trim().to_string();
+            Err(HarnessError::Busy { path: dir.to_path_buf(), holder })
+        }
+        Err(TryLockError::Error(e)) => Err(HarnessError::bad_file(&path, e)),
+    }
+}
+
+/// Whether `name` is a temporary file of an atomic write (`.<name>.tmp-<pid>[...]`).
+fn is_temp(name: &str) -> bool {
+    name.starts_with('.') && name.contains(".tmp-")
+}
+
+/// Removes the temporary files of killed writers directly in `dir` (call with the lock held:
+/// every writer of the folder holds it, so any temporary file there is stale).
+fn remove_stale_temps(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        if e.file_name().to_str().is_some_and(is_temp) && e.path().is_file() {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// One file of a commit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CommittedFile {
+    /// File name inside the folder (no path separators).
+    pub name: String,
+    /// Size in bytes.
+    pub bytes: u64,
+    /// [`digest`] of its content.
+    pub digest: String,
+}
+
+/// `commit.json`: the files a finished run wrote into a folder.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Commit {
+    /// [`COMMIT_FORMAT`].
+    pub format: u32,
+    /// The run's id (also `meta.run_id` in summary.json).
+    pub run: String,
+    /// For a plots folder: the id of the results it was drawn from.
+    #[serde(default)]
+    pub source_run: Option<String>,
+    /// The files, in the order written.
+    pub files: Vec<CommittedFile>,
+}
+
+/// A folder a run writes into: every write is atomic and recorded for the commit.
+#[derive(Debug)]
+pub struct OutputDir {
+    dir: PathBuf,
+    files: Mutex<Vec<CommittedFile>>,
+}
+
+impl OutputDir {
+    /// A writer into `dir` (created on the first write).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        OutputDir { dir: dir.into(), files: Mutex::new(Vec::new()) }
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &Path {
+        &self.dir
+    }
+
+    /// `<dir>/<name>`.
+    pub fn join(&self, name: &str) -> PathBuf {
+        self.dir.join(name)
+    }
+
+    fn note(&self, name: String, bytes: &[u8]) {
+        let entry = CommittedFile { name, bytes: bytes.len() as u64, digest: digest(bytes) };
+        if let Ok(mut files) = self.files.lock() {
+            files.retain(|f| f.name != entry.name);
+            files.push(entry);
+        }
+    }
+
+    /// Writes `<dir>/<name>` atomically and records it.
+    pub fn write(&self, name: &str, bytes: &[u8]) -> Result<PathBuf> {
+        let path = self.dir.join(name);
+        crate::output::write_atomic(&path, bytes)?;
+        self.note(name.to_string(), bytes);
+        Ok(path)
+    }
+
+    /// Records a file that was written into the folder by other means (the PNG encoder writes its
+    /// own files; they are renamed into place atomically, then read back here for the digest).
+    pub fn record(&self, path: &Path) -> Result<()> {
+        let name = path
+            .strip_prefix(&self.dir)
+            .ok()
+            .and_then(|p| p.to_str())
+            .filter(|n| !n.contains('/'))
+            .ok_or_else(|| HarnessError::write(path, format!("not directly in {}", self.dir.display())))?;
+        let bytes = std::fs::read(path).map_err(|e| HarnessError::write(path, e))?;
+        self.note(name.to_string(), &bytes);
+        Ok(())
+    }
+
+    /// Writes `commit.json`, last: the run's files become one consistent set for readers.
+    pub fn commit(&self, run: &str, source_run: Option<&str>) -> Result<()> {
+        let files = self.files.lock().map(|f| f.clone()).unwrap_or_default();
+        let commit =
+            Commit { format: COMMIT_FORMAT, run: run.to_string(), source_run: source_run.map(String::from), files };
+        let text = serde_json::to_string_pretty(&commit).map_err(|e| HarnessError::write(self.join(COMMIT), e))?;
+        crate::output::write_atomic(&self.join(COMMIT), text.as_bytes())
+    }
+}
+
+/// Reads `<dir>/commit.json` and checks that every file it lists is there with its committed
+/// size and digest, and that `required` files are among them. A folder without a commit (an
+/// unfinished first run, or written by another program) or with files of another run is refused.
+pub fn verify(dir: &Path, required: &[&str]) -> Result<Commit> {
+    let path = dir.join(COMMIT);
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        let why = if e.kind() == std::io::ErrorKind::NotFound {
+            "missing: not the folder of a finished run (re-run the experiment to finish it)".to_string()
+        } else {
+            e.to_string()
+        };
+        HarnessError::bad_file(&path, why)
+    })?;
+    let commit: Commit =
+        serde_json::from_str(&text).map_err(|e| HarnessError::bad_file(&path, format!("corrupt ({e})")))?;
+    if commit.format != COMMIT_FORMAT {
+        return Err(HarnessError::bad_file(
+            &path,
+            format!("format {} (this mcbench reads {COMMIT_FORMAT})", commit.format),
+        ));
+    }
+    for f in &commit.files {
+        let plain = !f.name.is_empty()
+            && !f.name.starts_with('.')
+            && !f.name.contains(['/', '\\'])
+            && Path::new(&f.name).file_name().is_some_and(|n| n == f.name.as_str());
+        if !plain {
+            return Err(HarnessError::bad_file(&path, format!("corrupt (file name {:?} is not a plain name)", f.name)));
+        }
+        let file = dir.join(&f.name);
+        let bytes = std::fs::read(&file).map_err(|e| {
+            HarnessError::bad_file(
+                &path,
+                format!("lists {} but it cannot be read ({e}); re-run the experiment", f.name),
+            )
+        })?;
+        if bytes.len() as u64 != f.bytes || digest(&bytes) != f.digest {
+            return Err(HarnessError::bad_file(
+                &file,
+                "mixed folder: this file is not the one the last finished run committed (another run wrote it, or a run was killed while writing); re-run the experiment",
+            ));
+        }
+    }
+    for r in required {
+        if !commit.files.iter().any(|f| f.name == *r) {
+            return Err(HarnessError::bad_file(&path, format!("corrupt (does not list {r})")));
+        }
+    }
+    Ok(commit)
+}
+
+/// A fresh run id: a digest of the experiment, the process and the time.
+pub fn run_id(experiment: &str) -> String {
+    let nanos = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(0);
+    digest(format!("{experiment}:{}:{nanos}", std::process::id()).as_bytes())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_commit_verifies_until_a_file_changes() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let out = OutputDir::new(dir.path().join("r"));
+        out.write("a.csv", b"x,y\n1,2\n").expect("write");
+        out.write("b.json", b"{}").expect("write");
+        out.commit("run1", None).expect("commit");
+        let c = verify(out.path(), &["a.csv"]).expect("consistent");
+        assert_eq!(c.files.len(), 2);
+        assert!(verify(out.path(), &["c.csv"]).is_err(), "a required file that is not listed");
+        std::fs::write(out.join("a.csv"), b"x,y\n1,3\n").expect("overwrite");
+        let e = verify(out.path(), &[]).expect_err("mixed");
+        assert!(e.to_string().contains("mixed folder") && e.exit_code() == 2, "{e}");
+    }
+
+    #[test]
+    fn a_second_lock_is_refused_and_stale_temps_are_removed() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let d = dir.path().join("r");
+        std::fs::create_dir_all(d.join("cells")).expect("dirs");
+        std::fs::write(d.join(".summary.csv.tmp-123"), b"half").expect("temp");
+        std::fs::write(d.join("cells/.x.json.tmp-9"), b"half").expect("temp");
+        let lock = FolderLock::acquire(&d, false, &["cells"]).expect("free");
+        assert!(!d.join(".summary.csv.tmp-123").exists() && !d.join("cells/.x.json.tmp-9").exists());
+        let e = FolderLock::acquire(&d, false, &[]).expect_err("held");
+        assert_eq!(e.exit_code(), 3, "{e}");
+        assert!(read_lock(&d, false).is_err(), "a reader waits for the writer");
+        drop(lock);
+        assert!(FolderLock::acquire(&d, false, &[]).is_ok());
+        assert!(read_lock(&d, false).expect("free").is_some());
+    }
+
+    #[test]
+    fn output_paths_must_be_folders() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let file = dir.path().join("f");
+        std::fs::write(&file, b"").expect("file");
+        assert!(check_output_dir("--plots", &file).is_err());
+        assert!(check_output_dir("--plots", &file.join("below")).is_err());
+        assert!(check_output_dir("--plots", &dir.path().join("new/deeper")).is_ok());
+        assert!(!dir.path().join("new").exists(), "nothing is created");
+    }
+}
