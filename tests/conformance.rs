@@ -1,11 +1,11 @@
 //! The conformance suite (issue 9 item 2): every registered estimator goes through
-//! `experiments::conformance::conformance` (builds, finite output or a clean refusal on the SPEC
+//! `mcbench::conformance::conformance` (builds, finite output or a clean refusal on the SPEC
 //! §10 stability beds, determinism for a seed, chi-square of its samplers, unbiasedness at a small
 //! budget), so a new plug-in is covered without new test code.
 
 use estimators::registry::{self, ESTIMATORS};
-use experiments::analysis::UNBIASEDNESS_ALPHA;
-use experiments::conformance::{conformance, small_budget_unbiasedness};
+use mcbench::analysis::UNBIASEDNESS_ALPHA;
+use mcbench::conformance::{conformance, small_budget_unbiasedness};
 
 #[test]
 fn every_registered_estimator_conforms() {

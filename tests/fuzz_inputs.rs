@@ -4,11 +4,11 @@
 //! file, and for parse errors its position) and maps to exit code 2 (`tests/cli.rs` and
 //! `tests/promises.rs` check that the binary exits with the mapped code).
 
-use experiments::config::{Mode, SweepFile};
-use experiments::error::HarnessError;
-use experiments::execute::{execute, prepare, ExecOptions};
-use experiments::output::{read_results, read_results_unverified};
-use experiments::runner::Silent;
+use mcbench::config::{Mode, SweepFile};
+use mcbench::error::HarnessError;
+use mcbench::execute::{execute, ExecOptions};
+use mcbench::output::{read_results, read_results_unverified};
+use mcbench::runner::Silent;
 use proptest::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
@@ -57,6 +57,12 @@ const FIELDS: &[&str] = &[
     "variant",
     "resolution",
     "clamp",
+    "version",
+    "format",
+    "config",
+    "shard",
+    "experiment",
+    "merge",
 ];
 
 /// Whether `msg` names one of [`FIELDS`] as a whole word (a path counts by its file name).
@@ -159,12 +165,12 @@ proptest! {
 }
 
 /// A tiny finished run of [`SMALL`] in a temp folder: (folder, plan, options' roots).
-fn tiny_run() -> (tempfile::TempDir, experiments::plan::Plan) {
+fn tiny_run() -> (tempfile::TempDir, mcbench::plan::Plan) {
     let dir = tempfile::tempdir().expect("tempdir");
     let config = dir.path().join("tiny.toml");
     std::fs::write(&config, SMALL).expect("write");
     let sweep = SweepFile::read(&config).and_then(|f| f.apply(None, Mode::Quick)).expect("valid sweep");
-    let plan = prepare(sweep).expect("plan");
+    let plan = plan_of(sweep).expect("plan");
     execute(&plan, None, &options(dir.path())).expect("runs");
     (dir, plan)
 }
@@ -177,6 +183,7 @@ fn options(root: &Path) -> ExecOptions<'static> {
         observer: &Silent,
         plots: false,
         wait: false,
+        registry: registry(),
     }
 }
 
@@ -219,7 +226,7 @@ fn edited_result_files_never_panic_and_fail_in_one_line() {
         .expect("no edit makes the reader panic or fail in more than one line");
 }
 
-/// Random edits of a stored cell: the resume's check ([`experiments::runner::preload`]) never
+/// Random edits of a stored cell: the resume's check ([`mcbench::runner::preload`]) never
 /// panics, and refuses in one line naming the cell file.
 #[test]
 fn edited_cells_never_panic_and_fail_in_one_line() {
@@ -231,7 +238,7 @@ fn edited_cells_never_panic_and_fail_in_one_line() {
     runner(300)
         .run(&edits(), |edits| {
             std::fs::write(&cell, mutate(&original, &edits)).expect("write");
-            prop_assert_eq!(file_rejected_well(&name, || experiments::runner::preload(&plan, Some(&cells))), Ok(()));
+            prop_assert_eq!(file_rejected_well(&name, || mcbench::runner::preload(&plan, Some(&cells))), Ok(()));
             Ok(())
         })
         .expect("no edit makes the resume panic or fail in more than one line");
@@ -244,8 +251,8 @@ fn edited_manifests_never_panic_and_fail_in_one_line() {
     let (dir, plan) = tiny_run();
     let root = dir.path().join("results");
     let shard = "1/1".parse().expect("spec");
-    let pre = experiments::shard::preflight(&plan, shard, &root).expect("preflight");
-    experiments::shard::run_shard(&plan, None, pre, Some(1), false, &Silent).expect("shard");
+    let pre = mcbench::shard::preflight(&plan, shard, &root).expect("preflight");
+    mcbench::shard::run_shard(&plan, None, pre, Some(1), false, &Silent).expect("shard");
     let folder = root.join("tiny/shard-1-of-1");
     let manifest = folder.join("manifest.json");
     let original = std::fs::read_to_string(&manifest).expect("manifest");
@@ -254,7 +261,7 @@ fn edited_manifests_never_panic_and_fail_in_one_line() {
         .run(&edits(), |edits| {
             std::fs::write(&manifest, mutate(&original, &edits)).expect("write");
             let opts = options(&out);
-            let merged = experiments::merge::merge(std::slice::from_ref(&folder), &opts);
+            let merged = mcbench::merge::merge(std::slice::from_ref(&folder), &opts);
             prop_assert_eq!(file_rejected_well("manifest.json", || merged), Ok(()));
             Ok(())
         })
@@ -288,4 +295,15 @@ fn edited_references_never_panic_and_pass_only_when_well_formed() {
             Ok(())
         })
         .expect("no edit makes the reference check panic");
+}
+
+/// The registry of the `mcbench` binary (built-in plug-ins and the paper suite).
+fn registry() -> &'static mcbench::Registry {
+    static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
+    REGISTRY.get_or_init(experiments::registry)
+}
+
+/// Plans a sweep against [`registry`].
+fn plan_of(sweep: mcbench::config::Sweep) -> mcbench::error::Result<mcbench::plan::Plan> {
+    mcbench::plan::Plan::prepare(sweep, registry())
 }

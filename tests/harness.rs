@@ -3,9 +3,9 @@
 //! test's teeth.
 
 use estimators::params::Params;
-use experiments::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
-use experiments::execute::{execute, prepare, ExecOptions};
-use experiments::runner::Silent;
+use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
+use mcbench::execute::{execute, ExecOptions};
+use mcbench::runner::Silent;
 use std::path::Path;
 
 mod common;
@@ -28,8 +28,8 @@ fn sweep(ids: &[&str], reps: usize) -> Sweep {
     }
 }
 
-fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> experiments::execute::Outcome {
-    let plan = prepare(sweep).expect("valid sweep");
+fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> mcbench::execute::Outcome {
+    let plan = plan_of(sweep).expect("valid sweep");
     let opts = ExecOptions {
         results_root: dir.join("results"),
         plots_root: dir.join("plots"),
@@ -37,6 +37,7 @@ fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> experiment
         observer: &Silent,
         plots,
         wait: false,
+        registry: registry(),
     };
     execute(&plan, None, &opts).expect("run succeeds")
 }
@@ -157,19 +158,19 @@ fn independent_mc_error_falls_as_the_inverse_square_root() {
 
 #[test]
 fn incompatible_pairs_are_skipped_with_a_reason_and_bad_sweeps_refused() {
-    let plan = prepare(sweep(&["is0_cv0", "delta_tracking"], 3)).expect("valid");
+    let plan = plan_of(sweep(&["is0_cv0", "delta_tracking"], 3)).expect("valid");
     assert_eq!(plan.pairs.len(), 1);
     assert!(plan.skipped[0].reason.contains("medium"), "{}", plan.skipped[0].reason);
     // A sweep in which no pair can run is refused (it would only overwrite results with nothing).
     let mut s = sweep(&["is0_cv0"], 3);
     s.budgets = vec![estimators::budget::Budget { kind: estimators::budget::BudgetKind::Fetches, amount: 10 }];
-    let err = prepare(s).err().expect("refused");
+    let err = plan_of(s).err().expect("refused");
     assert!(err.to_string().contains("medium") && err.exit_code() == 2, "{err}");
     let mut s = sweep(&["no_such_estimator"], 3);
-    assert!(prepare(s.clone()).err().map(|e| e.to_string()).unwrap_or_default().contains("is0_cv0"));
+    assert!(plan_of(s.clone()).err().map(|e| e.to_string()).unwrap_or_default().contains("is0_cv0"));
     s.estimators = vec![EstimatorSpec::new("is0_cv0")];
     s.reps = 1;
-    assert_eq!(prepare(s).err().map(|e| e.exit_code()), Some(2));
+    assert_eq!(plan_of(s).err().map(|e| e.exit_code()), Some(2));
 }
 
 /// Sequences (paper 004 frames) are scheduled whole, each on the stream of its first integral:
@@ -232,4 +233,15 @@ fn a_fetch_budget_buys_a_fixed_calibrated_number_of_rays() {
         // The calibration aims at the budget: the mean fetches land within a factor 2 of it.
         assert!(row.fetches > 20.0 && row.fetches < 80.0, "{}: {} fetches", row.estimator, row.fetches);
     }
+}
+
+/// The registry of the `mcbench` binary (built-in plug-ins and the paper suite).
+fn registry() -> &'static mcbench::Registry {
+    static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
+    REGISTRY.get_or_init(experiments::registry)
+}
+
+/// Plans a sweep against [`registry`].
+fn plan_of(sweep: mcbench::config::Sweep) -> mcbench::error::Result<mcbench::plan::Plan> {
+    mcbench::plan::Plan::prepare(sweep, registry())
 }

@@ -78,7 +78,7 @@ fn recommit(folder: &Path, name: &str) {
     for f in c["files"].as_array_mut().expect("files") {
         if f["name"] == name {
             f["bytes"] = serde_json::json!(bytes.len());
-            f["digest"] = serde_json::json!(experiments::folder::digest(&bytes));
+            f["digest"] = serde_json::json!(mcbench::folder::digest(&bytes));
         }
     }
     std::fs::write(&path, serde_json::to_string(&c).expect("json")).expect("write");
@@ -142,11 +142,11 @@ fn numbers_are_bounded_on_every_input_path() {
     ok(d, &["run", "--config", "tiny.toml", "--shard", "1/1"]);
     let shard = d.join("results/tiny/shard-1-of-1");
     let path = shard.join("manifest.json");
-    let mut m: experiments::shard::Manifest =
+    let mut m: mcbench::shard::Manifest =
         serde_json::from_str(&std::fs::read_to_string(&path).expect("manifest")).expect("parses");
     m.sweep.reps = 1_000_000_000_000;
     m.reps = m.sweep.reps;
-    m.sweep_digest = experiments::shard::sweep_digest(&m.sweep);
+    m.sweep_digest = mcbench::shard::sweep_digest(&m.sweep);
     std::fs::write(&path, serde_json::to_string(&m).expect("json")).expect("write");
     refused(d, &["merge", "results/tiny/shard-1-of-1"], 2, "reps");
 }

@@ -7,7 +7,7 @@ use std::process::{Command, Output};
 
 mod common;
 use common::deterministic_csv;
-use experiments::metrics::TIMING_COLUMNS;
+use mcbench::metrics::TIMING_COLUMNS;
 
 /// The transmittance experiment (its claims and post hook included) shrunk to seconds: two small
 /// test beds, three fetch budgets (pilot-calibrated per cell), and 40 repetitions, i.e. three

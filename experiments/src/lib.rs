@@ -1,37 +1,105 @@
 //! # experiments
 //!
-//! The `mcbench` harness: budget sweeps over (test bed x estimator x budget x repetitions) run in
-//! parallel with reproducible streams, SPEC §5 metrics and slope fits, SPEC §6 tests, the SPEC §8
-//! result files, plots and reports, and the named experiments of SPEC §7. Pipeline:
-//! [`config`] -> [`plan`] -> [`runner`] -> [`metrics`] / [`analysis`] -> [`output`] / [`plot`] /
-//! [`report`]; [`execute`] ties them together and [`cli`] is the binary's front; [`shard`] and [`merge`] split a
-//! sweep over machines and join it again (SPEC §12).
-#![warn(missing_docs)]
+//! The paper suite of mcbench: the named experiments of SPEC §7 (each a sweep for quick and for
+//! full mode, the paper's claims judged against what the run measured, and the figures and tables
+//! of its own), registered on top of the harness ([`mcbench`]) by [`registry`]; the `mcbench`
+//! binary is `mcbench::cli::main_with(experiments::registry())`.
 
-pub mod analysis;
-pub mod cell;
-pub mod cli;
-pub mod config;
-pub mod conformance;
-pub mod console;
-pub mod cputime;
-pub mod error;
-pub mod execute;
-pub mod folder;
-pub mod guarded;
-pub mod limits;
-pub mod merge;
-pub mod metrics;
-pub mod output;
-pub mod plan;
-pub mod plot;
-pub mod progress;
-pub mod report;
-pub mod runner;
-pub mod shard;
-pub mod suite;
+pub mod canonical_cells;
+pub mod canonical_sweep;
+pub mod canonical_sweep_claims;
+pub mod canonical_sweep_plots;
+pub mod canonical_sweep_post;
+#[cfg(test)]
+mod canonical_tests;
+pub mod canonical_winners;
+pub mod envmap_smc;
+pub mod envmap_smc_post;
+pub mod envmap_unbiasedness;
+pub mod media_smc;
+pub mod media_smc_post;
+pub mod particle_sweep;
+pub mod particle_sweep_post;
+pub mod pmc_hi;
+pub mod pmc_hi_post;
+pub mod pmc_ip;
+pub mod pmc_ip_post;
+pub mod single_scatter;
+pub mod single_scatter_post;
+pub mod stability;
+pub mod stability_cases;
+pub mod stability_list;
+pub mod stability_numeric;
+pub mod surface_smc;
+pub mod transmittance;
+pub mod transmittance_post;
+pub mod unbiasedness;
+pub mod unbiasedness_reps;
+pub mod unbiasedness_run;
+pub mod unbiasedness_stats;
+pub mod unbiasedness_table;
+pub mod variance_claims;
 
-/// The README's code blocks, compiled and run as doc tests.
-#[cfg(doctest)]
-#[doc = include_str!("../../README.md")]
-pub struct ReadmeDoctests;
+use mcbench::config::{EstimatorSpec, Mode, Sweep};
+use mcbench::output::{Claim, RunReport};
+use mcbench::registry::{Experiment, PostFn, Registry};
+
+/// A named experiment of the suite, as a static definition (see [`Experiment`]).
+pub struct ExperimentDef {
+    /// Name (results folder, CLI argument).
+    pub name: &'static str,
+    /// The paper figure or table it reproduces.
+    pub reproduces: &'static str,
+    /// One line for `mcbench list experiments`.
+    pub summary: &'static str,
+    /// Every estimator id it runs.
+    pub ids: &'static [&'static str],
+    /// The sweep for a mode.
+    pub sweep: fn(Mode) -> Sweep,
+    /// The paper's claims judged on a finished run.
+    pub claims: fn(&RunReport) -> Vec<Claim>,
+    /// Optional analysis beyond the summary rows, run after the claims with the cells of the run:
+    /// it may add claims and write extra result files and plots (returned for the report).
+    pub post: Option<PostFn>,
+}
+
+impl ExperimentDef {
+    /// The harness's experiment.
+    pub fn experiment(&self) -> Experiment {
+        Experiment {
+            name: self.name.into(),
+            reproduces: self.reproduces.into(),
+            summary: self.summary.into(),
+            quick: (self.sweep)(Mode::Quick),
+            full: (self.sweep)(Mode::Full),
+            claims: Some(self.claims),
+            post: self.post,
+        }
+    }
+}
+
+/// Every experiment, in the order the default suite runs them.
+pub static EXPERIMENTS: &[&ExperimentDef] = &[
+    &surface_smc::DEF,
+    &media_smc::DEF,
+    &transmittance::DEF,
+    &particle_sweep::DEF,
+    &pmc_hi::DEF,
+    &pmc_ip::DEF,
+    &envmap_smc::DEF,
+    &single_scatter::DEF,
+    &canonical_sweep::DEF,
+    &unbiasedness::DEF,
+    &stability::DEF,
+];
+
+/// The built-in estimators and test beds with every experiment of the suite: what the `mcbench`
+/// binary runs.
+pub fn registry() -> Registry {
+    EXPERIMENTS.iter().fold(Registry::builtin(), |r, d| r.with_experiment(d.experiment()))
+}
+
+/// Estimator specs with default parameters for `ids`.
+pub fn available(ids: &[&str]) -> (Vec<EstimatorSpec>, Vec<String>) {
+    (ids.iter().map(|id| EstimatorSpec::new(id)).collect(), Vec::new())
+}

@@ -1,6 +1,6 @@
-//! `mcbench`: the command-line front of the harness (SPEC §9). Exit codes: 0 success, 2 bad
-//! input, 1 internal failure.
+//! `mcbench`: the command-line front of the harness over the paper suite (SPEC §9). Exit codes:
+//! the table of `mcbench::error`.
 
 fn main() {
-    std::process::exit(experiments::cli::main_with_args(std::env::args_os()));
+    std::process::exit(mcbench::cli::main_with(experiments::registry()));
 }

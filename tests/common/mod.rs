@@ -1,6 +1,6 @@
 //! Helpers shared by the integration tests.
 
-use experiments::metrics::TIMING_COLUMNS;
+use mcbench::metrics::TIMING_COLUMNS;
 use std::path::Path;
 
 /// summary.csv with the wall-clock columns removed.

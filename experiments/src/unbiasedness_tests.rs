@@ -1,0 +1,181 @@
+//! Unit tests of the `unbiasedness` table: verdict logic and the claims it feeds.
+
+use super::*;
+
+fn row(paper: &str, verdict: &str, p: f64) -> Row {
+    let mut r = not_run("e", "t", "v", Bias::Unbiased, "x");
+    r.paper_bias = paper.into();
+    r.verdict = verdict.into();
+    r.test = "holm_t".into();
+    r.p_value = p;
+    r.detectable_rel_bias = 0.01;
+    r.reps = 100;
+    r.reps_for_target = reps_for_target(0.01, 100, 1.0);
+    r.rel_bias = 0.0;
+    r.rel_bias_se = 0.003;
+    judge(&mut r);
+    r
+}
+
+#[test]
+fn verdicts_follow_the_papers_claims() {
+    let ok = row("unbiased", "pass", 0.5);
+    assert_eq!(ok.agrees, Some(true));
+    let fail = row("unbiased", "biased", 1e-6);
+    assert_eq!(fail.agrees, Some(false));
+    assert!(fail.note.contains("FAILS") && fail.note.contains("measured relative bias"), "{}", fail.note);
+    assert_eq!(row("biased", "biased", 1e-9).agrees, Some(true));
+    let missed = row("biased", "pass", 0.2);
+    assert_eq!(missed.agrees, Some(false));
+    assert!(missed.note.contains("NOT flagged"), "{}", missed.note);
+    let consistent = row("consistent", "biased", 1e-9);
+    assert_eq!(consistent.agrees, None);
+    assert!(consistent.note.contains("consistent only"), "{}", consistent.note);
+    assert_eq!(row("unbiased", "untested", f64::NAN).agrees, None);
+    // 0.01 detectable at 100 reps: 0.1% needs 100 x 10^2 reps.
+    assert!(ok.note.contains("needs about 1.0e4 reps"), "{}", ok.note);
+}
+
+#[test]
+fn exempt_controls_are_expected_to_pass() {
+    let mut r = row("biased", "pass", 0.5);
+    r.estimator = "bidirectional_is_sn[candidates=2]".into();
+    r.variant = "mixed-lns".into();
+    judge(&mut r);
+    assert_eq!(r.agrees, Some(true));
+    assert!(r.note.starts_with("not a control here"), "{}", r.note);
+    r.verdict = "biased".into();
+    judge(&mut r);
+    assert_eq!(r.agrees, Some(false), "an exempt control flagged is a finding, not a pass");
+    assert!(control_exemption("ray_marching[step=5]", "canonical-1d", "constant-T0.5").is_some());
+    assert!(control_exemption("ray_marching[step=5]", "canonical-1d", "cosine-T0.5").is_none());
+    assert!(control_exemption("rm_is1_cv2", "gradient-box", "albedo-0.8").is_none());
+}
+
+#[test]
+fn a_control_that_is_not_flagged_fails_its_claim() {
+    let control = |verdict: &str, variant: &str| {
+        let mut r = row("biased", verdict, if verdict == "biased" { 1e-9 } else { 0.3 });
+        r.estimator = "clamped_is0_cv0".into();
+        r.variant = variant.into();
+        judge(&mut r);
+        r
+    };
+    let held = |rows: &[Row]| {
+        claims(rows).into_iter().find(|c| c.claim.contains("clamped_is0_cv0 is flagged")).and_then(|c| c.held)
+    };
+    let good = vec![control("biased", "a"), control("biased", "b"), row("unbiased", "pass", 0.4)];
+    assert_eq!(held(&good), Some(true));
+    let bad = vec![control("biased", "a"), control("pass", "b")];
+    assert_eq!(held(&bad), Some(false));
+    // The aggregate claim over unbiased ids fails on one flagged row.
+    let all = claims(&[row("unbiased", "pass", 0.4), row("unbiased", "biased", 1e-8)]);
+    assert_eq!(all.last().and_then(|c| c.held), Some(false));
+    // One `paper` entry per row, plus the aggregates.
+    assert_eq!(claims(&good).len(), 3 + 2);
+}
+
+#[test]
+fn repetitions_for_a_tenth_of_a_percent() {
+    assert_eq!(reps_for_target(0.01, 100, 1.0), Some(10_000.0));
+    assert_eq!(reps_for_target(0.0005, 100, 1.0), Some(25.0));
+    // Half the tested variance from a stored reference with 0.5% detectable on its own: no R helps.
+    assert_eq!(reps_for_target(0.01, 100, 0.5), None);
+    assert_eq!(reps_for_target(f64::NAN, 100, 1.0), None);
+}
+
+fn test_row(test: &str, p: f64, d: f64) -> TestRow {
+    TestRow {
+        testbed: "t".into(),
+        variant: "v".into(),
+        estimator: "e".into(),
+        test: test.into(),
+        budget: 4,
+        statistic: 0.0,
+        p_value: p,
+        verdict: if p.is_nan() { "untested" } else { "pass" }.into(),
+        alpha: 1e-3,
+        detectable_rel_bias: d,
+        claim: "unbiased".into(),
+        agrees: true,
+        untested: 0,
+    }
+}
+
+#[test]
+fn the_holm_and_pooled_tests_combine_by_bonferroni() {
+    let (name, p, d) = combined(&[test_row("holm_t", 0.3, 0.05), test_row("pooled_z", 1e-4, 0.01)]);
+    assert_eq!(name, "holm_t+pooled_z");
+    assert!((p - 2e-4).abs() < 1e-15 && d == 0.01);
+    // An untested Holm test leaves the pooled one; the sequence-aware pooled test wins over the other.
+    let (name, p, _) = combined(&[
+        test_row("holm_welch", f64::NAN, 0.05),
+        test_row("pooled_z", 1e-9, 0.01),
+        test_row("pooled_z_seq", 0.2, 0.03),
+    ]);
+    assert_eq!((name.as_str(), p), ("pooled_z_seq", 0.2));
+    assert!(combined(&[]).1.is_nan());
+}
+
+/// A tiny sweep end to end (well under a second): independent MC passes, the clamped control is
+/// flagged, and the pooled test over sequences is never less conservative than the independent one.
+#[test]
+fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
+    use estimators::budget::Budget;
+    use estimators::params::Params;
+    use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
+    use mcbench::plan::Plan;
+    use mcbench::runner::{run, RunOptions, Silent};
+    let sweep = Sweep {
+        experiment: "unbiasedness-test".into(),
+        testbeds: vec![TestBedSpec {
+            id: "gradient-plane".into(),
+            variant: Some("default".into()),
+            params: Params::new().with("resolution", 2.0),
+        }],
+        estimators: vec![EstimatorSpec::new("is0_cv0"), EstimatorSpec::new("clamped_is0_cv0")],
+        budgets: vec![Budget::samples(16).unwrap()],
+        reps: 64,
+        seed: 3,
+        mode: Mode::Quick,
+        baseline: None,
+    };
+    let plan = Plan::prepare(sweep, &mcbench::Registry::builtin()).unwrap();
+    let results = run(&plan, &RunOptions { threads: Some(1), cell_dir: None, observer: &Silent }).unwrap();
+    let reference = plan.beds[0].bed.reference();
+    let rows: Vec<Row> = results
+        .cells
+        .iter()
+        .map(|(_, ei, cell)| super::row(cell, reference, plan.estimators[*ei].entry.bias, 1).0)
+        .collect();
+    assert_eq!((rows[0].verdict.as_str(), rows[0].agrees), ("pass", Some(true)), "{:?}", rows[0]);
+    assert_eq!((rows[1].verdict.as_str(), rows[1].agrees), ("biased", Some(true)), "{:?}", rows[1]);
+    assert!(rows[0].detectable_rel_bias > 0.0 && rows[0].reps_for_target.is_some());
+    let cell = &results.cells[0].2;
+    let independent = pooled_over_sequences(cell, reference, 1).unwrap();
+    let whole = pooled_over_sequences(cell, reference, 4).unwrap();
+    assert!(whole.detectable_rel_bias > independent.detectable_rel_bias);
+}
+
+#[test]
+fn every_registered_estimator_is_in_a_part() {
+    use crate::unbiasedness::{parts, IDS};
+    use mcbench::config::Mode;
+    let mut ids: Vec<&str> = IDS.to_vec();
+    let mut registered: Vec<&str> = estimators::registry::ESTIMATORS.iter().map(|e| e.id).collect();
+    ids.sort();
+    registered.sort();
+    assert_eq!(ids, registered, "IDS must list every registered estimator");
+    let all = parts(Mode::Quick);
+    for id in IDS {
+        assert!(all.iter().any(|p| p.sweep.estimators.iter().any(|e| e.id == *id)), "{id} is in no part");
+    }
+    // Every variant of every test bed is in some part.
+    for t in estimators::registry::TESTBEDS {
+        for v in t.variants {
+            let covered =
+                all.iter().any(|p| p.sweep.testbeds.iter().any(|b| b.id == t.id && b.variant.as_deref() == Some(*v)));
+            assert!(covered, "{}/{v} is in no part", t.id);
+        }
+    }
+}

@@ -1,0 +1,94 @@
+//! Paper 002 Eq. 16-20 against measured variance on the eq21 central ray (Fig. 8): one-ray
+//! estimates of T(s) at s = 5 and 10, 20000 rays per point; held when the measured variance is
+//! within 4 standard errors (from the sample fourth moment) of the prediction.
+
+use estimators::budget::Budget;
+use estimators::estimator::Estimator;
+use estimators::math::Vec3;
+use estimators::media::variance::{predicted, Model};
+use estimators::media::{Field, MediumBed};
+use estimators::params::Params;
+use estimators::registry;
+use estimators::rng::stream;
+use estimators::stats::Moments;
+use estimators::task::Task;
+use estimators::testbed::TestBed;
+use mcbench::output::Claim;
+
+/// Albedo of the eq21 medium (the non-terminating model's `w` depends on it).
+const ALBEDO: f64 = 0.7;
+
+/// The estimator / model / sigma_samp cases of paper 002 Fig. 8 that Eq. 16 predicts.
+pub const CASES: [(&str, Model, f64); 5] = [
+    ("double_particle", Model::Double, 0.4),
+    ("double_particle", Model::Double, 1.0),
+    ("single_particle_nonterminating", Model::NonTerminating { a: ALBEDO }, 0.4),
+    ("single_particle_nonterminating", Model::NonTerminating { a: ALBEDO }, 1.0),
+    ("single_particle_terminating", Model::Terminating, 1.0),
+];
+
+/// The sample mean and variance of `n` one-ray estimates of integral `k`, and the standard error
+/// of that variance (from the sample fourth moment).
+pub struct Measured {
+    /// Mean of the one-ray estimates.
+    pub mean: f64,
+    /// Their sample variance.
+    pub variance: f64,
+    /// Standard error of `variance`.
+    pub variance_se: f64,
+}
+
+/// `n` one-ray estimates of integral `k` of `bed` on the stream `(seed, "eq16 claim")`.
+pub fn measure(est: &dyn Estimator, bed: &dyn TestBed, k: usize, n: usize, seed: u64) -> Measured {
+    let mut rng = stream(seed, "eq16 claim");
+    let mut xs = Vec::with_capacity(n);
+    let mut m = Moments::default();
+    for _ in 0..n {
+        let task = Task::new(bed, k, Budget { kind: estimators::budget::BudgetKind::Samples, amount: 1 });
+        let x = est.estimate(&task, &mut rng).map(|v| v[0]).unwrap_or(f64::NAN);
+        m.push(x);
+        xs.push(x);
+    }
+    let v = m.variance();
+    let m4 = xs.iter().map(|x| (x - m.mean()).powi(4)).sum::<f64>() / n as f64;
+    Measured { mean: m.mean(), variance: v, variance_se: ((m4 - v * v) / n as f64).max(0.0).sqrt() }
+}
+
+/// The central-ray bed with `points` integrals, its extinction along the ray and the grid of s.
+pub fn central_ray(points: usize) -> Option<(MediumBed, Vec<f64>)> {
+    let bed = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", points as f64)).ok()?;
+    let grid: Vec<f64> = (0..points).filter_map(|k| bed.medium().map(|m| m.ray(k).length)).collect();
+    Some((bed, grid))
+}
+
+/// Builds the estimator of a case (None when the id is not registered).
+pub fn build(id: &str, samp: f64) -> Option<Box<dyn Estimator>> {
+    registry::estimator(id).and_then(|e| (e.build)(&Params::new().with("sigma_samp", samp))).ok()
+}
+
+/// The Eq. 16 claims.
+pub fn eq16_claims() -> Vec<Claim> {
+    let Some((bed, grid)) = central_ray(4) else {
+        return Vec::new();
+    };
+    let sigma = |t: f64| bed.extinction(Vec3::new(0.0, 0.0, t));
+    let mut out = Vec::new();
+    for (ci, (id, model, samp)) in CASES.into_iter().enumerate() {
+        let Some(est) = build(id, samp) else { continue };
+        let pred = predicted(sigma, model, samp, &grid);
+        for k in 0..2 {
+            let n = 20_000;
+            let Measured { variance: v, variance_se: se, .. } =
+                measure(est.as_ref(), &bed, k, n, ci as u64 * 7 + k as u64);
+            out.push(Claim {
+                testbed: "eq21-medium/central-ray".into(),
+                claim: format!("paper 002 Eq. 16 ({id}, sigma_samp {samp}): predicted variance of T(s = {}) equals the measured one", grid[k]),
+                paper_value: Some(pred[k].1),
+                our_value: Some(v),
+                held: Some((v - pred[k].1).abs() <= 4.0 * se),
+                note: format!("T = {:.5}, measured variance {v:.5e} +- {se:.2e} (1 SE, {n} one-ray estimates); std band T +- {:.4}", pred[k].0, pred[k].1.sqrt()),
+            });
+        }
+    }
+    out
+}

@@ -1,0 +1,453 @@
+//! The `mcbench` command line (SPEC §9): `list`, `run`, `reference`, `merge`, `plot`, and the
+//! default quick suite. Every subcommand exits by the one table of [`crate::error`]: bad input is
+//! one line on stderr naming the field or file, exit code 2, and nothing written; a results folder
+//! that another run holds is exit code 3 (or a wait, with `--wait`).
+
+use crate::config::{Mode, SweepFile};
+use crate::error::{HarnessError, Result};
+use crate::execute::{self, ExecOptions};
+use crate::progress::Progress;
+use crate::registry::Registry;
+use crate::report::markdown_table;
+use crate::shard::ShardSpec;
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use estimators::params::Params;
+use std::ffi::OsString;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Convergence-study harness for adaptive Monte Carlo rendering estimators.
+#[derive(Parser, Debug)]
+#[command(name = "mcbench", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Settings for the default suite (no subcommand).
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// List test beds, estimators (with the test beds each runs on) or experiments.
+    List {
+        /// What to list (all when omitted).
+        what: Option<ListWhat>,
+    },
+    /// Run experiments by name, or a custom sweep from --config.
+    Run {
+        /// Experiment names (see `mcbench list experiments`).
+        experiments: Vec<String>,
+        #[command(flatten)]
+        args: RunArgs,
+    },
+    /// Compute and store the reference of a test bed.
+    Reference {
+        /// Test bed id.
+        testbed: String,
+        /// Variant (the first when omitted).
+        #[arg(long)]
+        variant: Option<String>,
+        /// Paths per integral for stored Monte Carlo references (the test bed's default when omitted).
+        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+        samples: Option<u64>,
+        /// Results root.
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
+        /// Wait for another run writing the references folder instead of refusing.
+        #[arg(long)]
+        wait: bool,
+    },
+    /// Merge the folders of `run --shard i/n` into the files a single run writes (SPEC §12).
+    Merge {
+        /// Shard folders (`<results>/<experiment>/shard-<i>-of-<n>`), or the experiment's results
+        /// folder holding them.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Results root (the experiment's folder is written below it).
+        #[arg(long, value_name = "DIR", default_value = "results")]
+        results: PathBuf,
+        /// Plots root.
+        #[arg(long, value_name = "DIR", default_value = "plots")]
+        plots: PathBuf,
+        /// Worker threads (default: all cores).
+        #[arg(long, value_name = "T", value_parser = clap::value_parser!(u64).range(1..=1024))]
+        threads: Option<u64>,
+        /// Skip plots and reports.
+        #[arg(long)]
+        no_plots: bool,
+        /// Wait for another run holding the output folders instead of refusing.
+        #[arg(long)]
+        wait: bool,
+        /// Plain progress lines on stderr even when it is not a terminal.
+        #[arg(long)]
+        progress: bool,
+    },
+    /// Redraw the plots and report of a results folder.
+    Plot {
+        /// A results folder holding summary.csv and summary.json of a finished run.
+        results_dir: PathBuf,
+        /// Plots root (the folder `<plots>/<name of results_dir>` is written).
+        #[arg(long, default_value = "plots")]
+        plots: PathBuf,
+        /// Wait for a run writing the folders instead of refusing.
+        #[arg(long)]
+        wait: bool,
+    },
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum ListWhat {
+    Testbeds,
+    Estimators,
+    Experiments,
+}
+
+#[derive(Args, Debug)]
+struct RunArgs {
+    /// Small sizes (the default).
+    #[arg(long, conflicts_with = "full")]
+    quick: bool,
+    /// The papers' sizes.
+    #[arg(long)]
+    full: bool,
+    /// Experiment seed.
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
+    seed: Option<u64>,
+    /// Repetitions per integral (2 to 1000000).
+    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(2..=crate::limits::MAX_REPS as u64))]
+    reps: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=crate::limits::MAX_THREADS))]
+    threads: Option<u64>,
+    /// Results root.
+    #[arg(long, value_name = "DIR", default_value = "results")]
+    results: PathBuf,
+    /// Plots root.
+    #[arg(long, value_name = "DIR", default_value = "plots")]
+    plots: PathBuf,
+    /// A TOML or JSON file describing a custom sweep or overriding the named experiments.
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+    /// Skip plots and reports.
+    #[arg(long)]
+    no_plots: bool,
+    /// Run only shard I of N of each sweep and write its statistics for `mcbench merge`.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<ShardSpec>,
+    /// Wait for another run holding the output folders instead of refusing (exit 3).
+    #[arg(long)]
+    wait: bool,
+    /// Plain progress lines on stderr even when it is not a terminal.
+    #[arg(long)]
+    progress: bool,
+}
+
+impl RunArgs {
+    fn mode(&self) -> Mode {
+        if self.full {
+            Mode::Full
+        } else {
+            Mode::Quick
+        }
+    }
+}
+
+/// The whole command line over `registry`, on the process's arguments; returns the exit code. A
+/// binary of your own is one line (see [`crate::registry`] for adding plug-ins):
+///
+/// ```no_run
+/// // The whole body of `main`:
+/// std::process::exit(mcbench::cli::main_with(mcbench::Registry::builtin()));
+/// ```
+pub fn main_with(registry: Registry) -> i32 {
+    main_with_args(registry, std::env::args_os())
+}
+
+/// Runs the CLI over `registry` on `args` (the first is the program name) and returns the exit
+/// code.
+pub fn main_with_args(registry: Registry, args: impl IntoIterator<Item = impl Into<OsString> + Clone>) -> i32 {
+    if let Err(e) = registry.check() {
+        eprintln!("error: {e}");
+        return crate::error::EXIT_BAD_INPUT;
+    }
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            use clap::error::ErrorKind::*;
+            return match e.kind() {
+                DisplayHelp | DisplayVersion | DisplayHelpOnMissingArgumentOrSubcommand => {
+                    let _ = e.print();
+                    0
+                }
+                _ => {
+                    let text = e.render().to_string();
+                    eprintln!("{}", text.lines().next().unwrap_or("error: bad arguments"));
+                    2
+                }
+            };
+        }
+    };
+    match dispatch(cli, &registry) {
+        Ok(()) => 0,
+        Err(e) => {
+            let text = e.to_string();
+            eprintln!("error: {}", text.lines().next().unwrap_or("failed"));
+            e.exit_code()
+        }
+    }
+}
+
+fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
+    match cli.command {
+        None => {
+            let names: Vec<String> = registry.experiments().iter().map(|e| e.name.clone()).collect();
+            if names.is_empty() {
+                return Err(estimators::error::ConfigError::invalid(
+                    "experiment",
+                    "(none)",
+                    "this binary registers no named experiment: use `run --config FILE`",
+                )
+                .into());
+            }
+            run(&names, &cli.run, registry)
+        }
+        Some(Command::Run { experiments, args }) => run(&experiments, &args, registry),
+        Some(Command::List { what }) => {
+            list(what, registry);
+            Ok(())
+        }
+        Some(Command::Reference { testbed, variant, samples, results, wait }) => {
+            reference(&testbed, variant, samples, &results, wait, registry)
+        }
+        Some(Command::Merge { dirs, results, plots, threads, no_plots, wait, progress }) => {
+            let progress = Progress::new(progress);
+            let opts = ExecOptions {
+                results_root: results,
+                plots_root: plots,
+                threads: threads.map(|t| t as usize),
+                observer: &progress,
+                plots: !no_plots,
+                wait,
+                registry,
+            };
+            let t0 = Instant::now();
+            let out = crate::merge::merge(&dirs, &opts)?;
+            crate::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
+            println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
+            Ok(())
+        }
+        Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait, registry),
+    }
+}
+
+fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
+    let mode = args.mode();
+    let file = args.config.as_deref().map(SweepFile::read).transpose()?;
+    // Build every plan first: any bad name or value stops here, before a file is written.
+    let mut plans = Vec::new();
+    if names.is_empty() {
+        let file = file.ok_or_else(|| {
+            estimators::error::ConfigError::invalid(
+                "experiment",
+                "(none)",
+                format!("name one (valid: {}) or give --config", valid_experiments(registry)),
+            )
+        })?;
+        plans.push((None, file.apply(None, mode)?));
+    } else {
+        for name in names {
+            let def = registry.experiment(name)?;
+            let sweep = def.sweep(mode);
+            let sweep = match &file {
+                Some(f) => f.clone().apply(Some(sweep), mode)?,
+                None => sweep,
+            };
+            plans.push((Some(def), sweep));
+        }
+    }
+    let mut prepared = Vec::new();
+    for (def, mut sweep) in plans {
+        if let Some(s) = args.seed {
+            sweep.seed = s;
+        }
+        if let Some(r) = args.reps {
+            sweep.reps = r as usize;
+        }
+        prepared.push((def, execute::prepare(sweep, registry)?));
+    }
+    let progress = Progress::new(args.progress);
+    let opts = ExecOptions {
+        results_root: args.results.clone(),
+        plots_root: args.plots.clone(),
+        threads: args.threads.map(|t| t as usize),
+        observer: &progress,
+        plots: !args.no_plots,
+        wait: args.wait,
+        registry,
+    };
+    // Everything every experiment of the call will read is checked before the first one writes.
+    let mut checked = Vec::new();
+    for (_, plan) in &prepared {
+        checked.push(match args.shard {
+            Some(shard) => Checked::Shard(crate::shard::preflight(plan, shard, &args.results)?),
+            None => Checked::Run(execute::preflight(plan, &opts)?),
+        });
+    }
+    let started = Instant::now();
+    for ((def, plan), checked) in prepared.iter().zip(checked) {
+        let t0 = Instant::now();
+        if let Checked::Shard(pre) = checked {
+            let threads = args.threads.map(|t| t as usize);
+            let out = crate::shard::run_shard(plan, *def, pre, threads, args.wait, &progress)?;
+            progress.finish();
+            println!(
+                "{} shard {}: {} of {} units ({} resumed) in {:.1} s, written to {}",
+                plan.sweep.experiment,
+                args.shard.map(|s| s.to_string()).unwrap_or_default(),
+                out.owned,
+                out.units,
+                out.resumed,
+                t0.elapsed().as_secs_f64(),
+                out.dir.display()
+            );
+            continue;
+        }
+        let Checked::Run(pre) = checked else { continue };
+        let out = execute::execute_checked(plan, *def, &opts, pre)?;
+        progress.finish();
+        crate::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
+        println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
+    }
+    println!("\ntotal wall time {:.1} s", started.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// What was checked for one experiment of a `run` before anything was written.
+enum Checked {
+    Run(execute::Preflight),
+    Shard(crate::shard::ShardPreflight),
+}
+
+/// `mcbench plot`: redraws a finished run's plots into `<plots>/<results folder's name>` (the
+/// folder name comes from the command line, never from the files read).
+fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, _registry: &Registry) -> Result<()> {
+    let name = std::fs::canonicalize(results_dir)
+        .ok()
+        .and_then(|p| p.file_name().and_then(|n| n.to_str()).map(String::from))
+        .ok_or_else(|| HarnessError::bad_file(results_dir, "not a results folder"))?;
+    let _read = crate::folder::read_lock(results_dir, wait)?;
+    let report = crate::output::read_results(results_dir)?;
+    let dir = plots.join(&name);
+    crate::folder::check_output_dir("--plots", &dir)?;
+    let _lock = crate::folder::FolderLock::acquire(&dir, wait, &[])?;
+    execute::draw(&report, &dir, results_dir)?;
+    println!("plots and report.md written to {}", dir.display());
+    Ok(())
+}
+
+fn valid_experiments(registry: &Registry) -> String {
+    registry.experiments().iter().map(|e| e.name.as_str()).collect::<Vec<_>>().join(", ")
+}
+
+fn list(what: Option<ListWhat>, registry: &Registry) {
+    let all = what.is_none();
+    if all || matches!(what, Some(ListWhat::Testbeds)) {
+        let rows: Vec<Vec<String>> = registry
+            .test_beds()
+            .iter()
+            .map(|t| vec![t.id.into(), t.variants.join(", "), t.provides.to_string(), t.summary.into()])
+            .collect();
+        println!("{}", markdown_table(&["test bed", "variants", "provides", "summary"], &rows));
+    }
+    if all || matches!(what, Some(ListWhat::Estimators)) {
+        let rows: Vec<Vec<String>> = registry
+            .estimators()
+            .iter()
+            .map(|e| {
+                let on: Vec<&str> =
+                    registry.test_beds().iter().filter(|t| e.skip_reason(t.provides).is_none()).map(|t| t.id).collect();
+                vec![
+                    e.id.into(),
+                    e.paper.into(),
+                    e.bias.name().into(),
+                    e.needs.to_string(),
+                    on.join(", "),
+                    e.summary.into(),
+                ]
+            })
+            .collect();
+        println!("{}", markdown_table(&["estimator", "paper", "claim", "needs", "runs on", "summary"], &rows));
+    }
+    if all || matches!(what, Some(ListWhat::Experiments)) {
+        let rows: Vec<Vec<String>> = registry
+            .experiments()
+            .iter()
+            .map(|e| vec![e.name.clone(), e.reproduces.clone(), e.summary.clone()])
+            .collect();
+        println!("{}", markdown_table(&["experiment", "reproduces", "summary"], &rows));
+    }
+}
+
+fn reference(
+    testbed: &str,
+    variant: Option<String>,
+    samples: Option<u64>,
+    results: &std::path::Path,
+    wait: bool,
+    registry: &Registry,
+) -> Result<()> {
+    let entry = registry.test_bed(testbed)?;
+    let variant = variant.unwrap_or_else(|| entry.variants[0].to_string());
+    entry.check_variant(&variant)?;
+    let folder = results.join("references");
+    crate::folder::check_output_dir("--results", &folder)?;
+    let t0 = Instant::now();
+    // Exact variants compute their reference when built; stored ones run the test bed's hook.
+    let built = (entry.build)(&variant, &Params::new());
+    let (r, resolution) = match (built, entry.compute_reference) {
+        (Ok(bed), _) if bed.reference().is_exact() || entry.compute_reference.is_none() => {
+            (bed.reference().clone(), bed.resolution())
+        }
+        (_, Some(compute)) => {
+            let mut params = Params::new();
+            if let Some(n) = samples {
+                params = params.with("samples", n as f64);
+            }
+            let threads = std::thread::available_parallelism().map(|t| t.get()).unwrap_or(1);
+            compute(&variant, &params, threads)?
+        }
+        (Ok(bed), None) => (bed.reference().clone(), bed.resolution()),
+        (Err(e), None) => return Err(e.into()),
+    };
+    let path = results.join("references").join(format!("{testbed}_{variant}.json"));
+    let command = match &r.kind {
+        estimators::testbed::ReferenceKind::Stored { command, .. } => command.clone(),
+        _ => format!("mcbench reference {testbed} --variant {variant}"),
+    };
+    let doc = serde_json::json!({
+        "testbed": testbed,
+        "variant": variant,
+        "command": command,
+        "resolution": resolution,
+        "reference": r,
+    });
+    let text = serde_json::to_string(&doc).map_err(|e| HarnessError::write(&path, e))?;
+    let _lock = crate::folder::FolderLock::acquire(&folder, wait, &[])?;
+    crate::output::write_atomic(&path, text.as_bytes())?;
+    let kind = match &r.kind {
+        estimators::testbed::ReferenceKind::Exact { method, bound } => {
+            format!("exact: {method}; absolute error bound {bound:.3e}")
+        }
+        estimators::testbed::ReferenceKind::Stored { command, samples } => {
+            format!("stored: `{command}`, {samples} samples per value")
+        }
+    };
+    println!(
+        "{testbed}/{variant}: {} integrals, {kind}, computed in {:.2} s",
+        r.value.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    println!("written to {}", path.display());
+    Ok(())
+}

@@ -1,0 +1,278 @@
+//! One experiment end to end: plan (all validation before any file is touched), run (with
+//! resume), metrics, fits, tests, claims, result files, plots and report.
+
+use crate::analysis::{self, TestRow};
+use crate::cell::CellResult;
+use crate::config::Sweep;
+use crate::error::Result;
+use crate::folder::{check_output_dir, FolderLock, OutputDir};
+use crate::metrics::{summarize, SummaryRow};
+use crate::output::{self, Diagnostic, IntegralRow, Meta, RunReport};
+use crate::plan::Plan;
+use crate::registry::{Experiment, Registry};
+use crate::runner::{self, Observer, RunOptions, RunResults};
+use estimators::budget::BudgetKind;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Where and how to run.
+pub struct ExecOptions<'a> {
+    /// Root of result folders (`results/`).
+    pub results_root: PathBuf,
+    /// Root of plot folders (`plots/`).
+    pub plots_root: PathBuf,
+    /// Worker threads (None: all cores).
+    pub threads: Option<usize>,
+    /// Progress receiver.
+    pub observer: &'a dyn Observer,
+    /// Draw plots and the report.
+    pub plots: bool,
+    /// Wait for another run's lock on the folders instead of refusing (exit 3).
+    pub wait: bool,
+    /// Where names are looked up (experiments' own analyses build further plans).
+    pub registry: &'a Registry,
+}
+
+/// What a finished experiment produced.
+pub struct Outcome {
+    /// Everything in summary.json plus the rows.
+    pub report: RunReport,
+    /// The results folder.
+    pub results_dir: PathBuf,
+    /// The plots folder.
+    pub plots_dir: PathBuf,
+}
+
+/// Builds the plan of a sweep (validation only; nothing is written).
+pub fn prepare(sweep: Sweep, registry: &Registry) -> Result<Plan> {
+    Plan::prepare(sweep, registry)
+}
+
+/// What a run reads before it writes anything: the stored cells it will resume from, checked.
+pub struct Preflight {
+    stored: Vec<Option<CellResult>>,
+}
+
+/// Everything a run checks before it writes anything (after [`prepare`] checked the plan): the
+/// output folders are folders or can be made, and every stored cell it will read is well formed.
+pub fn preflight(plan: &Plan, opts: &ExecOptions<'_>) -> Result<Preflight> {
+    let results_dir = opts.results_root.join(&plan.sweep.experiment);
+    check_output_dir("--results", &results_dir)?;
+    if opts.plots {
+        check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
+    }
+    let stored = runner::preload(plan, Some(&results_dir.join("cells")))?;
+    Ok(Preflight { stored })
+}
+
+/// Runs a prepared plan and writes every output ([`preflight`], then [`execute_checked`]).
+pub fn execute(plan: &Plan, def: Option<&Experiment>, opts: &ExecOptions<'_>) -> Result<Outcome> {
+    let checked = preflight(plan, opts)?;
+    execute_checked(plan, def, opts, checked)
+}
+
+/// The folders' locks of a run: results (with its `cells`) and, when plots are drawn, plots.
+pub fn lock_folders(experiment: &str, opts: &ExecOptions<'_>) -> Result<Vec<FolderLock>> {
+    let mut locks = vec![FolderLock::acquire(&opts.results_root.join(experiment), opts.wait, &["cells"])?];
+    if opts.plots {
+        locks.push(FolderLock::acquire(&opts.plots_root.join(experiment), opts.wait, &[])?);
+    }
+    Ok(locks)
+}
+
+/// Runs a plan whose [`preflight`] passed: takes the folders' locks (refusing, exit 3, or waiting
+/// when another run holds them), runs the missing cells, and writes every output.
+pub fn execute_checked(
+    plan: &Plan,
+    def: Option<&Experiment>,
+    opts: &ExecOptions<'_>,
+    checked: Preflight,
+) -> Result<Outcome> {
+    let started = Instant::now();
+    let _locks = lock_folders(&plan.sweep.experiment, opts)?;
+    let results_dir = opts.results_root.join(&plan.sweep.experiment);
+    let run = runner::run_preloaded(
+        plan,
+        &RunOptions { threads: opts.threads, cell_dir: Some(results_dir.join("cells")), observer: opts.observer },
+        checked.stored,
+    )?;
+    finish(plan, def, &run, opts, started)
+}
+
+/// Everything after the cells are known: metrics, fits, tests, claims, the experiment's post hook,
+/// result files, plots and report. A single run and a merge of shards
+/// ([`crate::merge`]) both end here, so equal cells give equal files. The caller holds the
+/// folders' locks ([`lock_folders`]); the files of each folder are committed last.
+pub fn finish(
+    plan: &Plan,
+    def: Option<&Experiment>,
+    run: &RunResults,
+    opts: &ExecOptions<'_>,
+    started: Instant,
+) -> Result<Outcome> {
+    let sweep = &plan.sweep;
+    let results_dir = opts.results_root.join(&sweep.experiment);
+    let plots_dir = opts.plots_root.join(&sweep.experiment);
+    let results = OutputDir::new(&results_dir);
+    let run_id = crate::folder::run_id(&sweep.experiment);
+    let mut rows: Vec<SummaryRow> = Vec::new();
+    let mut tests: Vec<TestRow> = Vec::new();
+    let mut integrals: Vec<IntegralRow> = Vec::new();
+    let mut diagnostics = Vec::new();
+    let last_budget = sweep.budgets.last().map(|b| b.amount);
+    for (bi, ei, cell) in &run.cells {
+        let (bed, est) = (&plan.beds[*bi], &plan.estimators[*ei]);
+        let reference = bed.bed.reference();
+        rows.push(summarize(cell, reference));
+        for (name, sum) in &cell.diagnostics {
+            diagnostics.push(Diagnostic {
+                testbed: cell.key.testbed.clone(),
+                variant: cell.key.variant.clone(),
+                estimator: cell.key.estimator.clone(),
+                budget: cell.key.budget.amount,
+                name: name.clone(),
+                mean: sum / cell.estimates.max(1) as f64,
+            });
+        }
+        if Some(cell.key.budget.amount) == last_budget {
+            tests.extend(analysis::unbiasedness(cell, reference, est.entry.bias));
+            integrals.extend(integral_rows(cell, bed.bed.as_ref()));
+        }
+    }
+    let fits = analysis::fits(&rows);
+    let speedups = sweep.baseline.as_deref().map(|b| analysis::speedups(&rows, &fits, b)).unwrap_or_default();
+    let mut notes = Vec::new();
+    for b in &plan.beds {
+        notes.push(match &b.bed.reference().kind {
+            estimators::testbed::ReferenceKind::Exact { method, bound } => {
+                format!("{}: exact reference ({method}), absolute error bound {bound:.3e}", b.label())
+            }
+            estimators::testbed::ReferenceKind::Stored { command, samples } => format!(
+                "{}: stored reference from `{command}` ({samples} samples per value); its variance is subtracted from the MSE",
+                b.label()
+            ),
+        });
+    }
+    let reproducible = sweep.budgets.iter().all(|b| b.kind != BudgetKind::Micros);
+    if !reproducible {
+        notes.push(
+            "time budgets (micros) become a sample count calibrated by a CPU-time pilot on this machine: results are not bit-reproducible across runs or machines".into(),
+        );
+    }
+    let threads = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.threads.unwrap_or(0))
+        .build()
+        .map(|p| p.current_num_threads())
+        .unwrap_or(1);
+    let mut report = RunReport {
+        meta: Meta {
+            experiment: sweep.experiment.clone(),
+            seed: sweep.seed,
+            git_commit: git_commit(),
+            threads,
+            cpu: cpu_model(),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            mode: sweep.mode.name().to_string(),
+            reps: sweep.reps,
+            wall_seconds: 0.0,
+            notes,
+            run_id: run_id.clone(),
+            reproducible,
+        },
+        fits,
+        tests,
+        paper: Vec::new(),
+        speedups,
+        skipped: plan.skipped.clone(),
+        unavailable: Vec::new(),
+        rows,
+        labels: plan.estimators.iter().map(|e| (e.name.clone(), e.entry.label.to_string())).collect(),
+        diagnostics,
+    };
+    if let Some(d) = def {
+        if let Some(claims) = d.claims {
+            report.paper = claims(&report);
+        }
+    }
+    let mut extra_plots = Vec::new();
+    if let Some(post) = def.and_then(|d| d.post) {
+        extra_plots = post(plan, run, &mut report, &results, opts.plots.then_some(plots_dir.as_path()), opts.registry)?;
+    }
+    report.meta.wall_seconds = started.elapsed().as_secs_f64();
+    output::write_summary_csv(&results, &report.rows)?;
+    output::write_integrals_csv(&results, &integrals)?;
+    output::write_summary_json(&results, &report)?;
+    results.commit(&run_id, None)?;
+    if opts.plots {
+        draw_with(&report, &plots_dir, &results_dir, extra_plots)?;
+    }
+    Ok(Outcome { report, results_dir, plots_dir })
+}
+
+/// Draws the plots and the report of a finished run into `plots_dir` and commits them.
+pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path) -> Result<()> {
+    draw_with(report, plots_dir, results_dir, Vec::new())
+}
+
+fn draw_with(report: &RunReport, plots_dir: &Path, results_dir: &Path, extra: Vec<PathBuf>) -> Result<()> {
+    let plots = OutputDir::new(plots_dir);
+    let mut files = crate::plot::write_plots(report, plots_dir)?;
+    files.extend(extra);
+    for f in &files {
+        plots.record(f)?;
+    }
+    let md = crate::report::render_report(report, &files, plots_dir, results_dir);
+    plots.write("report.md", md.as_bytes())?;
+    plots.commit(&crate::folder::run_id(&report.meta.experiment), Some(&report.meta.run_id))
+}
+
+fn integral_rows(cell: &CellResult, bed: &dyn estimators::testbed::TestBed) -> Vec<IntegralRow> {
+    let (w, h) = bed.resolution();
+    // Integrals per pixel (frames of paper 004); 1 when a sequence spans pixels (gradient-box).
+    let frames = (bed.integrals() / (w * h).max(1)).max(1);
+    let reference = bed.reference();
+    let mut out = Vec::with_capacity(cell.moments.len() * 3);
+    for (i, m) in cell.moments.iter().enumerate() {
+        let geometry = bed.geometry(i);
+        for (c, mc) in m.iter().enumerate() {
+            out.push(IntegralRow {
+                testbed: cell.key.testbed.clone(),
+                variant: cell.key.variant.clone(),
+                estimator: cell.key.estimator.clone(),
+                integral: i,
+                px: (i / frames) % w,
+                py: (i / frames) / w,
+                channel: c,
+                reference: reference.value[i][c],
+                reference_se: reference.std_err[i][c],
+                mean: mc.mean(),
+                std_err: mc.std_err(),
+                geometry: geometry.clone(),
+            });
+        }
+    }
+    out
+}
+
+fn git_commit() -> String {
+    std::process::Command::new("git")
+        .args(["rev-parse", "HEAD"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .map(|s| s.trim().to_string())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}

@@ -1,0 +1,95 @@
+//! # mcbench
+//!
+//! A convergence-study harness for Monte Carlo estimators. Plug in an estimator and a test bed (a
+//! scene whose integrals have exact or stored reference values) and get budget sweeps over
+//! repetitions run in parallel on reproducible streams, RMSE / efficiency / FoM against samples,
+//! fetches and time, convergence-slope fits with intervals, unbiasedness tests with their power,
+//! the result files of SPEC §8, log-log plots and a report, and a command line with config files,
+//! resume, shards and merge.
+//!
+//! Pipeline: [`config`] -> [`plan`] -> [`runner`] -> [`metrics`] / [`analysis`] -> [`output`] /
+//! [`plot`] / [`report`]; [`execute`] ties them together, [`cli`] is the command line, [`shard`]
+//! and [`merge`] split a sweep over machines and join it again, [`conformance`] is the check every
+//! plug-in goes through. Names are looked up in a [`Registry`], a value you build in `main`.
+//!
+//! ## Quick start: your own estimator, from your own crate
+//!
+//! ```no_run
+//! use mcbench::{EstimateError, Estimator, EstimatorEntry, Registry, Rgb, StreamRng, Task};
+//! use mcbench::estimators::{estimator::Bias, testbed::Needs};
+//!
+//! /// Independent uniform-hemisphere sampling of a surface integral.
+//! struct Uniform;
+//!
+//! impl Estimator for Uniform {
+//!     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+//!         use mcbench::estimators::{math::Frame, samplers::uniform_hemisphere};
+//!         let probe = task.hemisphere().ok_or(EstimateError::Refused("needs a surface".into()))?;
+//!         let frame = Frame::around(probe.point().normal);
+//!         let (mut sum, mut n) = (Rgb::ZERO, 0.0);
+//!         while task.more() {
+//!             let wi = frame.to_world(uniform_hemisphere::sample_local(rng));
+//!             sum += probe.integrand(wi) / uniform_hemisphere::pdf(1.0);
+//!             n += 1.0;
+//!         }
+//!         Ok(sum / n)
+//!     }
+//! }
+//!
+//! static UNIFORM: EstimatorEntry = EstimatorEntry {
+//!     id: "my_uniform",
+//!     paper: "mine",
+//!     label: "uniform hemisphere sampling",
+//!     bias: Bias::Unbiased,
+//!     needs: Needs::SURFACE,
+//!     samplers: &["uniform_hemisphere"],
+//!     summary: "independent uniform sampling of the hemisphere",
+//!     build: |_params| Ok(Box::new(Uniform)),
+//! };
+//!
+//! fn main() {
+//!     // The whole CLI (run, list, plot, shards, merge, conformance) over the built-in plug-ins
+//!     // and this one: `cargo run -- run --config my-sweep.toml`.
+//!     std::process::exit(mcbench::cli::main_with(Registry::builtin().with_estimator(&UNIFORM)));
+//! }
+//! ```
+#![warn(missing_docs)]
+
+pub mod analysis;
+pub mod cell;
+pub mod claims;
+pub mod cli;
+pub mod config;
+pub mod conformance;
+pub mod console;
+pub mod cputime;
+pub mod error;
+pub mod execute;
+pub mod folder;
+pub mod guarded;
+pub mod limits;
+pub mod merge;
+pub mod metrics;
+pub mod output;
+pub mod plan;
+pub mod plot;
+pub mod progress;
+pub mod registry;
+pub mod report;
+pub mod runner;
+pub mod shard;
+
+pub use estimators;
+pub use estimators::error::{ConfigError, EstimateError};
+pub use estimators::estimator::{Bias, Estimator};
+pub use estimators::math::Rgb;
+pub use estimators::registry::{EstimatorEntry, TestBedEntry};
+pub use estimators::rng::StreamRng;
+pub use estimators::task::Task;
+pub use estimators::testbed::{Needs, Reference, TestBed};
+pub use registry::{Experiment, Registry};
+
+/// The README's code blocks, compiled and run as doc tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;

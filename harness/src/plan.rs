@@ -1,0 +1,146 @@
+//! Turning a [`Sweep`] into built test beds and estimators, before anything is written: every
+//! bad name or value is found here (exit 2, no files touched), and pairs that cannot run are
+//! listed with their reason.
+
+use crate::config::{EstimatorSpec, Sweep, TestBedSpec};
+use crate::error::Result;
+use crate::registry::Registry;
+use estimators::budget::BudgetKind;
+use estimators::error::ConfigError;
+use estimators::estimator::Estimator;
+use estimators::registry::EstimatorEntry;
+use estimators::testbed::{Needs, TestBed};
+use serde::{Deserialize, Serialize};
+
+/// A built test bed.
+pub struct PreparedBed {
+    /// Its spec.
+    pub spec: TestBedSpec,
+    /// Resolved variant.
+    pub variant: String,
+    /// The scene with its reference.
+    pub bed: Box<dyn TestBed>,
+}
+
+impl PreparedBed {
+    /// `id/variant`, the stream label of the test bed.
+    pub fn label(&self) -> String {
+        format!("{}/{}", self.spec.id, self.variant)
+    }
+}
+
+/// A built estimator.
+pub struct PreparedEstimator {
+    /// Its spec.
+    pub spec: EstimatorSpec,
+    /// Name in result files.
+    pub name: String,
+    /// Registry entry (label, bias claim, needs).
+    pub entry: &'static EstimatorEntry,
+    /// The configured estimator.
+    pub estimator: Box<dyn Estimator>,
+}
+
+/// A pair that does not run, and why.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Skipped {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// The reason.
+    pub reason: String,
+}
+
+/// A sweep with everything built.
+pub struct Plan {
+    /// The sweep.
+    pub sweep: Sweep,
+    /// Built test beds.
+    pub beds: Vec<PreparedBed>,
+    /// Built estimators.
+    pub estimators: Vec<PreparedEstimator>,
+    /// (bed index, estimator index) pairs that run.
+    pub pairs: Vec<(usize, usize)>,
+    /// Pairs that do not.
+    pub skipped: Vec<Skipped>,
+}
+
+impl Plan {
+    /// Validates and builds everything (computing exact references), looking names up in
+    /// `registry`.
+    pub fn prepare(sweep: Sweep, registry: &Registry) -> Result<Plan> {
+        sweep.validate()?;
+        let mut beds = Vec::new();
+        for spec in &sweep.testbeds {
+            let entry = registry.test_bed(&spec.id)?;
+            let variant = spec.variant.clone().unwrap_or_else(|| entry.variants[0].to_string());
+            entry.check_variant(&variant)?;
+            if beds
+                .iter()
+                .any(|b: &PreparedBed| b.spec.id == spec.id && b.variant == variant && b.spec.params == spec.params)
+            {
+                return Err(ConfigError::invalid("testbeds", format!("{}/{variant}", spec.id), "listed twice").into());
+            }
+            let bed = (entry.build)(&variant, &spec.params)?;
+            beds.push(PreparedBed { spec: spec.clone(), variant, bed });
+        }
+        let mut estimators = Vec::new();
+        for spec in &sweep.estimators {
+            let entry = registry.estimator(&spec.id)?;
+            let estimator = (entry.build)(&spec.params)?;
+            estimators.push(PreparedEstimator { name: spec.name(), spec: spec.clone(), entry, estimator });
+        }
+        let kind = sweep.budgets[0].kind;
+        let (mut pairs, mut skipped) = (Vec::new(), Vec::new());
+        for (bi, b) in beds.iter().enumerate() {
+            for (ei, e) in estimators.iter().enumerate() {
+                let reason = e
+                    .entry
+                    .skip_reason(b.bed.provides())
+                    .or_else(|| e.estimator.supports(b.bed.as_ref()).err())
+                    .or_else(|| {
+                        (kind == BudgetKind::Fetches && !b.bed.provides().contains(Needs::MEDIUM))
+                            .then(|| "a fetch budget needs a test bed with a medium".to_string())
+                    });
+                match reason {
+                    None => {
+                        // An invalid configuration (not merely an unsupported pair) is bad input.
+                        e.estimator.validate(b.bed.as_ref())?;
+                        pairs.push((bi, ei))
+                    }
+                    Some(reason) => skipped.push(Skipped {
+                        testbed: b.spec.id.clone(),
+                        variant: b.variant.clone(),
+                        estimator: e.name.clone(),
+                        reason,
+                    }),
+                }
+            }
+        }
+        // A sweep in which nothing can run would only overwrite earlier results with empty files.
+        if pairs.is_empty() {
+            let why = skipped
+                .first()
+                .map(|s| format!(" (e.g. {} on {}/{}: {})", s.estimator, s.testbed, s.variant, s.reason));
+            return Err(ConfigError::invalid(
+                "estimators",
+                &sweep.experiment,
+                format!("no estimator of the sweep can run on any of its test beds{}", why.unwrap_or_default()),
+            )
+            .into());
+        }
+        if let Some(b) = &sweep.baseline {
+            let runs = pairs.iter().any(|&(_, ei)| &estimators[ei].name == b);
+            if !runs {
+                let why = skipped.iter().find(|s| &s.estimator == b).map(|s| s.reason.clone()).unwrap_or_default();
+                return Err(
+                    ConfigError::invalid("baseline", b, format!("runs on no test bed of the sweep: {why}")).into()
+                );
+            }
+        }
+        Ok(Plan { sweep, beds, estimators, pairs, skipped })
+    }
+}

@@ -1,0 +1,170 @@
+use super::*;
+use crate::analysis::{fits, SpeedUp, TestRow};
+use crate::output::{Claim, Diagnostic, Meta};
+use crate::plan::Skipped;
+
+fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
+    let variance = rmse * rmse * 0.9;
+    SummaryRow {
+        testbed: "gradient-plane".into(),
+        variant: "default".into(),
+        estimator: estimator.into(),
+        budget_kind: "samples".into(),
+        budget,
+        reps: 16,
+        integrals: 64,
+        rmse,
+        mse: rmse * rmse,
+        variance,
+        bias: 1e-4,
+        bias_se: 2e-4,
+        samples: budget as f64,
+        fetches: 0.0,
+        rays: budget as f64,
+        seconds,
+        efficiency: Some(1.0 / (variance * seconds)),
+        fom: None,
+        rel_rmse: rmse / 0.7,
+        reference_var: 0.0,
+        cheap_fetches: 0.0,
+        seconds_median: seconds,
+        efficiency_mse: Some(1.0 / (rmse * rmse * seconds)),
+        p_err: 0.0,
+        p_eff: None,
+    }
+}
+
+/// A small report: two estimators x three budgets on one test bed, with fits, tests and claims.
+pub fn synthetic_report() -> RunReport {
+    let mut rows = Vec::new();
+    for (k, budget) in [4u64, 16, 64].into_iter().enumerate() {
+        let b = budget as f64;
+        rows.push(row("is0_cv0", budget, 0.2 * b.powf(-0.5) * (1.0 + 0.01 * k as f64), 2e-7 * b));
+        rows.push(row("is1_cv2", budget, 0.15 * b.powf(-0.9), 3.5e-7 * b));
+    }
+    let fits = fits(&rows);
+    let test = |estimator: &str, p: f64, verdict: &str| TestRow {
+        testbed: "gradient-plane".into(),
+        variant: "default".into(),
+        estimator: estimator.into(),
+        test: "holm_t".into(),
+        budget: 64,
+        statistic: 2.5,
+        p_value: p,
+        verdict: verdict.into(),
+        alpha: 1e-3,
+        detectable_rel_bias: 3.2e-3,
+        claim: "unbiased".into(),
+        agrees: verdict == "pass",
+        untested: 0,
+    };
+    RunReport {
+        meta: Meta {
+            experiment: "surface-smc".into(),
+            seed: 7,
+            git_commit: "abc1234".into(),
+            threads: 2,
+            cpu: "Test CPU".into(),
+            version: "0.1.0".into(),
+            mode: "quick".into(),
+            reps: 16,
+            wall_seconds: 12.5,
+            notes: vec!["exact reference".into()],
+            run_id: "r1".into(),
+            reproducible: true,
+        },
+        fits,
+        tests: vec![test("is0_cv0", 0.42, "pass"), test("is1_cv2", 3.1e-7, "biased")],
+        paper: vec![Claim {
+            testbed: "gradient-plane".into(),
+            claim: "is1_cv2 slope about -0.94 (paper 001 Fig. 4)".into(),
+            paper_value: Some(-0.94),
+            our_value: Some(-0.9),
+            held: Some(true),
+            note: "within the CI".into(),
+        }],
+        speedups: vec![SpeedUp {
+            testbed: "gradient-plane".into(),
+            variant: "default".into(),
+            estimator: "is1_cv2".into(),
+            baseline: "is0_cv0".into(),
+            budget: 64,
+            sample_ratio: 20.0,
+            overhead: 1.75,
+            speedup: 11.43,
+        }],
+        skipped: vec![Skipped {
+            testbed: "gradient-plane".into(),
+            variant: "default".into(),
+            estimator: "ratio_tracking".into(),
+            reason: "needs a medium".into(),
+        }],
+        unavailable: vec!["brdf_is1_cv2".into()],
+        rows,
+        labels: vec![("is0_cv0".into(), "MCMC (independent MC)".into()), ("is1_cv2".into(), "IS1 + CV2".into())],
+        diagnostics: vec![Diagnostic {
+            testbed: "gradient-plane".into(),
+            variant: "default".into(),
+            estimator: "is1_cv2".into(),
+            budget: 64,
+            name: "cache_bytes".into(),
+            mean: 4096.0,
+        }],
+    }
+}
+
+#[test]
+fn writes_svg_and_png_for_every_plot() {
+    let report = synthetic_report();
+    assert_eq!(report.fits.len(), 2);
+    let dir = tempfile::TempDir::new().unwrap();
+    let files = write_plots(&report, dir.path()).unwrap();
+    assert_eq!(files.len(), 6);
+    for kind in PlotKind::ALL {
+        let stem = plot_stem("gradient-plane", "default", kind);
+        let png = dir.path().join(format!("{stem}.png"));
+        let bytes = std::fs::read(&png).unwrap();
+        assert!(bytes.len() > 1000 && bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "{png:?}");
+        assert!(dir.path().join(format!("{stem}.svg")).is_file());
+    }
+    let svg = std::fs::read_to_string(dir.path().join("gradient-plane_default_rmse.svg")).unwrap();
+    assert!(svg.contains("MCMC (independent MC)  slope -0.4"), "legend text missing");
+    assert!(svg.contains("IS1 + CV2  slope -0.90 [-0.90, -0.90]"));
+    assert!(svg.contains("samples per pixel (spp)"));
+    // No temp files are left behind.
+    let names: Vec<String> =
+        std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    assert!(names.iter().all(|n| !n.starts_with('.')), "{names:?}");
+}
+
+#[test]
+fn empty_and_degenerate_reports_do_not_panic() {
+    let dir = tempfile::TempDir::new().unwrap();
+    let mut report = synthetic_report();
+    report.rows.clear();
+    assert!(write_plots(&report, dir.path()).unwrap().is_empty());
+
+    // Single-point series only (a single-budget sweep): no plot against the budget is drawn.
+    let mut report = synthetic_report();
+    report.rows.truncate(2);
+    assert!(write_plots(&report, dir.path()).unwrap().is_empty());
+
+    let mut report = synthetic_report();
+    report.rows.truncate(3); // is0_cv0 at 4 and 16 spp, is1_cv2 at 4 spp only
+    report.rows.push(row("nan_estimator", 4, f64::NAN, f64::NAN));
+    report.rows.push(row("zero_estimator", 4, 0.0, 0.0));
+    report.rows[0].efficiency = None;
+    report.rows.push(row("inf", 8, f64::INFINITY, -1.0));
+    report.fits[0].slope = f64::NAN;
+    let files = write_plots(&report, dir.path()).unwrap();
+    // RMSE and RMSE-vs-time have a two-point series beside single points and undrawable values
+    // (NaN, zero, infinite, negative); efficiency has at most one point per series.
+    assert_eq!(files.len(), 4, "{files:?}");
+}
+
+#[test]
+fn names_are_sanitised() {
+    assert_eq!(sanitize("a b/c.d-e_f"), "a_b_c_d-e_f");
+    assert_eq!(sanitize(""), "_");
+    assert_eq!(plot_stem("checker direct", "occl/uded", PlotKind::RmseVsTime), "checker_direct_occl_uded_rmse_vs_time");
+}

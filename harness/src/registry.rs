@@ -1,0 +1,199 @@
+//! The registry a run looks names up in: estimators, test beds and named experiments. It is a
+//! value, built in `main` and handed to [`crate::cli::main_with`] and to planning, so a crate of
+//! your own adds its plug-ins to the built-in ones without touching mcbench:
+//!
+//! ```
+//! use mcbench::{EstimatorEntry, Registry};
+//!
+//! // An estimator of your own: here the built-in independent estimator under another id.
+//! static MINE: EstimatorEntry = EstimatorEntry { id: "my_estimator", ..estimators::independent::is0_cv0::ENTRY };
+//!
+//! let registry = Registry::builtin().with_estimator(&MINE);
+//! assert!(registry.estimator("my_estimator").is_ok());
+//! assert!(registry.estimator("is1_cv2").is_ok(), "the built-in ones stay");
+//! registry.check().expect("no id registered twice");
+//! // In `main`: std::process::exit(mcbench::cli::main_with(registry));
+//! ```
+
+use crate::config::{Mode, Sweep};
+use crate::error::Result;
+use crate::folder::OutputDir;
+use crate::output::{Claim, RunReport};
+use crate::plan::Plan;
+use crate::runner::RunResults;
+use estimators::error::ConfigError;
+use estimators::registry::{EstimatorEntry, TestBedEntry};
+use std::path::{Path, PathBuf};
+
+/// An experiment's own analysis after the run: (plan, finished cells, report to extend, results
+/// folder (its files are written through it and committed with the run's), plots folder when plots
+/// are drawn, the registry) -> extra plot files. For real figures and tables beyond what every run
+/// writes.
+pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &OutputDir, Option<&Path>, &Registry) -> Result<Vec<PathBuf>>;
+
+/// The claims of an experiment, judged on a finished run.
+pub type ClaimsFn = fn(&RunReport) -> Vec<Claim>;
+
+/// A named experiment: a sweep for quick and for full mode, the claims it judges, and optionally
+/// an analysis of its own.
+#[derive(Clone)]
+pub struct Experiment {
+    /// Name (results folder, CLI argument).
+    pub name: String,
+    /// The paper figure or table it reproduces (free text).
+    pub reproduces: String,
+    /// One line for `mcbench list experiments`.
+    pub summary: String,
+    /// The sweep of `--quick` (the default).
+    pub quick: Sweep,
+    /// The sweep of `--full`.
+    pub full: Sweep,
+    /// Claims judged on the finished run.
+    pub claims: Option<ClaimsFn>,
+    /// Analysis after the run.
+    pub post: Option<PostFn>,
+}
+
+impl Experiment {
+    /// The sweep for a mode.
+    pub fn sweep(&self, mode: Mode) -> Sweep {
+        match mode {
+            Mode::Quick => self.quick.clone(),
+            Mode::Full => self.full.clone(),
+        }
+    }
+}
+
+impl std::fmt::Debug for Experiment {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Experiment").field("name", &self.name).finish_non_exhaustive()
+    }
+}
+
+/// Estimators, test beds and experiments by name.
+#[derive(Clone, Default)]
+pub struct Registry {
+    estimators: Vec<&'static EstimatorEntry>,
+    test_beds: Vec<&'static TestBedEntry>,
+    experiments: Vec<Experiment>,
+}
+
+impl std::fmt::Debug for Registry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Registry")
+            .field("estimators", &self.estimators.iter().map(|e| e.id).collect::<Vec<_>>())
+            .field("test_beds", &self.test_beds.iter().map(|t| t.id).collect::<Vec<_>>())
+            .field("experiments", &self.experiments.iter().map(|e| e.name.as_str()).collect::<Vec<_>>())
+            .finish()
+    }
+}
+
+impl Registry {
+    /// Nothing registered.
+    pub fn empty() -> Self {
+        Registry::default()
+    }
+
+    /// Every estimator and test bed of the `estimators` crate (the five papers' and the biased
+    /// controls), and no named experiment.
+    pub fn builtin() -> Self {
+        Registry {
+            estimators: estimators::registry::ESTIMATORS.to_vec(),
+            test_beds: estimators::registry::TESTBEDS.to_vec(),
+            experiments: Vec::new(),
+        }
+    }
+
+    /// Adds an estimator.
+    pub fn with_estimator(mut self, entry: &'static EstimatorEntry) -> Self {
+        self.estimators.push(entry);
+        self
+    }
+
+    /// Adds a test bed.
+    pub fn with_test_bed(mut self, entry: &'static TestBedEntry) -> Self {
+        self.test_beds.push(entry);
+        self
+    }
+
+    /// Adds a named experiment.
+    pub fn with_experiment(mut self, experiment: Experiment) -> Self {
+        self.experiments.push(experiment);
+        self
+    }
+
+    /// Checks that no id or name is registered twice (the CLI refuses to start otherwise).
+    pub fn check(&self) -> std::result::Result<(), ConfigError> {
+        fn dup<'a>(kind: &'static str, names: impl Iterator<Item = &'a str>) -> std::result::Result<(), ConfigError> {
+            let mut seen: Vec<&str> = Vec::new();
+            for n in names {
+                if seen.contains(&n) {
+                    return Err(ConfigError::invalid(kind, n, "registered twice"));
+                }
+                seen.push(n);
+            }
+            Ok(())
+        }
+        dup("estimator", self.estimators.iter().map(|e| e.id))?;
+        dup("test bed", self.test_beds.iter().map(|t| t.id))?;
+        dup("experiment", self.experiments.iter().map(|e| e.name.as_str()))
+    }
+
+    /// Every estimator, in registration order.
+    pub fn estimators(&self) -> &[&'static EstimatorEntry] {
+        &self.estimators
+    }
+
+    /// Every test bed, in registration order.
+    pub fn test_beds(&self) -> &[&'static TestBedEntry] {
+        &self.test_beds
+    }
+
+    /// Every named experiment, in registration order (the order of the default suite).
+    pub fn experiments(&self) -> &[Experiment] {
+        &self.experiments
+    }
+
+    /// An estimator by id; unknown ids list the valid ones.
+    pub fn estimator(&self, id: &str) -> std::result::Result<&'static EstimatorEntry, ConfigError> {
+        self.estimators
+            .iter()
+            .copied()
+            .find(|e| e.id == id)
+            .ok_or_else(|| ConfigError::unknown("estimator", id, self.estimators.iter().map(|e| e.id)))
+    }
+
+    /// A test bed by id; unknown ids list the valid ones.
+    pub fn test_bed(&self, id: &str) -> std::result::Result<&'static TestBedEntry, ConfigError> {
+        self.test_beds
+            .iter()
+            .copied()
+            .find(|e| e.id == id)
+            .ok_or_else(|| ConfigError::unknown("test bed", id, self.test_beds.iter().map(|e| e.id)))
+    }
+
+    /// A named experiment; unknown names list the valid ones.
+    pub fn experiment(&self, name: &str) -> std::result::Result<&Experiment, ConfigError> {
+        self.experiments
+            .iter()
+            .find(|e| e.name == name)
+            .ok_or_else(|| ConfigError::unknown("experiment", name, self.experiments.iter().map(|e| e.name.as_str())))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lookups_name_the_valid_ids_and_duplicates_are_found() {
+        let r = Registry::builtin();
+        assert!(r.estimator("is1_cv2").is_ok() && r.test_bed("gradient-box").is_ok());
+        let e = r.estimator("nope").err().map(|e| e.to_string()).unwrap_or_default();
+        assert!(e.contains("is0_cv0"), "{e}");
+        assert!(r.check().is_ok());
+        let twice = r.clone().with_estimator(estimators::registry::ESTIMATORS[0]);
+        assert!(twice.check().expect_err("duplicate").to_string().contains("registered twice"));
+        assert!(Registry::empty().estimators().is_empty());
+    }
+}
