@@ -1,15 +1,17 @@
-//! The conformance suite (issue 9 item 2): every registered estimator goes through
-//! `mcbench::conformance::conformance` (builds, finite output or a clean refusal on the SPEC
-//! §10 stability beds, determinism for a seed, chi-square of its samplers, unbiasedness at a small
-//! budget), so a new plug-in is covered without new test code.
+//! The conformance suite: every registered estimator goes through
+//! `mcbench::conformance::Conformance` (builds, finite output or a clean refusal on the test beds'
+//! SPEC §10 stability cases, determinism for a seed, chi-square of its samplers, unbiasedness at a
+//! small budget), so a new plug-in is covered without new test code.
 
-use estimators::registry::{self, ESTIMATORS};
+use estimators::registry;
 use mcbench::analysis::UNBIASEDNESS_ALPHA;
-use mcbench::conformance::{conformance, small_budget_unbiasedness};
+use mcbench::conformance::{small_budget_unbiasedness, Conformance};
 
 #[test]
 fn every_registered_estimator_conforms() {
-    let failures: Vec<String> = ESTIMATORS.iter().flat_map(|e| conformance(e)).map(|f| f.to_string()).collect();
+    let suite = Conformance::new(registry()).expect("every test bed's cases build");
+    let failures: Vec<String> =
+        registry().estimators().iter().flat_map(|e| suite.check(e)).map(|f| f.to_string()).collect();
     assert!(failures.is_empty(), "{} conformance failures:\n{}", failures.len(), failures.join("\n"));
 }
 
@@ -22,6 +24,7 @@ fn the_small_budget_check_flags_the_biased_control() {
     let bed = (registry::testbed("gradient-plane").expect("registered").build)(
         "default",
         &estimators::params::Params::new().with("resolution", 2.0),
+        &estimators::references::NoReferences,
     )
     .expect("builds");
     let row = small_budget_unbiasedness(entry, est.as_ref(), bed.as_ref()).expect("the control runs");
@@ -34,10 +37,21 @@ fn the_small_budget_check_flags_the_biased_control() {
 fn an_unregistered_sampler_name_fails_the_suite() {
     let real = registry::estimator("is0_cv0").expect("registered");
     let entry = registry::EstimatorEntry { samplers: &["no_such_sampler"], ..*real };
-    let failures = conformance(&entry);
+    let failures = Conformance::new(registry()).expect("builds").check(&entry);
     assert!(
         failures.iter().any(|f| f.check == "samplers" && f.detail.contains("no_such_sampler")),
         "{:?}",
         failures.iter().map(|f| format!("{}: {}", f.check, f.detail)).collect::<Vec<_>>()
     );
+}
+
+/// The registry of the `mcbench` binary, reading the repository's stored references.
+fn registry() -> &'static mcbench::Registry {
+    static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
+    REGISTRY.get_or_init(|| {
+        experiments::registry().with_references(mcbench::references::ReferenceDir::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../results/references"
+        )))
+    })
 }

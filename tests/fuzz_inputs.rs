@@ -297,10 +297,14 @@ fn edited_references_never_panic_and_pass_only_when_well_formed() {
         .expect("no edit makes the reference check panic");
 }
 
-/// The registry of the `mcbench` binary (built-in plug-ins and the paper suite).
+/// The repository's stored references.
+const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
+
+/// The registry of the `mcbench` binary (built-in plug-ins and the paper suite), reading the
+/// repository's stored references.
 fn registry() -> &'static mcbench::Registry {
     static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
-    REGISTRY.get_or_init(experiments::registry)
+    REGISTRY.get_or_init(|| experiments::registry().with_references(mcbench::references::ReferenceDir::new(REFERENCES)))
 }
 
 /// Plans a sweep against [`registry`].

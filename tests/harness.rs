@@ -235,10 +235,14 @@ fn a_fetch_budget_buys_a_fixed_calibrated_number_of_rays() {
     }
 }
 
-/// The registry of the `mcbench` binary (built-in plug-ins and the paper suite).
+/// The repository's stored references.
+const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
+
+/// The registry of the `mcbench` binary (built-in plug-ins and the paper suite), reading the
+/// repository's stored references.
 fn registry() -> &'static mcbench::Registry {
     static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
-    REGISTRY.get_or_init(experiments::registry)
+    REGISTRY.get_or_init(|| experiments::registry().with_references(mcbench::references::ReferenceDir::new(REFERENCES)))
 }
 
 /// Plans a sweep against [`registry`].

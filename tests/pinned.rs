@@ -33,7 +33,8 @@ fn first_estimates() -> BTreeMap<String, String> {
         .into_iter()
         .map(|(id, v, p)| {
             let entry = registry::testbed(id).expect("registered test bed");
-            (format!("{id}/{v}"), (entry.build)(v, &p).expect("builds"))
+            let refs = mcbench::references::ReferenceDir::new(REFERENCES);
+            (format!("{id}/{v}"), (entry.build)(v, &p, &refs).expect("builds"))
         })
         .collect();
     let mut out = BTreeMap::new();
@@ -91,3 +92,6 @@ fn first_estimates_are_pinned() {
         diffs.join("\n")
     );
 }
+
+/// The repository's stored references.
+const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");

@@ -61,8 +61,12 @@ fn cache_ops(c: &mut Criterion) {
 }
 
 fn is1_cv2_estimate(c: &mut Criterion) {
-    let bed = (registry::testbed("gradient-plane").unwrap().build)("default", &Params::new().with("resolution", 8.0))
-        .expect("test bed");
+    let bed = (registry::testbed("gradient-plane").unwrap().build)(
+        "default",
+        &Params::new().with("resolution", 8.0),
+        &estimators::references::NoReferences,
+    )
+    .expect("test bed");
     let mut group = c.benchmark_group("is1_cv2_estimate");
     for spp in [64u64, 1024, 4096] {
         group.throughput(Throughput::Elements(spp));

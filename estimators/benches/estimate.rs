@@ -13,7 +13,11 @@ fn one_estimate(c: &mut Criterion) {
     for bed_entry in TESTBEDS {
         let variant = bed_entry.variants[0];
         // Test beds with stored references exist only at the stored resolution (benches/media.rs).
-        let Ok(bed) = (bed_entry.build)(variant, &Params::new().with("resolution", 8.0)) else { continue };
+        let Ok(bed) =
+            (bed_entry.build)(variant, &Params::new().with("resolution", 8.0), &estimators::references::NoReferences)
+        else {
+            continue;
+        };
         let mut group = c.benchmark_group(format!("estimate_{}_{}spp", bed_entry.id, budget.amount));
         group.throughput(Throughput::Elements(budget.amount));
         for e in ESTIMATORS.iter().filter(|e| e.skip_reason(bed.provides()).is_none()) {

@@ -78,7 +78,8 @@ fn resampling(c: &mut Criterion) {
 
 fn pmc_hi_iteration(c: &mut Criterion) {
     let entry = registry::testbed("checker-direct").expect("registered");
-    let bed = (entry.build)("default", &Params::new().with("resolution", 8.0)).expect("bed");
+    let bed = (entry.build)("default", &Params::new().with("resolution", 8.0), &estimators::references::NoReferences)
+        .expect("bed");
     let est = (registry::estimator("pmc_hi").expect("registered").build)(&Params::new()).expect("builds");
     // m = lights + 2 mixture components; one population (one iteration) is 2 m samples.
     let m = bed.hemisphere().expect("surface").lights().len() + 2;

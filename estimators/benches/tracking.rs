@@ -57,7 +57,7 @@ impl Tally {
 
 fn bed(id: &str, variant: &str) -> Box<dyn TestBed> {
     let entry = registry::testbed(id).expect("registered medium");
-    (entry.build)(variant, &Params::new()).expect("builds")
+    (entry.build)(variant, &Params::new(), &estimators::references::NoReferences).expect("builds")
 }
 
 /// 1024 random points along the central ray (where the trackers step, so the bare loop and the

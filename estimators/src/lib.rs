@@ -26,6 +26,7 @@ pub mod perception;
 pub mod phase;
 pub mod pmc;
 pub mod quadrature;
+pub mod references;
 pub mod registry;
 pub mod rng;
 pub mod samplers;

@@ -248,7 +248,7 @@ pub trait MediumScene: Send + Sync {
 /// ```
 /// use estimators::registry::testbed;
 /// use estimators::params::Params;
-/// let bed = (testbed("gradient-plane").unwrap().build)("diffuse", &Params::new().with("resolution", 4.0)).unwrap();
+/// let bed = testbed("gradient-plane").unwrap().build_exact("diffuse", &Params::new().with("resolution", 4.0)).unwrap();
 /// assert_eq!(bed.integrals(), 16);
 /// assert!(bed.reference().is_exact());
 /// // A diffuse pixel integrates to kd (c0 + 2 c1 / 3) in closed form (red: 0.8 * (1 + 2/3)).
@@ -265,6 +265,11 @@ pub trait TestBed: Send + Sync {
     fn resolution(&self) -> (usize, usize);
     /// The references of every integral.
     fn reference(&self) -> &Reference;
+    /// What a stored reference of this scene is looked up by, for scenes whose reference can be
+    /// stored ([`crate::references`]); `None` (the default) for closed forms.
+    fn reference_key(&self) -> Option<crate::references::ReferenceKey> {
+        None
+    }
     /// Extra geometry columns for integral `i` in `integrals.csv` (name, value).
     fn geometry(&self, _i: usize) -> Vec<(&'static str, f64)> {
         Vec::new()

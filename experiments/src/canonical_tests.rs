@@ -139,7 +139,7 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
         mode: Mode::Quick,
         baseline: None,
     };
-    let registry = crate::registry();
+    let registry = crate::test_registry();
     let opts = ExecOptions {
         results_root: dir.path().join("results"),
         plots_root: dir.path().join("plots"),

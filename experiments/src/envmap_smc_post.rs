@@ -82,7 +82,7 @@ pub fn post(
     report: &mut RunReport,
     results_dir: &OutputDir,
     plots_dir: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
+    registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
     let mode = plan.sweep.mode;
     let errors = frame_errors(plan, run);
@@ -252,7 +252,7 @@ pub fn post(
         ));
     }
     // The dedicated unbiasedness check (thousands of repetitions at a small size).
-    let dedicated = crate::envmap_unbiasedness::check(mode, plan.sweep.seed)?;
+    let dedicated = crate::envmap_unbiasedness::check(mode, plan.sweep.seed, registry)?;
     for t in dedicated.iter().filter(|t| t.test.starts_with("holm")) {
         let Some(t) = mcbench::claims::decisive_test(&dedicated, &t.variant, &t.estimator, "_dedicated") else {
             continue;

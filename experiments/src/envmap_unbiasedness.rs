@@ -9,7 +9,6 @@
 
 use estimators::budget::Budget;
 use estimators::params::Params;
-use estimators::registry;
 use estimators::rng::StreamKey;
 use estimators::stats::Moments;
 use estimators::task::Task;
@@ -17,6 +16,7 @@ use mcbench::analysis::{unbiasedness, TestRow};
 use mcbench::cell::{CellKey, CellResult};
 use mcbench::config::Mode;
 use mcbench::error::Result;
+use mcbench::registry::Registry;
 use rayon::prelude::*;
 
 /// (estimator id, its parameters) checked.
@@ -33,17 +33,17 @@ fn cases() -> Vec<(&'static str, Params)> {
 
 /// Runs the check; one `holm_t` and one `pooled_z` row per (variant, estimator), test names
 /// suffixed `_dedicated`.
-pub fn check(mode: Mode, seed: u64) -> Result<Vec<TestRow>> {
+pub fn check(mode: Mode, seed: u64, registry: &Registry) -> Result<Vec<TestRow>> {
     let reps: u64 = if mode == Mode::Quick { 3000 } else { 20_000 };
     let n = 4u64;
     let mut rows = Vec::new();
     for variant in ["mixed", "mixed-lns"] {
         let params = Params::new().with("resolution", 2.0).with("frames", 4.0);
-        let bed = (registry::testbed("envmap-sequence")?.build)(variant, &params)?;
+        let bed = (registry.test_bed("envmap-sequence")?.build)(variant, &params, registry.references())?;
         let f = bed.sequence_length();
         let seqs = bed.integrals() / f;
         for (id, p) in cases() {
-            let entry = registry::estimator(id)?;
+            let entry = registry.estimator(id)?;
             let est = (entry.build)(&p)?;
             let label = format!("{id}-dedicated");
             let per_rep: Vec<Vec<[f64; 3]>> = (0..reps)

@@ -99,6 +99,16 @@ pub fn registry() -> Registry {
     EXPERIMENTS.iter().fold(Registry::builtin(), |r, d| r.with_experiment(d.experiment()))
 }
 
+/// The registry for the crate's own tests: [`registry`] reading the repository's stored
+/// references.
+#[cfg(test)]
+pub(crate) fn test_registry() -> Registry {
+    registry().with_references(mcbench::references::ReferenceDir::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../results/references"
+    )))
+}
+
 /// Estimator specs with default parameters for `ids`.
 pub fn available(ids: &[&str]) -> (Vec<EstimatorSpec>, Vec<String>) {
     (ids.iter().map(|id| EstimatorSpec::new(id)).collect(), Vec::new())

@@ -115,7 +115,7 @@ pub fn post(
     report: &mut RunReport,
     results: &OutputDir,
     _plots: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
+    registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
     let mode = plan.sweep.mode;
     let seed = plan.sweep.seed;
@@ -147,7 +147,7 @@ pub fn post(
         ]);
     };
     for c in cases(k) {
-        let o = sc::run(&c, seed);
+        let o = sc::run(&c, seed, registry);
         let bed_params = params_text(&c.bed);
         let est_params = params_text(&c.params);
         let params = match (est_params.is_empty(), bed_params.is_empty()) {

@@ -14,7 +14,6 @@
 use estimators::budget::Budget;
 use estimators::error::EstimateError;
 use estimators::params::Params;
-use estimators::registry;
 use estimators::rng::StreamKey;
 use estimators::stats::Moments;
 use estimators::task::Task;
@@ -22,6 +21,7 @@ use estimators::testbed::TestBed;
 use mcbench::analysis::unbiasedness;
 use mcbench::claims::decisive_test;
 use mcbench::guarded::{self, one_line, Stopped};
+use mcbench::registry::Registry;
 use rayon::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -122,21 +122,21 @@ fn one_rep(
 }
 
 /// Runs one case (never panics: panics inside estimators are caught and reported).
-pub fn run(case: &Case, seed: u64) -> Outcome {
-    catch_unwind(AssertUnwindSafe(|| run_inner(case, seed)))
+pub fn run(case: &Case, seed: u64, registry: &Registry) -> Outcome {
+    catch_unwind(AssertUnwindSafe(|| run_inner(case, seed, registry)))
         .unwrap_or_else(|p| Outcome::failed(format!("panic: {}", guarded::panic_message(p))))
 }
 
-fn run_inner(case: &Case, seed: u64) -> Outcome {
-    let entry = match registry::testbed(case.testbed) {
+fn run_inner(case: &Case, seed: u64, registry: &Registry) -> Outcome {
+    let entry = match registry.test_bed(case.testbed) {
         Ok(e) => e,
         Err(e) => return Outcome::refused(e),
     };
-    let bed = match (entry.build)(case.variant, &case.bed) {
+    let bed = match (entry.build)(case.variant, &case.bed, registry.references()) {
         Ok(b) => b,
         Err(e) => return Outcome::refused(e),
     };
-    let est_entry = match registry::estimator(case.estimator) {
+    let est_entry = match registry.estimator(case.estimator) {
         Ok(e) => e,
         Err(e) => return Outcome::refused(e),
     };
@@ -273,20 +273,20 @@ mod tests {
 
     #[test]
     fn outcomes_are_correct_refused_or_failed_never_a_panic() {
-        let ok = run(&case("delta_tracking", Params::new(), Expect::Correct), 1);
+        let ok = run(&case("delta_tracking", Params::new(), Expect::Correct), 1, &Registry::builtin());
         assert_eq!(ok.outcome, "correct", "{ok:?}");
         // Optical depth ln 2 (the default of constant-T0.5): r = 1e6 > 2/(a+1), the model refuses.
         let terminating = Case {
             bed: Params::new(),
             ..case("single_particle_terminating", Params::new().with("sigma_samp_ratio", 1e-6), Expect::Refused)
         };
-        let refused = run(&terminating, 1);
+        let refused = run(&terminating, 1, &Registry::builtin());
         assert!(refused.outcome == "refused" && refused.text.contains("sigma_samp"), "{refused:?}");
-        let unknown = run(&case("no_such_estimator", Params::new(), Expect::Refused), 1);
+        let unknown = run(&case("no_such_estimator", Params::new(), Expect::Refused), 1, &Registry::builtin());
         assert!(unknown.outcome == "refused" && unknown.text.contains("no_such_estimator"), "{unknown:?}");
         // A panicking estimator is caught and reported in one line.
         let c = case("delta_tracking", Params::new(), Expect::Correct);
-        let bed = (registry::testbed("canonical-1d").unwrap().build)(c.variant, &c.bed).unwrap();
+        let bed = Registry::builtin().test_bed("canonical-1d").unwrap().build_exact(c.variant, &c.bed).unwrap();
         let err = one_rep(&Panics, bed.as_ref(), &c, 1, 0).unwrap_err();
         assert_eq!(err, "panic: boom");
     }

@@ -125,7 +125,7 @@ mod tests {
             mode: Mode::Quick,
             baseline: None,
         };
-        let plan = Plan::prepare(sweep, &mcbench::Registry::builtin()).unwrap();
+        let plan = Plan::prepare(sweep, &crate::test_registry()).unwrap();
         let cells = run(&plan, &RunOptions { threads: Some(2), cell_dir: None, observer: &Silent }).unwrap().cells;
         let d = deviations(&plan, 0, 0, 1).unwrap().unwrap();
         let r = plan.beds[0].bed.reference();

@@ -140,7 +140,7 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
         mode: Mode::Quick,
         baseline: None,
     };
-    let plan = Plan::prepare(sweep, &mcbench::Registry::builtin()).unwrap();
+    let plan = Plan::prepare(sweep, &crate::test_registry()).unwrap();
     let results = run(&plan, &RunOptions { threads: Some(1), cell_dir: None, observer: &Silent }).unwrap();
     let reference = plan.beds[0].bed.reference();
     let rows: Vec<Row> = results

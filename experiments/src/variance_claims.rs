@@ -56,7 +56,13 @@ pub fn measure(est: &dyn Estimator, bed: &dyn TestBed, k: usize, n: usize, seed:
 
 /// The central-ray bed with `points` integrals, its extinction along the ray and the grid of s.
 pub fn central_ray(points: usize) -> Option<(MediumBed, Vec<f64>)> {
-    let bed = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", points as f64)).ok()?;
+    let bed = MediumBed::new(
+        Field::Eq21,
+        "central-ray",
+        &Params::new().with("points", points as f64),
+        &estimators::references::NoReferences,
+    )
+    .ok()?;
     let grid: Vec<f64> = (0..points).filter_map(|k| bed.medium().map(|m| m.ray(k).length)).collect();
     Some((bed, grid))
 }

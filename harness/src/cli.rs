@@ -42,22 +42,7 @@ enum Command {
         args: RunArgs,
     },
     /// Compute and store the reference of a test bed.
-    Reference {
-        /// Test bed id.
-        testbed: String,
-        /// Variant (the first when omitted).
-        #[arg(long)]
-        variant: Option<String>,
-        /// Paths per integral for stored Monte Carlo references (the test bed's default when omitted).
-        #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
-        samples: Option<u64>,
-        /// Results root.
-        #[arg(long, default_value = "results")]
-        results: PathBuf,
-        /// Wait for another run writing the references folder instead of refusing.
-        #[arg(long)]
-        wait: bool,
-    },
+    Reference(ReferenceArgs),
     /// Merge the folders of `run --shard i/n` into the files a single run writes (SPEC §12).
     Merge {
         /// Shard folders (`<results>/<experiment>/shard-<i>-of-<n>`), or the experiment's results
@@ -82,6 +67,22 @@ enum Command {
         /// Plain progress lines on stderr even when it is not a terminal.
         #[arg(long)]
         progress: bool,
+        /// Where stored references are read (default: `<results>/references`).
+        #[arg(long, value_name = "DIR")]
+        references: Option<PathBuf>,
+    },
+    /// Run the conformance suite on estimators (every registered one when none is named): builds,
+    /// finite output on the stability cases, determinism, its samplers' chi-square tests, and
+    /// unbiasedness at a small budget. Exit 1 when an estimator fails.
+    Conformance {
+        /// Estimator ids.
+        estimators: Vec<String>,
+        /// Results root (stored references are read from its `references` folder).
+        #[arg(long, value_name = "DIR", default_value = "results")]
+        results: PathBuf,
+        /// Where stored references are read (default: `<results>/references`).
+        #[arg(long, value_name = "DIR")]
+        references: Option<PathBuf>,
     },
     /// Redraw the plots and report of a results folder.
     Plot {
@@ -94,6 +95,30 @@ enum Command {
         #[arg(long)]
         wait: bool,
     },
+}
+
+#[derive(Args, Debug)]
+struct ReferenceArgs {
+    /// Test bed id.
+    testbed: String,
+    /// Variant (the first when omitted).
+    #[arg(long)]
+    variant: Option<String>,
+    /// A test-bed parameter the reference is made for (repeatable): `--param resolution=8`.
+    #[arg(long = "param", value_name = "KEY=VALUE")]
+    params: Vec<String>,
+    /// Paths per integral for stored Monte Carlo references (the test bed's default when omitted).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1u64 << 40))]
+    samples: Option<u64>,
+    /// Results root (the reference goes to its `references` folder).
+    #[arg(long, default_value = "results")]
+    results: PathBuf,
+    /// The references folder (default: `<results>/references`).
+    #[arg(long, value_name = "DIR")]
+    references: Option<PathBuf>,
+    /// Wait for another run writing the references folder instead of refusing.
+    #[arg(long)]
+    wait: bool,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -141,6 +166,9 @@ struct RunArgs {
     /// Plain progress lines on stderr even when it is not a terminal.
     #[arg(long)]
     progress: bool,
+    /// Where stored references are read (default: `<results>/references`).
+    #[arg(long, value_name = "DIR")]
+    references: Option<PathBuf>,
 }
 
 impl RunArgs {
@@ -210,17 +238,20 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
                 )
                 .into());
             }
-            run(&names, &cli.run, registry)
+            let registry = with_references(registry, &cli.run.results, &cli.run.references);
+            run(&names, &cli.run, &registry)
         }
-        Some(Command::Run { experiments, args }) => run(&experiments, &args, registry),
+        Some(Command::Run { experiments, args }) => {
+            let registry = with_references(registry, &args.results, &args.references);
+            run(&experiments, &args, &registry)
+        }
         Some(Command::List { what }) => {
             list(what, registry);
             Ok(())
         }
-        Some(Command::Reference { testbed, variant, samples, results, wait }) => {
-            reference(&testbed, variant, samples, &results, wait, registry)
-        }
-        Some(Command::Merge { dirs, results, plots, threads, no_plots, wait, progress }) => {
+        Some(Command::Reference(args)) => reference(args, registry),
+        Some(Command::Merge { dirs, results, plots, threads, no_plots, wait, progress, references }) => {
+            let registry = &with_references(registry, &results, &references);
             let progress = Progress::new(progress);
             let opts = ExecOptions {
                 results_root: results,
@@ -238,6 +269,9 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             Ok(())
         }
         Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait, registry),
+        Some(Command::Conformance { estimators, results, references }) => {
+            conformance(&estimators, &with_references(registry, &results, &references))
+        }
     }
 }
 
@@ -323,6 +357,40 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     Ok(())
 }
 
+/// `mcbench conformance`: every check on the named estimators (all when none is named); one line
+/// per estimator, the failures below it.
+fn conformance(ids: &[String], registry: &Registry) -> Result<()> {
+    let entries: Vec<&estimators::registry::EstimatorEntry> = if ids.is_empty() {
+        registry.estimators().to_vec()
+    } else {
+        ids.iter().map(|id| registry.estimator(id)).collect::<std::result::Result<_, _>>()?
+    };
+    let suite = crate::conformance::Conformance::new(registry)?;
+    let mut failed = 0;
+    for e in entries {
+        let failures = suite.check(e);
+        println!(
+            "{}: {}",
+            e.id,
+            if failures.is_empty() { "conforms".to_string() } else { format!("{} failures", failures.len()) }
+        );
+        for f in &failures {
+            println!("  [{}] {}", f.check, f.detail);
+        }
+        failed += usize::from(!failures.is_empty());
+    }
+    if failed > 0 {
+        return Err(HarnessError::Failed(format!("{failed} estimators failed the conformance suite")));
+    }
+    Ok(())
+}
+
+/// `registry` reading stored references from `references`, or `<results>/references`.
+fn with_references(registry: &Registry, results: &std::path::Path, references: &Option<PathBuf>) -> Registry {
+    let dir = references.clone().unwrap_or_else(|| results.join("references"));
+    registry.clone().with_references(crate::references::ReferenceDir::new(dir))
+}
+
 /// What was checked for one experiment of a `run` before anything was written.
 enum Checked {
     Run(execute::Preflight),
@@ -389,52 +457,17 @@ fn list(what: Option<ListWhat>, registry: &Registry) {
     }
 }
 
-fn reference(
-    testbed: &str,
-    variant: Option<String>,
-    samples: Option<u64>,
-    results: &std::path::Path,
-    wait: bool,
-    registry: &Registry,
-) -> Result<()> {
-    let entry = registry.test_bed(testbed)?;
-    let variant = variant.unwrap_or_else(|| entry.variants[0].to_string());
-    entry.check_variant(&variant)?;
-    let folder = results.join("references");
-    crate::folder::check_output_dir("--results", &folder)?;
+fn reference(args: ReferenceArgs, registry: &Registry) -> Result<()> {
+    let entry = registry.test_bed(&args.testbed)?;
+    let variant = args.variant.clone().unwrap_or_else(|| entry.variants[0].to_string());
+    let params = param_pairs(&args.params)?;
+    let field = if args.references.is_some() { "--references" } else { "--results" };
+    let folder =
+        crate::references::ReferenceDir::new(args.references.unwrap_or_else(|| args.results.join("references")));
+    crate::folder::check_output_dir(field, folder.path())?;
     let t0 = Instant::now();
-    // Exact variants compute their reference when built; stored ones run the test bed's hook.
-    let built = (entry.build)(&variant, &Params::new());
-    let (r, resolution) = match (built, entry.compute_reference) {
-        (Ok(bed), _) if bed.reference().is_exact() || entry.compute_reference.is_none() => {
-            (bed.reference().clone(), bed.resolution())
-        }
-        (_, Some(compute)) => {
-            let mut params = Params::new();
-            if let Some(n) = samples {
-                params = params.with("samples", n as f64);
-            }
-            let threads = std::thread::available_parallelism().map(|t| t.get()).unwrap_or(1);
-            compute(&variant, &params, threads)?
-        }
-        (Ok(bed), None) => (bed.reference().clone(), bed.resolution()),
-        (Err(e), None) => return Err(e.into()),
-    };
-    let path = results.join("references").join(format!("{testbed}_{variant}.json"));
-    let command = match &r.kind {
-        estimators::testbed::ReferenceKind::Stored { command, .. } => command.clone(),
-        _ => format!("mcbench reference {testbed} --variant {variant}"),
-    };
-    let doc = serde_json::json!({
-        "testbed": testbed,
-        "variant": variant,
-        "command": command,
-        "resolution": resolution,
-        "reference": r,
-    });
-    let text = serde_json::to_string(&doc).map_err(|e| HarnessError::write(&path, e))?;
-    let _lock = crate::folder::FolderLock::acquire(&folder, wait, &[])?;
-    crate::output::write_atomic(&path, text.as_bytes())?;
+    let made = crate::references::make(entry, &variant, &params, args.samples, &folder, args.wait)?;
+    let r = &made.stored.reference;
     let kind = match &r.kind {
         estimators::testbed::ReferenceKind::Exact { method, bound } => {
             format!("exact: {method}; absolute error bound {bound:.3e}")
@@ -444,10 +477,27 @@ fn reference(
         }
     };
     println!(
-        "{testbed}/{variant}: {} integrals, {kind}, computed in {:.2} s",
+        "{}/{variant}: {} integrals, {kind}, computed in {:.2} s",
+        entry.id,
         r.value.len(),
         t0.elapsed().as_secs_f64()
     );
-    println!("written to {}", path.display());
+    println!("written to {}", made.path.display());
     Ok(())
+}
+
+/// `--param key=value` pairs as parameters: a number where the value parses as one, else text.
+fn param_pairs(pairs: &[String]) -> Result<Params> {
+    let mut p = Params::new();
+    for pair in pairs {
+        let (k, v) = pair.split_once('=').ok_or_else(|| {
+            estimators::error::ConfigError::invalid("--param", pair, "must be key=value (e.g. --param resolution=8)")
+        })?;
+        let value = match v.trim().parse::<f64>() {
+            Ok(x) => estimators::params::ParamValue::Number(x),
+            Err(_) => estimators::params::ParamValue::Text(v.trim().to_string()),
+        };
+        p.0.insert(k.trim().to_string(), value);
+    }
+    Ok(p)
 }

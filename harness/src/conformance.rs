@@ -1,18 +1,19 @@
-//! The conformance suite (issue 9 item 2): one function, [`conformance`], that every registered
-//! estimator goes through (`tests/conformance.rs` calls it for every entry of
-//! [`estimators::registry::ESTIMATORS`], so a new plug-in is covered without new test code):
+//! The conformance suite: the checks every estimator of a [`Registry`] goes through
+//! ([`Conformance::check`]; `mcbench conformance` on the command line, `tests/conformance.rs` for
+//! every built-in estimator), so a new plug-in is covered without new test code:
 //!
 //! 1. **builds** with its default parameters;
-//! 2. **finite output on the SPEC §10 stability beds** it runs on ([`stability_beds`]: albedo 1 and
-//!    0, optical depth 1e4 and 0, rays missing the medium, Phong n = 10000, an environment of
-//!    dynamic range 1e6, mostly occluded lights): every estimate finite or a clean one-line
+//! 2. **finite output on the SPEC §10 stability cases** it runs on (the `Stability` cases the test
+//!    beds declare, [`estimators::registry::BedCase`]: albedo 1 and 0, optical depth 1e4 and 0,
+//!    rays missing the medium, Phong n = 10000, an environment of dynamic range 1e6, mostly
+//!    occluded lights): every estimate finite or a clean one-line
 //!    refusal, never a panic, a NaN or an infinity; a validation error must be one line;
 //! 3. **determinism**: the same stream key gives the same bits twice;
 //! 4. **chi-square of its samplers**: the samplers its registry entry names
 //!    ([`estimators::registry::EstimatorEntry::samplers`]) are registered in
 //!    [`estimators::samplers::registry`] and pass their checks at the Sidak family level;
 //! 5. **unbiasedness at a small budget** (estimators whose bias claim is `unbiased`): on every small
-//!    exact-reference bed it runs on ([`unbiasedness_beds`]), 4 samples per estimate, the
+//!    case it runs on (the `Check` cases the test beds declare), 4 samples per estimate, the
 //!    harness's own test ([`crate::analysis::unbiasedness`], deciding test as in the claims; about
 //!    8000 estimates per bed) must
 //!    not flag it. The same check must flag the known-biased control `clamped_is0_cv0`
@@ -23,10 +24,11 @@ use crate::claims::decisive_test;
 use crate::guarded::{self, Stopped};
 use crate::registry::Registry;
 use estimators::budget::Budget;
+use estimators::error::ConfigError;
 use estimators::error::EstimateError;
 use estimators::estimator::{Bias, Estimator};
 use estimators::params::Params;
-use estimators::registry::EstimatorEntry;
+use estimators::registry::{CaseRole, EstimatorEntry};
 use estimators::rng::StreamKey;
 use estimators::samplers::registry as samplers;
 use estimators::samplers::testing::sampler_alpha;
@@ -51,64 +53,45 @@ impl std::fmt::Display for Failure {
     }
 }
 
-fn p(pairs: &[(&str, f64)]) -> Params {
-    pairs.iter().fold(Params::new(), |p, (k, v)| p.with(k, *v))
-}
-
-/// The SPEC §10 stability beds (small): (test bed, variant, parameters).
-pub fn stability_beds() -> Vec<(&'static str, &'static str, Params)> {
-    let res2 = || p(&[("resolution", 2.0)]);
-    vec![
-        ("gradient-box", "furnace", res2()),
-        ("gradient-box", "albedo-0", res2()),
-        ("gradient-box", "thick", Params::new()),
-        ("canonical-1d", "constant-T0.5", p(&[("tau", 1e4)])),
-        ("canonical-1d", "constant-T0.5", p(&[("tau", 0.0)])),
-        ("canonical-1d", "hole-T0.1", p(&[("albedo", 0.0)])),
-        ("canonical-1d", "hole-T0.1", p(&[("albedo", 1.0)])),
-        ("eq21-medium", "transmittance", p(&[("resolution", 4.0)])),
-        ("eq21-medium", "single-scatter", res2()),
-        ("gradient-plane", "stiff", res2()),
-        ("checker-direct", "occluded", res2()),
-        ("envmap-sequence", "mixed", p(&[("resolution", 2.0), ("frames", 2.0), ("sun", 1e6)])),
-    ]
-}
-
-/// Small beds with exact (or stored) references for the small-budget unbiasedness check.
-pub fn unbiasedness_beds() -> Vec<(&'static str, &'static str, Params)> {
-    let res2 = || p(&[("resolution", 2.0)]);
-    vec![
-        ("gradient-plane", "default", res2()),
-        ("checker-direct", "default", res2()),
-        ("canonical-1d", "hole-T0.1", p(&[("points", 2.0)])),
-        ("eq21-medium", "single-scatter", res2()),
-        ("gradient-box", "furnace", res2()),
-        ("envmap-sequence", "mixed", p(&[("resolution", 2.0), ("frames", 2.0)])),
-        ("checker-image", "default", Params::new()),
-    ]
-}
-
 type Beds = Vec<(String, Box<dyn TestBed>)>;
 
-fn build(list: Vec<(&'static str, &'static str, Params)>) -> Beds {
-    let registry = Registry::builtin();
-    list.into_iter()
-        .map(|(id, v, params)| {
-            let entry = registry.test_bed(id).unwrap_or_else(|e| panic!("conformance bed {id}: {e}"));
-            let bed = (entry.build)(v, &params).unwrap_or_else(|e| panic!("conformance bed {id}/{v}: {e}"));
-            (format!("{id}/{v} {params:?}"), bed)
-        })
-        .collect()
+/// The test beds of the suite, built once: every registered test bed's declared cases
+/// ([`estimators::registry::BedCase`]) of the roles `Stability` and `Check`.
+pub struct Conformance {
+    stability: Beds,
+    check: Beds,
 }
 
-fn stability() -> &'static Beds {
-    static BEDS: OnceLock<Beds> = OnceLock::new();
-    BEDS.get_or_init(|| build(stability_beds()))
-}
+impl Conformance {
+    /// Builds the cases of every test bed of `registry` (a case that does not build is bad input
+    /// naming it).
+    pub fn new(registry: &Registry) -> crate::error::Result<Self> {
+        let (mut stability, mut check) = (Vec::new(), Vec::new());
+        for entry in registry.test_beds() {
+            for case in entry.cases {
+                let into = match case.role {
+                    CaseRole::Stability => &mut stability,
+                    CaseRole::Check => &mut check,
+                    CaseRole::Unbiasedness { .. } => continue,
+                };
+                let params = case.params();
+                let bed = (entry.build)(case.variant, &params, registry.references()).map_err(|e| {
+                    ConfigError::invalid(
+                        format!("{} case {}", entry.id, case.variant),
+                        format!("{params:?}"),
+                        e.to_string(),
+                    )
+                })?;
+                into.push((format!("{}/{} {params:?}", entry.id, case.variant), bed));
+            }
+        }
+        Ok(Conformance { stability, check })
+    }
 
-fn unbiased() -> &'static Beds {
-    static BEDS: OnceLock<Beds> = OnceLock::new();
-    BEDS.get_or_init(|| build(unbiasedness_beds()))
+    /// Runs every conformance check on one estimator and returns what failed.
+    pub fn check(&self, entry: &EstimatorEntry) -> Vec<Failure> {
+        conformance_on(entry, &self.stability, &self.check)
+    }
 }
 
 /// Every registered sampler's checks: (sampler id, failures as text).
@@ -202,8 +185,7 @@ pub fn small_budget_unbiasedness(entry: &EstimatorEntry, est: &dyn Estimator, be
     decisive_test(&rows, bed.variant(), entry.id, "").cloned()
 }
 
-/// Runs every conformance check on one registered estimator and returns what failed.
-pub fn conformance(entry: &EstimatorEntry) -> Vec<Failure> {
+fn conformance_on(entry: &EstimatorEntry, stability: &Beds, unbiased: &Beds) -> Vec<Failure> {
     let fail = |check, detail: String| Failure { estimator: entry.id.into(), check, detail };
     let est = match (entry.build)(&Params::new()) {
         Ok(e) => e,
@@ -212,7 +194,7 @@ pub fn conformance(entry: &EstimatorEntry) -> Vec<Failure> {
     let mut out = Vec::new();
     // 2. Finite output (or a clean refusal) on the stability beds; 3. determinism on the first.
     let mut determinism_done = false;
-    for (label, bed) in stability() {
+    for (label, bed) in stability {
         match runs_on(entry, est.as_ref(), bed.as_ref()) {
             Err(e) => out.push(fail("finite", format!("{label}: {e}"))),
             Ok(false) => {}
@@ -248,7 +230,7 @@ pub fn conformance(entry: &EstimatorEntry) -> Vec<Failure> {
     }
     // 5. Unbiasedness at a small budget.
     if entry.bias == Bias::Unbiased {
-        for (label, bed) in unbiased() {
+        for (label, bed) in unbiased {
             if !matches!(runs_on(entry, est.as_ref(), bed.as_ref()), Ok(true)) {
                 continue;
             }

@@ -4,7 +4,7 @@
 //! | code | meaning | examples |
 //! |---|---|---|
 //! | 0 | success | |
-//! | 1 | internal failure while running or writing | an estimator failed, the disk filled up |
+//! | 1 | failure while running or writing, or a failed check | an estimator failed, the disk filled up, an estimator failed `mcbench conformance` |
 //! | 2 | bad input: nothing was run or written | unknown names, values out of bounds, a config, stored cell, reference, manifest or summary file that is malformed or inconsistent, an output path that is not a writable folder |
 //! | 3 | busy: another mcbench holds the results folder | a second run into the same folder (`--wait` waits instead) |
 
@@ -64,6 +64,9 @@ pub enum HarnessError {
         /// The failure.
         source: estimators::error::EstimateError,
     },
+    /// A check failed (exit 1): an estimator that does not pass the conformance suite.
+    #[error("{0}")]
+    Failed(String),
     /// Writing outputs failed (exit 1).
     #[error("cannot write {path}: {reason}")]
     Write {
@@ -80,7 +83,7 @@ impl HarnessError {
         match self {
             HarnessError::Config(_) | HarnessError::BadFile { .. } | HarnessError::BadOutput { .. } => EXIT_BAD_INPUT,
             HarnessError::Busy { .. } => EXIT_BUSY,
-            HarnessError::Estimate { .. } | HarnessError::Write { .. } => EXIT_FAILURE,
+            HarnessError::Estimate { .. } | HarnessError::Write { .. } | HarnessError::Failed(_) => EXIT_FAILURE,
         }
     }
     /// A bad-file error.

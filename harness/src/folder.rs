@@ -45,7 +45,7 @@ pub fn check_output_dir(field: &'static str, path: &Path) -> Result<()> {
             Ok(_) => {
                 return Err(HarnessError::bad_output(field, path, format!("{} is a file, not a folder", p.display())))
             }
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) if matches!(e.kind(), std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory) => {}
             Err(e) => return Err(HarnessError::bad_output(field, path, e)),
         }
         match p.parent() {

@@ -15,7 +15,7 @@
 //! ## Quick start: your own estimator, from your own crate
 //!
 //! ```no_run
-//! use mcbench::{EstimateError, Estimator, EstimatorEntry, Registry, Rgb, StreamRng, Task};
+//! use mcbench::{Checks, EstimateError, Estimator, EstimatorEntry, Registry, Rgb, StreamRng, Task};
 //! use mcbench::estimators::{estimator::Bias, testbed::Needs};
 //!
 //! /// Independent uniform-hemisphere sampling of a surface integral.
@@ -45,6 +45,7 @@
 //!     samplers: &["uniform_hemisphere"],
 //!     summary: "independent uniform sampling of the hemisphere",
 //!     build: |_params| Ok(Box::new(Uniform)),
+//!     checks: Checks::DEFAULT,
 //! };
 //!
 //! fn main() {
@@ -74,6 +75,7 @@ pub mod output;
 pub mod plan;
 pub mod plot;
 pub mod progress;
+pub mod references;
 pub mod registry;
 pub mod report;
 pub mod runner;
@@ -83,7 +85,7 @@ pub use estimators;
 pub use estimators::error::{ConfigError, EstimateError};
 pub use estimators::estimator::{Bias, Estimator};
 pub use estimators::math::Rgb;
-pub use estimators::registry::{EstimatorEntry, TestBedEntry};
+pub use estimators::registry::{BedCase, CaseRole, Checks, EstimatorEntry, Exemption, TestBedEntry};
 pub use estimators::rng::StreamRng;
 pub use estimators::task::Task;
 pub use estimators::testbed::{Needs, Reference, TestBed};

@@ -84,7 +84,7 @@ impl Plan {
             {
                 return Err(ConfigError::invalid("testbeds", format!("{}/{variant}", spec.id), "listed twice").into());
             }
-            let bed = (entry.build)(&variant, &spec.params)?;
+            let bed = (entry.build)(&variant, &spec.params, registry.references())?;
             beds.push(PreparedBed { spec: spec.clone(), variant, bed });
         }
         let mut estimators = Vec::new();

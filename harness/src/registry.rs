@@ -20,10 +20,13 @@ use crate::error::Result;
 use crate::folder::OutputDir;
 use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
+use crate::references::ReferenceDir;
 use crate::runner::RunResults;
 use estimators::error::ConfigError;
+use estimators::references::ReferenceSource;
 use estimators::registry::{EstimatorEntry, TestBedEntry};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// An experiment's own analysis after the run: (plan, finished cells, report to extend, results
 /// folder (its files are written through it and committed with the run's), plots folder when plots
@@ -70,13 +73,29 @@ impl std::fmt::Debug for Experiment {
     }
 }
 
-/// Estimators, test beds and experiments by name.
-#[derive(Clone, Default)]
+/// Estimators, test beds and experiments by name, and where stored references are found.
+#[derive(Clone)]
 pub struct Registry {
     estimators: Vec<&'static EstimatorEntry>,
     test_beds: Vec<&'static TestBedEntry>,
     experiments: Vec<Experiment>,
+    references: Arc<dyn ReferenceSource>,
 }
+
+impl Default for Registry {
+    fn default() -> Self {
+        Registry {
+            estimators: Vec::new(),
+            test_beds: Vec::new(),
+            experiments: Vec::new(),
+            references: Arc::new(ReferenceDir::new(DEFAULT_REFERENCES)),
+        }
+    }
+}
+
+/// Where stored references are looked up unless told otherwise (`--references`, `--results`):
+/// `results/references` below the working directory.
+pub const DEFAULT_REFERENCES: &str = "results/references";
 
 impl std::fmt::Debug for Registry {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -84,6 +103,7 @@ impl std::fmt::Debug for Registry {
             .field("estimators", &self.estimators.iter().map(|e| e.id).collect::<Vec<_>>())
             .field("test_beds", &self.test_beds.iter().map(|t| t.id).collect::<Vec<_>>())
             .field("experiments", &self.experiments.iter().map(|e| e.name.as_str()).collect::<Vec<_>>())
+            .field("references", &self.references.location())
             .finish()
     }
 }
@@ -100,8 +120,19 @@ impl Registry {
         Registry {
             estimators: estimators::registry::ESTIMATORS.to_vec(),
             test_beds: estimators::registry::TESTBEDS.to_vec(),
-            experiments: Vec::new(),
+            ..Registry::default()
         }
+    }
+
+    /// Looks stored references up in `source` (for example a [`ReferenceDir`]).
+    pub fn with_references(mut self, source: impl ReferenceSource + 'static) -> Self {
+        self.references = Arc::new(source);
+        self
+    }
+
+    /// Where test beds find stored references.
+    pub fn references(&self) -> &dyn ReferenceSource {
+        self.references.as_ref()
     }
 
     /// Adds an estimator.

@@ -4,7 +4,7 @@
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::task::Task;
 use crate::testbed::Needs;
@@ -22,6 +22,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         p.reject_unknown("brdf_is0_cv0", &[])?;
         Ok(Box::new(BrdfIs0Cv0))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator (no parameters).

@@ -5,7 +5,7 @@
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::uniform_hemisphere;
 use crate::task::Task;
@@ -28,6 +28,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         }
         Ok(Box::new(ClampedIs0Cv0 { clamp }))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

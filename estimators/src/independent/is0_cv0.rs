@@ -4,7 +4,7 @@
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::uniform_hemisphere;
 use crate::task::Task;
@@ -26,6 +26,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             medium: Box::new(crate::media_smc::PathTracer),
         }))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator (no parameters).

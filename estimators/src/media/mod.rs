@@ -22,6 +22,7 @@
 pub mod density;
 pub mod environment;
 pub mod moments;
+pub mod params;
 pub mod reference;
 pub mod scatter_reference;
 pub mod variance;
@@ -29,8 +30,9 @@ pub mod variance;
 use crate::error::ConfigError;
 use crate::lighting::PointLight;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::registry::TestBedEntry;
+use crate::params::{parse, ParamSpec, Params};
+use crate::references::{ReferenceKey, ReferenceSource};
+use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, TestBed};
 
 /// Sphere centre.
@@ -76,9 +78,27 @@ pub static EQ21: TestBedEntry = TestBedEntry {
     variants: VARIANTS,
     provides: Needs::MEDIUM.and(Needs::POINT_LIGHT),
     summary: "paper 002 Eq. 21 medium in a sphere, Rayleigh, albedo 0.7: central ray T(s), transmittance image, multiple scattering, point-light single scattering",
-    build: |v, p| Ok(Box::new(MediumBed::new(Field::Eq21, v, p)?)),
-    compute_reference: Some(|v, p, t| reference::compute_stored(Field::Eq21, v, p, t)),
+    build: |v, p, refs| Ok(Box::new(MediumBed::new(Field::Eq21, v, p, refs)?)),
+    compute_reference: Some(|v, p, n, t| reference::compute_stored(Field::Eq21, v, p, n, t)),
+    params: ParamSpec::of::<params::MediumParams>(),
+    cases: &[
+        BedCase { variant: "transmittance", params: &[("resolution", 4.0)], role: CaseRole::Stability },
+        BedCase { variant: "single-scatter", params: &[("resolution", 2.0)], role: CaseRole::Stability },
+        BedCase { variant: "single-scatter", params: &[("resolution", 2.0)], role: CaseRole::Check },
+        BedCase { variant: "central-ray", params: &[("points", 8.0)], role: TRACKING_PART },
+        BedCase { variant: "transmittance", params: &[("resolution", 4.0)], role: TRACKING_PART },
+        BedCase { variant: "single-scatter", params: &[("resolution", 4.0)], role: SCATTER_PART },
+        BedCase { variant: "multiple", params: &[], role: MULTIPLE_PART },
+    ],
 };
+
+/// The tracking part of the `unbiasedness` experiment: 4 rays per estimate, 1024 repetitions
+/// (quick) or 32768 (full).
+const TRACKING_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1024, 32_768) };
+/// The single-scattering part: 4 samples per estimate, 1024 or 8192 repetitions.
+const SCATTER_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1024, 8192) };
+/// The multiple-scattering part: 4 paths per estimate, 64 or 256 repetitions.
+const MULTIPLE_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (64, 256) };
 
 /// `perlin-medium` registry entry.
 pub static PERLIN: TestBedEntry = TestBedEntry {
@@ -86,8 +106,15 @@ pub static PERLIN: TestBedEntry = TestBedEntry {
     variants: VARIANTS,
     provides: Needs::MEDIUM.and(Needs::POINT_LIGHT),
     summary: "12-octave Perlin fbm medium (max 1, mostly < 0.6), Rayleigh, albedo 0.9; cheap = first 3 octaves; same variants",
-    build: |v, p| Ok(Box::new(MediumBed::new(Field::Perlin, v, p)?)),
-    compute_reference: Some(|v, p, t| reference::compute_stored(Field::Perlin, v, p, t)),
+    build: |v, p, refs| Ok(Box::new(MediumBed::new(Field::Perlin, v, p, refs)?)),
+    compute_reference: Some(|v, p, n, t| reference::compute_stored(Field::Perlin, v, p, n, t)),
+    params: ParamSpec::of::<params::MediumParams>(),
+    cases: &[
+        BedCase { variant: "central-ray", params: &[("points", 8.0)], role: TRACKING_PART },
+        BedCase { variant: "transmittance", params: &[("resolution", 4.0)], role: TRACKING_PART },
+        BedCase { variant: "single-scatter", params: &[], role: SCATTER_PART },
+        BedCase { variant: "multiple", params: &[], role: MULTIPLE_PART },
+    ],
 };
 
 /// A medium test bed.
@@ -100,20 +127,6 @@ pub struct MediumBed {
     rays: Vec<MediumRay>,
     light: PointLight,
     reference: Reference,
-}
-
-/// The parameters of the point light (`single-scatter` only).
-const LIGHT_PARAMS: [&str; 4] = ["light_x", "light_y", "light_z", "intensity"];
-
-/// The point light from parameters (SPEC §3.3 defaults).
-fn light_param(field: Field, params: &Params) -> Result<PointLight, ConfigError> {
-    let p = LIGHT.position;
-    let position = Vec3::new(params.f64("light_x", p.x)?, params.f64("light_y", p.y)?, params.f64("light_z", p.z)?);
-    let intensity = params.f64("intensity", LIGHT.intensity)?;
-    if !(intensity > 0.0 && intensity <= 1e12) {
-        return Err(ConfigError::invalid(format!("{}.intensity", field.id()), intensity, "must lie in (0, 1e12]"));
-    }
-    Ok(PointLight { position, intensity })
 }
 
 /// Ray-sphere clip of the medium's sphere for unit `dir`, clamped to `t >= 0`.
@@ -131,25 +144,55 @@ pub fn clip_sphere(origin: Vec3, dir: Vec3) -> Option<(f64, f64)> {
 }
 
 impl MediumBed {
-    /// Builds a variant (validates parameters; computes exact or loads stored references).
-    pub fn new(field: Field, variant: &str, params: &Params) -> Result<Self, ConfigError> {
+    /// Builds a variant (validates parameters; computes exact references, or looks the stored one
+    /// of `multiple` up in `refs`, and the stored quadrature of `single-scatter` when there is one).
+    pub fn new(field: Field, variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let mut bed = Self::without_reference(field, variant, params)?;
         bed.reference = match variant {
-            "multiple" => reference::load_stored(field, bed.resolution.0, bed.scale, bed.albedo)?,
-            "single-scatter" => scatter_reference::reference(&bed)?,
+            "multiple" => crate::references::load(refs, &bed.reference_key(), bed.integrals())?,
+            "single-scatter" => scatter_reference::reference(&bed, refs)?,
             _ => reference::transmittance_reference(&bed),
         };
         Ok(bed)
     }
 
+    /// What a stored reference of this scene is looked up by: variant, resolution, extinction
+    /// scale and albedo, and for `single-scatter` the light.
+    pub fn reference_key(&self) -> ReferenceKey {
+        let mut params = vec![
+            ("resolution", serde_json::Value::from(self.resolution.0)),
+            ("scale", self.scale.into()),
+            ("albedo", self.albedo.into()),
+        ];
+        let default_res = if self.variant == "single-scatter" { self.default_resolution() } else { 16 };
+        let mut default = self.resolution.0 == default_res && self.scale == 1.0 && self.albedo == self.field.albedo();
+        if self.variant == "single-scatter" {
+            let l = self.light;
+            params.extend([
+                ("light_x", l.position.x.into()),
+                ("light_y", l.position.y.into()),
+                ("light_z", l.position.z.into()),
+                ("intensity", l.intensity.into()),
+            ]);
+            default &= l == LIGHT;
+        }
+        ReferenceKey::new(self.field.id(), &self.variant, &params, default)
+    }
+
+    fn default_resolution(&self) -> usize {
+        match (self.variant.as_str(), self.field) {
+            ("single-scatter", Field::Perlin) => scatter_reference::PERLIN_RESOLUTION,
+            ("single-scatter", Field::Eq21) => scatter_reference::EQ21_RESOLUTION,
+            ("multiple", _) | (_, Field::Perlin) => 16,
+            _ => 32,
+        }
+    }
+
     /// A variant without its reference (validates parameters; for computing a stored reference
     /// and for tests that need no reference).
     pub fn without_reference(field: Field, variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        let light_params: &[&str] = if variant == "single-scatter" { &LIGHT_PARAMS } else { &[] };
-        let known: Vec<&str> =
-            ["resolution", "points", "scale", "albedo"].iter().chain(light_params).copied().collect();
-        params.reject_unknown(field.id(), &known)?;
-        let albedo = params.f64_in("albedo", field.albedo(), 0.0, 1.0)?;
+        let p = parse::<params::MediumParams>(field.id(), params)?;
+        let albedo = p.albedo.unwrap_or(field.albedo());
         if !VARIANTS.contains(&variant) {
             return Err(ConfigError::unknown(
                 "variant",
@@ -157,20 +200,18 @@ impl MediumBed {
                 VARIANTS.iter().copied(),
             ));
         }
-        let scale = params.f64("scale", 1.0)?;
-        if !(scale > 0.0 && scale <= 1e6) {
-            return Err(ConfigError::invalid(format!("{}.scale", field.id()), scale, "must lie in (0, 1e6]"));
-        }
+        p.check_for(field, variant)?;
+        let scale = p.scale;
         let default_res = match (variant, field) {
             ("single-scatter", Field::Perlin) => scatter_reference::PERLIN_RESOLUTION,
             ("single-scatter", Field::Eq21) => scatter_reference::EQ21_RESOLUTION,
             ("multiple", _) | (_, Field::Perlin) => 16,
             _ => 32,
         };
-        let light = light_param(field, params)?;
+        let light = p.light(field)?;
         let (resolution, rays) = match variant {
             "central-ray" => {
-                let k = params.count("points", 40, 10_000)?;
+                let k = p.points;
                 let rays = (1..=k)
                     .map(|j| MediumRay {
                         origin: Vec3::default(),
@@ -182,7 +223,7 @@ impl MediumBed {
                 ((k, 1), rays)
             }
             _ => {
-                let n = params.count("resolution", default_res, 512)?;
+                let n = p.resolution.unwrap_or(default_res);
                 let dir = Vec3::new(0.0, 1.0, 0.0);
                 let quantity = match variant {
                     "multiple" => MediumQuantity::Radiance,
@@ -263,6 +304,9 @@ impl MediumBed {
 }
 
 impl TestBed for MediumBed {
+    fn reference_key(&self) -> Option<ReferenceKey> {
+        Some(MediumBed::reference_key(self))
+    }
     fn id(&self) -> &'static str {
         self.field.id()
     }

@@ -15,6 +15,7 @@ use crate::estimator::Estimator;
 use crate::math::{Rgb, Vec3};
 use crate::params::Params;
 use crate::quadrature::{gauss_kronrod_multi, Quadrature};
+use crate::references::{ReferenceKey, StoredReference};
 use crate::rng::StreamKey;
 use crate::stats::Moments;
 use crate::task::Task;
@@ -167,68 +168,31 @@ pub fn transmittance_reference(bed: &MediumBed) -> Reference {
     }
 }
 
-fn stored_path(field: Field) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join("results")
-        .join("references")
-        .join(format!("{}_multiple.json", field.id()))
-}
-
-/// Loads the stored multiple-scattering reference; it exists for the default parameters only.
-pub fn load_stored(field: Field, resolution: usize, scale: f64, albedo: f64) -> Result<Reference, ConfigError> {
-    let path = stored_path(field);
-    let cmd = format!("mcbench reference {} --variant multiple", field.id());
-    let text = std::fs::read_to_string(&path).map_err(|e| {
-        ConfigError::invalid(
-            format!("{}/multiple reference", field.id()),
-            path.display(),
-            format!("cannot read the stored reference ({e}); make it with `{cmd}`"),
-        )
-    })?;
-    let doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
-        ConfigError::invalid(format!("{}/multiple reference", field.id()), path.display(), format!("malformed ({e})"))
-    })?;
-    let stored_res = doc["resolution"][0].as_u64().unwrap_or(0) as usize;
-    if stored_res != resolution || scale != 1.0 || albedo != field.albedo() {
-        return Err(ConfigError::invalid(
-            format!("{}.resolution", field.id()),
-            resolution,
-            format!("the stored multiple-scattering reference is {stored_res}x{stored_res} at scale 1 and the default albedo; other settings need `{cmd}` with them"),
-        ));
-    }
-    let bad = |e: String| {
-        ConfigError::invalid(
-            format!("{}/multiple reference", field.id()),
-            path.display(),
-            format!("malformed reference ({e})"),
-        )
-    };
-    let r: Reference = serde_json::from_value(doc["reference"].clone()).map_err(|e| bad(e.to_string()))?;
-    r.check(resolution * resolution).map_err(bad)?;
-    Ok(r)
-}
-
-/// Computes the stored multiple-scattering reference by long-run delta tracking (parameter
-/// `samples` paths per pixel, default 20000 for Eq. 21 and 4000 for Perlin), seeded per pixel.
+/// Computes the stored multiple-scattering reference by long-run delta tracking (`samples` paths
+/// per pixel, default 20000 for Eq. 21 and 4000 for Perlin), seeded per pixel, for the test bed's
+/// `params`.
 pub fn compute_stored(
     field: Field,
     variant: &str,
     params: &Params,
+    samples: Option<u64>,
     threads: usize,
-) -> Result<(Reference, (usize, usize)), ConfigError> {
+) -> Result<(ReferenceKey, StoredReference), ConfigError> {
     if variant != "multiple" {
         return Err(ConfigError::invalid(
             "variant",
             variant,
-            "only `multiple` has a stored reference (the others are exact)",
+            "only `multiple` has a stored Monte Carlo reference (the others are exact)",
         ));
     }
-    params.reject_unknown(field.id(), &["resolution", "samples"])?;
     let default_n = if field == Field::Eq21 { 20_000 } else { 4_000 };
-    let samples = params.count("samples", default_n, 100_000_000)? as u64;
-    let res = params.count("resolution", 16, 512)?;
-    let bed = MediumBed::without_reference(field, variant, &Params::new().with("resolution", res as f64))?;
+    let samples = samples.unwrap_or(default_n);
+    if samples > 100_000_000 {
+        return Err(ConfigError::invalid("samples", samples, "must be a whole number in [1, 100000000]"));
+    }
+    let bed = MediumBed::without_reference(field, variant, params)?;
+    let key = bed.reference_key();
+    let res = bed.resolution().0;
     let tracker = crate::tracking::delta_tracking::DeltaTracking { sigma_samp: crate::tracking::SigmaSamp::Majorant };
     let n = bed.integrals();
     let out = crate::parallel::map_indices(n, threads, |i| {
@@ -249,16 +213,23 @@ pub fn compute_stored(
         }
         (Rgb(m.each_ref().map(|x| x.mean())), Rgb(m.each_ref().map(|x| x.std_err())))
     });
-    let command = format!(
-        "mcbench reference {} --variant multiple --samples {samples} (delta tracking, seed 20170001)",
-        field.id()
-    );
+    let command = format!("{} --samples {samples} (delta tracking, seed 20170001)", key.command());
     let reference = Reference {
-        kind: ReferenceKind::Stored { command, samples },
+        kind: ReferenceKind::Stored { command: command.clone(), samples },
         value: out.iter().map(|x| x.0).collect(),
         std_err: out.iter().map(|x| x.1).collect(),
     };
-    Ok((reference, (res, res)))
+    Ok((
+        key.clone(),
+        StoredReference {
+            testbed: key.testbed,
+            variant: key.variant,
+            params: key.params,
+            command,
+            resolution: (res, res),
+            reference,
+        },
+    ))
 }
 
 #[cfg(test)]
@@ -272,7 +243,13 @@ mod tests {
     #[test]
     fn transmittance_reference_is_within_1e_12() {
         for field in [Field::Eq21, Field::Perlin] {
-            let bed = MediumBed::new(field, "central-ray", &Params::new().with("points", 4.0)).unwrap();
+            let bed = MediumBed::new(
+                field,
+                "central-ray",
+                &Params::new().with("points", 4.0),
+                &crate::references::repository::Repository,
+            )
+            .unwrap();
             let (x, w) = gauss_legendre(20);
             if field == Field::Perlin {
                 // The clamp makes Perlin's extinction only C0, so fixed Gauss-Legendre is no

@@ -23,11 +23,12 @@
 //! `mcbench reference perlin-medium --variant single-scatter`) and other settings compute theirs.
 
 use super::reference::optical_depth_with;
-use super::{clip_sphere, Field, MediumBed, LIGHT};
+use super::{clip_sphere, Field, MediumBed};
 use crate::error::ConfigError;
 use crate::lighting::PointLight;
 use crate::math::{Rgb, Vec3};
 use crate::quadrature::gauss_kronrod_multi;
+use crate::references::ReferenceSource;
 use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Reference, ReferenceKind, TestBed};
 
 /// Default image side of `eq21-medium/single-scatter` (SPEC §3.3 camera b, full resolution).
@@ -153,8 +154,8 @@ pub fn single_scatter(bed: &MediumBed, ray: &MediumRay, light: &PointLight, s: &
 
 /// The reference of a `single-scatter` bed: the stored Perlin default when it matches these
 /// settings, otherwise computed in parallel over pixels.
-pub fn reference(bed: &MediumBed) -> Result<Reference, ConfigError> {
-    if let Some(r) = load_stored(bed)? {
+pub fn reference(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Reference, ConfigError> {
+    if let Some(r) = load_stored(bed, refs)? {
         return Ok(r);
     }
     Ok(compute(bed, &Settings::of(bed.field())))
@@ -177,38 +178,21 @@ pub fn compute(bed: &MediumBed, s: &Settings) -> Reference {
     }
 }
 
-/// Where the stored Perlin reference lives.
-pub fn stored_path() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("..")
-        .join("results")
-        .join("references")
-        .join("perlin-medium_single-scatter.json")
-}
-
-/// The stored reference, when `bed` is the Perlin default it was made for (resolution, scale,
-/// albedo, light) and it was made with the current settings; `None` otherwise (then it is
-/// computed). A file that exists but cannot be read is an error naming it.
-fn load_stored(bed: &MediumBed) -> Result<Option<Reference>, ConfigError> {
-    let default = bed.field() == Field::Perlin
-        && bed.resolution() == (PERLIN_RESOLUTION, PERLIN_RESOLUTION)
-        && bed.scale() == 1.0
-        && MediumScene::albedo(bed) == Field::Perlin.albedo()
-        && bed.light() == LIGHT;
-    let path = stored_path();
-    if !default || !path.is_file() {
-        return Ok(None);
-    }
-    let bad = |why: String| ConfigError::invalid("perlin-medium/single-scatter reference", path.display(), why);
-    let text = std::fs::read_to_string(&path).map_err(|e| bad(format!("cannot read ({e})")))?;
-    let doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| bad(format!("malformed ({e})")))?;
-    let r: Reference = serde_json::from_value(doc["reference"].clone()).map_err(|e| bad(format!("malformed ({e})")))?;
+/// The stored quadrature of `bed` from `refs` when there is one made with the current settings
+/// (it saves the nested quadrature at every build); `None` otherwise (then it is computed). A
+/// stored reference of the right key but another method is ignored; a malformed one is an error.
+fn load_stored(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Option<Reference>, ConfigError> {
+    let key = bed.reference_key();
+    let Some(stored) = refs.stored(&key)? else { return Ok(None) };
+    let r = stored.reference;
     let same_method =
-        matches!(&r.kind, ReferenceKind::Exact { method, .. } if *method == Settings::of(Field::Perlin).method());
+        matches!(&r.kind, ReferenceKind::Exact { method, .. } if *method == Settings::of(bed.field()).method());
     if !same_method {
         return Ok(None);
     }
-    r.check(bed.integrals()).map_err(|e| bad(format!("malformed ({e})")))?;
+    r.check(bed.integrals()).map_err(|e| {
+        ConfigError::invalid(format!("{} reference", key.describe()), key.file_name(), format!("malformed ({e})"))
+    })?;
     Ok(Some(r))
 }
 

@@ -68,7 +68,13 @@ mod tests {
     /// r reaches 2.5 > 2/(a+1)).
     #[test]
     fn eq16_matches_measured_variance_on_the_central_ray() {
-        let bed = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 4.0)).unwrap();
+        let bed = MediumBed::new(
+            Field::Eq21,
+            "central-ray",
+            &Params::new().with("points", 4.0),
+            &crate::references::repository::Repository,
+        )
+        .unwrap();
         let grid: Vec<f64> = (0..4).map(|k| bed.medium().unwrap().ray(k).length).collect();
         let sigma = |t: f64| bed.extinction(Vec3::new(0.0, 0.0, t));
         let a = 0.7;

@@ -12,7 +12,7 @@
 use super::{MediaSmc, Sampling, PARAMS};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry, Exemption};
 use crate::testbed::Needs;
 
 /// Registry entry.
@@ -32,5 +32,20 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         rest.0.remove("step");
         let est = MediaSmc::from_params("rm_is1_cv2", Sampling::Cache, ControlVariate::Bilinear, &rest)?;
         Ok(Box::new(est.ray_marching(step)))
+    },
+    checks: Checks {
+        params: &[],
+        exempt: &[
+            Exemption {
+                testbed: "gradient-box",
+                variants: &["albedo-0"],
+                reason: "not a control here: homogeneous and non-scattering, the marched optical depth is exact",
+            },
+            Exemption {
+                testbed: "gradient-box",
+                variants: &["furnace"],
+                reason: "not a control here: in the white furnace the in-scattered radiance is c0 everywhere, so taking it at the step's end is exact",
+            },
+        ],
     },
 };

@@ -11,7 +11,12 @@ use crate::testbed::{ReferenceKind, TestBed};
 use crate::testbeds::gradient_box::GradientBox;
 
 fn bed(variant: &str, resolution: usize) -> GradientBox {
-    GradientBox::new(variant, &Params::new().with("resolution", resolution as f64)).unwrap()
+    GradientBox::new(
+        variant,
+        &Params::new().with("resolution", resolution as f64),
+        &crate::references::repository::Repository,
+    )
+    .unwrap()
 }
 
 /// `reps` independent whole-image estimates of `id` at `spp`; per pixel and channel moments.
@@ -174,7 +179,7 @@ fn unbiased_against_stored_references_and_ray_marching_flagged() {
 #[test]
 fn optically_thick_box_is_finite_and_agrees_with_its_reference() {
     use crate::stats::welch;
-    let b = GradientBox::new("thick", &Params::new()).unwrap();
+    let b = GradientBox::new("thick", &Params::new(), &crate::references::repository::Repository).unwrap();
     let r = b.reference();
     let ReferenceKind::Stored { samples, .. } = r.kind else { panic!("stored") };
     for id in ["is0_cv0", "is1_cv2"] {

@@ -21,7 +21,7 @@ use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::{Rgb, Vec3};
 use crate::params::Params;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::mixture::dms_counts;
 use crate::task::{HemisphereProbe, Task};
@@ -37,6 +37,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["brdf", "rect_light", "cone", "mixture"],
     summary: "PMC for hemispheric integrals: BRDF + per-light + cone mixture adapted per population (Eq. 7-9)",
     build: |p| Ok(Box::new(PmcHi::from_params("pmc_hi", p, 1)?)),
+    checks: Checks::DEFAULT,
 };
 
 /// Registry entry of `pmc_hi_feedback`.
@@ -49,6 +50,7 @@ pub static FEEDBACK: EstimatorEntry = EstimatorEntry {
     samplers: &["brdf", "rect_light", "cone", "mixture"],
     summary: "PMC-HI whose weights start from the previous image-plane pass (paper 003 §6.1)",
     build: |p| Ok(Box::new(PmcHi::from_params("pmc_hi_feedback", p, 2)?)),
+    checks: Checks::DEFAULT,
 };
 
 /// The configured estimator.

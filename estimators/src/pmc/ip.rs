@@ -37,7 +37,7 @@ use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::params::Params;
 use crate::perception::{luminance, tvi};
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::mixture::dms_allocate;
 use crate::stats::Moments;
@@ -55,6 +55,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "PMC image-plane sampler: per-pixel mixture, alpha ∝ eps + sigma^2/tvi(L), DMS allocation (§4)",
     build: |p| Ok(Box::new(PmcIp::from_params(p)?)),
+    checks: Checks::DEFAULT,
 };
 
 /// The configured sampler.

@@ -9,7 +9,7 @@
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::task::{HemisphereProbe, Task};
 use crate::testbed::Needs;
@@ -37,6 +37,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             (crate::single_scatter::mis::PARAMS, |p| Ok(Box::new(crate::single_scatter::mis::MisScatter::from_params(p)?))),
         )
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

@@ -51,7 +51,12 @@ fn min_holm_p(bed: &dyn TestBed, est: &dyn Estimator, name: &str, spp: u64) -> f
 }
 
 fn bed(variant: &str) -> Box<dyn TestBed> {
-    (registry::testbed("checker-direct").unwrap().build)(variant, &Params::new().with("resolution", 5.0)).unwrap()
+    (registry::testbed("checker-direct").unwrap().build)(
+        variant,
+        &Params::new().with("resolution", 5.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap()
 }
 
 fn check(id: &str, params: Params, spp: u64) -> (f64, f64) {

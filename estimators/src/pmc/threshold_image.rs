@@ -11,7 +11,7 @@ use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::perception::luminance;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::stats::Moments;
 use crate::task::{ImageProbe, Task};
@@ -33,6 +33,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let threshold = p.f64_in("threshold", 0.1, 0.0, 1e6)?;
         Ok(Box::new(ThresholdImage { initial, threshold }))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

@@ -6,7 +6,7 @@
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::task::Task;
 use crate::testbed::Needs;
@@ -25,6 +25,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         p.reject_unknown("uniform_image", &[])?;
         Ok(Box::new(UniformImage))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

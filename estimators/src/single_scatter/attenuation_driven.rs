@@ -12,7 +12,7 @@ use super::{residual_params, run, supports_single_scatter, ShadowRays};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::task::Task;
 use crate::testbed::{Needs, TestBed};
@@ -28,6 +28,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "point-light single scattering at the primary ray's residual-ratio-tracking interaction points (density sigma_samp), a shadow ray from each",
     build: |p| Ok(Box::new(AttenuationDriven { cfg: residual_params(p, "attenuation_driven", &[])? })),
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

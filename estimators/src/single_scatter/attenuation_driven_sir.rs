@@ -12,7 +12,7 @@ use super::{residual_params, run, supports_single_scatter, ShadowRays};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::mixture::pick;
 use crate::task::Task;
@@ -33,6 +33,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let cfg = residual_params(p, "attenuation_driven_sir", &["shadow_rays"])?;
         Ok(Box::new(AttenuationDrivenSir { cfg, shadow_rays: p.count("shadow_rays", 1, 1000)? }))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

@@ -13,7 +13,7 @@ use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::params::Params;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::Task;
@@ -34,6 +34,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let cfg = residual_params(p, "scattering_driven", &["points", "scatter_floor"])?;
         Ok(Box::new(ScatteringDriven { cfg, points: p.count("points", 1, 1000)?, floor: scatter_floor(p, "scattering_driven")? }))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The `scatter_floor` parameter (> 0).

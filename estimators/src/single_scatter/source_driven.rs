@@ -9,7 +9,7 @@ use super::{residual_params, run, supports_single_scatter, Geometry};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::equiangular::Equiangular;
 use crate::task::Task;
@@ -30,6 +30,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let cfg = residual_params(p, "source_driven", &["points"])?;
         Ok(Box::new(SourceDriven { cfg, points: p.count("points", 1, 1000)? }))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

@@ -27,7 +27,7 @@ fn build(id: &str, p: Params) -> Box<dyn Estimator> {
 }
 
 fn bed(params: Params) -> MediumBed {
-    MediumBed::new(Field::Eq21, "single-scatter", &params).unwrap()
+    MediumBed::new(Field::Eq21, "single-scatter", &params, &crate::references::repository::Repository).unwrap()
 }
 
 /// Per-pixel moments of `reps` estimates of `spp` primary rays each (pixels `pixels`).
@@ -88,7 +88,9 @@ fn unbiased_ids_pass_and_ray_marching_is_flagged() {
 /// fetch budgets make the ray count a stopping time; these budgets do not).
 #[test]
 fn unbiased_ids_pass_on_the_perlin_medium() {
-    let bed = MediumBed::new(Field::Perlin, "single-scatter", &Params::new()).unwrap();
+    let bed =
+        MediumBed::new(Field::Perlin, "single-scatter", &Params::new(), &crate::references::repository::Repository)
+            .unwrap();
     let pixels: Vec<usize> = (0..16).filter(|i| ![0, 3, 12, 15].contains(i)).collect();
     for (k, id) in IDS.iter().enumerate().skip(1) {
         let m = moments(&bed, build(id, Params::new()).as_ref(), &pixels, 300, 4, 500 + 50 * k as u64);
@@ -143,13 +145,20 @@ fn bad_input_is_refused_naming_the_field() {
         Field::Eq21,
         "single-scatter",
         &Params::new().with("resolution", 4.0).with("light_x", -2.5).with("light_z", 12.5),
+        &crate::references::repository::Repository,
     )
     .err()
     .map(|e| e.to_string())
     .unwrap_or_default();
     assert!(err.contains("eq21-medium.light_x"), "{err}");
-    let err =
-        MediumBed::new(Field::Eq21, "transmittance", &Params::new().with("light_x", 1.0)).err().map(|e| e.to_string());
+    let err = MediumBed::new(
+        Field::Eq21,
+        "transmittance",
+        &Params::new().with("light_x", 1.0),
+        &crate::references::repository::Repository,
+    )
+    .err()
+    .map(|e| e.to_string());
     assert!(err.unwrap_or_default().contains("eq21-medium.light_x"));
     for (id, p, field) in [
         ("mis", Params::new().with("scatter_floor", 0.0), "mis.scatter_floor"),
@@ -175,10 +184,19 @@ fn bad_input_is_refused_naming_the_field() {
 #[test]
 fn supports_accepts_the_single_scatter_ids_only() {
     let single = bed(Params::new().with("resolution", 2.0));
-    let transmittance = MediumBed::new(Field::Eq21, "transmittance", &Params::new().with("resolution", 2.0)).unwrap();
-    let checker =
-        (registry::testbed("checker-direct").unwrap().build)("default", &Params::new().with("resolution", 2.0))
-            .unwrap();
+    let transmittance = MediumBed::new(
+        Field::Eq21,
+        "transmittance",
+        &Params::new().with("resolution", 2.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
+    let checker = (registry::testbed("checker-direct").unwrap().build)(
+        "default",
+        &Params::new().with("resolution", 2.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
     for entry in ESTIMATORS {
         let Ok(est) = (entry.build)(&Params::new()) else { continue };
         let runs = entry.skip_reason(single.provides()).is_none() && est.supports(&single).is_ok();

@@ -117,7 +117,13 @@ mod tests {
     #[test]
     fn continuous_transmittance_is_unbiased_between_interactions() {
         let points = [2.3, 7.7, 12.1, 19.9];
-        let bed = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 10.0)).unwrap();
+        let bed = MediumBed::new(
+            Field::Eq21,
+            "central-ray",
+            &Params::new().with("points", 10.0),
+            &crate::references::repository::Repository,
+        )
+        .unwrap();
         let z = crate::math::Vec3::Z;
         let exact: Vec<f64> = points
             .iter()

@@ -4,7 +4,7 @@
 //! the Rao-Blackwellised `mean(p~_c / q)`. Both unbiased (the resampled set is properly weighted).
 
 use crate::estimator::Bias;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
 /// Registry entry.
@@ -18,4 +18,5 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     summary:
         "SIR: M environment-map candidates (`candidates`, default 128), N = budget resampled by BRDF cos, every frame",
     build: |p| Ok(Box::new(super::SmcEstimator(super::config(p, "bidirectional_is", &[], 128, None)?))),
+    checks: Checks::DEFAULT,
 };

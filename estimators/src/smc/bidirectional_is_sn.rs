@@ -8,7 +8,7 @@ use super::resampling::{normalise_log_weights, resample, Scheme};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry, Exemption};
 use crate::rng::StreamRng;
 use crate::task::Task;
 use crate::testbed::{EnvQuantity, Needs};
@@ -23,6 +23,16 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "biased control: independent L_ns times the self-normalised SIR mean of V at tiny M (default 4)",
     build: |p| Ok(Box::new(BidirectionalSn(super::config(p, "bidirectional_is_sn", &[], 4, None)?))),
+    // Two candidates: the self-normalisation bias shrinks like 1/M, so more would hide it.
+    checks: Checks {
+        params: &[("candidates", 2.0)],
+        exempt: &[Exemption {
+            testbed: "envmap-sequence",
+            variants: &["*-lns"],
+            reason:
+                "not a control here: its L_ns estimate is the unnormalised (unbiased) one; only L_r is self-normalised",
+        }],
+    },
 };
 
 /// The control.

@@ -7,7 +7,7 @@
 
 use super::engine::Transition;
 use crate::estimator::Bias;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
 /// Registry entry.
@@ -23,4 +23,5 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let moves = p.count("moves", 5, 10_000)?;
         Ok(Box::new(super::SmcEstimator(super::config(p, "smc", &["moves"], 128, Some(Transition::Single { moves }))?)))
     },
+    checks: Checks::DEFAULT,
 };

@@ -7,7 +7,7 @@
 
 use super::engine::Transition;
 use crate::estimator::Bias;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
 /// Registry entry.
@@ -30,4 +30,5 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             Some(Transition::Adaptive { cess, max }),
         )?)))
     },
+    checks: Checks::DEFAULT,
 };

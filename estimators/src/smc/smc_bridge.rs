@@ -5,7 +5,7 @@
 
 use super::engine::Transition;
 use crate::estimator::Bias;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
 /// Registry entry.
@@ -27,4 +27,5 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             Some(Transition::Bridged { bridges, path: false }),
         )?)))
     },
+    checks: Checks::DEFAULT,
 };

@@ -6,7 +6,7 @@
 
 use super::engine::Transition;
 use crate::estimator::Bias;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
 /// Registry entry.
@@ -22,4 +22,5 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let bridges = p.count("bridges", 5, 10_000)?;
         Ok(Box::new(super::SmcEstimator(super::config(p, "smc_path", &["bridges"], 128, Some(Transition::Bridged { bridges, path: true }))?)))
     },
+    checks: Checks::DEFAULT,
 };

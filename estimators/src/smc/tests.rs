@@ -20,7 +20,8 @@ fn bed(variant: &str) -> Box<dyn TestBed> {
         .with("env_width", 64.0)
         .with("env_height", 32.0)
         .with("sun", 200.0);
-    (registry::testbed("envmap-sequence").unwrap().build)(variant, &p).unwrap()
+    (registry::testbed("envmap-sequence").unwrap().build)(variant, &p, &crate::references::repository::Repository)
+        .unwrap()
 }
 
 /// Smallest Holm-adjusted p-value of an estimator's per-integral t-tests over `reps` runs.
@@ -178,7 +179,12 @@ fn stable_under_a_1e6_sun_and_30_degree_rotations() {
         .with("env_height", 64.0)
         .with("sun", 1e5)
         .with("rotation", 30.0);
-    let b = (registry::testbed("envmap-sequence").unwrap().build)("specular", &p).unwrap();
+    let b = (registry::testbed("envmap-sequence").unwrap().build)(
+        "specular",
+        &p,
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
     for id in ["bidirectional_is", "smc", "smc_bridge", "smc_path", "smc_adaptive"] {
         let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
         for rep in 0..20 {
@@ -187,7 +193,9 @@ fn stable_under_a_1e6_sun_and_30_degree_rotations() {
             assert!(v.iter().all(|x| x.is_finite() && x.0.iter().all(|c| *c >= 0.0)), "{id}: {v:?}");
         }
     }
-    let mixed = (registry::testbed("envmap-sequence").unwrap().build)("mixed", &p).unwrap();
+    let mixed =
+        (registry::testbed("envmap-sequence").unwrap().build)("mixed", &p, &crate::references::repository::Repository)
+            .unwrap();
     for (id, params) in [("bidirectional_is", Params::new()), ("smc", Params::new().with("moves", 2.0))] {
         let p = holm_p(mixed.as_ref(), id, params.with("candidates", 16.0), 4, 1500);
         eprintln!("stability (sun 1e5, 30 degrees a frame) {id}: Holm p = {p:e}");

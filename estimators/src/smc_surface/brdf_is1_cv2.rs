@@ -6,7 +6,7 @@
 use super::{Sampling, SmcSurface};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
 /// Registry entry.
@@ -19,4 +19,5 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["brdf"],
     summary: "variance tracker choosing BRDF importance sampling or is1_cv2 per sample",
     build: |p| SmcSurface::build("brdf_is1_cv2", Sampling::BrdfTracked, ControlVariate::Bilinear, p),
+    checks: Checks::DEFAULT,
 };

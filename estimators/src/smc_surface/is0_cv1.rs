@@ -5,7 +5,7 @@ use super::{Sampling, SmcSurface};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
 use crate::media_smc::{MediaSmc, Sampling as MediaSampling};
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
 /// Registry entry.
@@ -24,4 +24,5 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             p,
         )
     },
+    checks: Checks::DEFAULT,
 };

@@ -18,9 +18,11 @@
 use super::canonical_profiles::Profile;
 use crate::error::ConfigError;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::registry::TestBedEntry;
+use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
+use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, ReferenceKind, TestBed};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// The target transmittances of the variants.
 pub const TARGETS: [f64; 5] = [0.01, 0.1, 0.5, 0.9, 0.99];
@@ -40,15 +42,71 @@ macro_rules! grid {
 /// Every variant: profile x target transmittance.
 pub const VARIANTS: &[&str] = grid!("constant", "cosine", "gaussian", "hole", "linear-up", "linear-down", "step");
 
+/// The canonical part of the `unbiasedness` experiment: 4 samples per estimate, 16384 repetitions
+/// (quick) or 65536 (full).
+const CANONICAL_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (16_384, 65_536) };
+
+/// The checks' cases: the SPEC §10 extremes (optical depth 1e4 and 0, albedo 0 and 1), a small
+/// check, and every variant in the `unbiasedness` experiment.
+macro_rules! cases {
+    ($($p:literal),*) => {
+        &[
+            BedCase { variant: "constant-T0.5", params: &[("tau", 1e4)], role: CaseRole::Stability },
+            BedCase { variant: "constant-T0.5", params: &[("tau", 0.0)], role: CaseRole::Stability },
+            BedCase { variant: "hole-T0.1", params: &[("albedo", 0.0)], role: CaseRole::Stability },
+            BedCase { variant: "hole-T0.1", params: &[("albedo", 1.0)], role: CaseRole::Stability },
+            BedCase { variant: "hole-T0.1", params: &[("points", 2.0)], role: CaseRole::Check },
+            $(
+                BedCase { variant: concat!($p, "-T0.01"), params: &[], role: CANONICAL_PART },
+                BedCase { variant: concat!($p, "-T0.1"), params: &[], role: CANONICAL_PART },
+                BedCase { variant: concat!($p, "-T0.5"), params: &[], role: CANONICAL_PART },
+                BedCase { variant: concat!($p, "-T0.9"), params: &[], role: CANONICAL_PART },
+                BedCase { variant: concat!($p, "-T0.99"), params: &[], role: CANONICAL_PART },
+            )*
+        ]
+    };
+}
+
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "canonical-1d",
     variants: VARIANTS,
     provides: Needs::MEDIUM,
     summary: "T of [0, 1] through 7 analytic extinction profiles x 5 target T, closed-form references (issue 12)",
-    build: |variant, params| Ok(Box::new(Canonical1d::new(variant, params)?)),
+    build: |variant, params, _| Ok(Box::new(Canonical1d::new(variant, params)?)),
     compute_reference: None,
+    params: ParamSpec::of::<Canonical1dParams>(),
+    cases: cases!("constant", "cosine", "gaussian", "hole", "linear-up", "linear-down", "step"),
 };
+
+/// Parameters of `canonical-1d`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct Canonical1dParams {
+    /// Ray lengths evaluated: `T(k / points)` for `k = 1..=points` (1 to 10000).
+    pub points: usize,
+    /// Single-scattering albedo (0 to 1; what the particle models' weights see).
+    pub albedo: f64,
+    /// Optical depth of the whole ray (0 to 1e6; unset: `-ln` of the variant's target T).
+    pub tau: Option<f64>,
+}
+
+impl Default for Canonical1dParams {
+    fn default() -> Self {
+        Canonical1dParams { points: 1, albedo: 0.7, tau: None }
+    }
+}
+
+impl ParamSet for Canonical1dParams {
+    fn validate(&self) -> Result<(), ConfigError> {
+        check_count("points", self.points, 10_000)?;
+        check_range("albedo", self.albedo, 0.0, 1.0)?;
+        if let Some(t) = self.tau {
+            check_range("tau", t, 0.0, 1e6)?;
+        }
+        Ok(())
+    }
+}
 
 /// Relative error bound of the closed-form references (f64 evaluation of `exp(-tau F(s))`;
 /// the closed forms agree with quadrature to 1e-13, see the profiles' tests).
@@ -80,13 +138,11 @@ pub struct Canonical1d {
 impl Canonical1d {
     /// Builds a variant (validates the parameters; the reference is the closed form).
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown("canonical-1d", &["points", "albedo", "tau"])?;
+        let p = parse::<Canonical1dParams>("canonical-1d", params)?;
         let (profile, target) = parse_variant(variant).ok_or_else(|| {
             ConfigError::unknown("variant", &format!("canonical-1d/{variant}"), VARIANTS.iter().copied())
         })?;
-        let points = params.count("points", 1, 10_000)?;
-        let albedo = params.f64_in("albedo", 0.7, 0.0, 1.0)?;
-        let tau = params.f64_in("tau", -target.ln(), 0.0, 1e6)?;
+        let (points, albedo, tau) = (p.points, p.albedo, p.tau.unwrap_or(-target.ln()));
         let rays: Vec<MediumRay> = (1..=points)
             .map(|k| MediumRay {
                 origin: Vec3::default(),

@@ -24,9 +24,11 @@ use crate::brdf::Phong;
 use crate::error::ConfigError;
 use crate::lighting::RectLight;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::registry::TestBedEntry;
+use crate::params::{check_count, parse, ParamSet, ParamSpec, Params};
+use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::testbed::{HemisphereScene, Needs, Reference, ShadingPoint, TestBed};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
@@ -35,9 +37,36 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     provides: Needs::SURFACE.and(Needs::AREA_LIGHTS),
     summary:
         "checkerboard of diffuse/glossy squares under two area lights, direct lighting (paper 003 Fig. 6, Table 2)",
-    build: |variant, params| Ok(Box::new(CheckerDirect::new(variant, params)?)),
+    build: |variant, params, _| Ok(Box::new(CheckerDirect::new(variant, params)?)),
     compute_reference: None,
+    params: ParamSpec::of::<CheckerDirectParams>(),
+    cases: &[
+        BedCase { variant: "occluded", params: &[("resolution", 2.0)], role: CaseRole::Stability },
+        BedCase { variant: "default", params: &[("resolution", 2.0)], role: CaseRole::Check },
+        BedCase { variant: "default", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
+        BedCase { variant: "occluded", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
+    ],
 };
+
+/// Parameters of `checker-direct`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct CheckerDirectParams {
+    /// Side of the square image in pixels (1 to 512).
+    pub resolution: usize,
+}
+
+impl Default for CheckerDirectParams {
+    fn default() -> Self {
+        CheckerDirectParams { resolution: 48 }
+    }
+}
+
+impl ParamSet for CheckerDirectParams {
+    fn validate(&self) -> Result<(), ConfigError> {
+        check_count("resolution", self.resolution, 512).map(|_| ())
+    }
+}
 
 /// The axis-aligned opaque square of the `occluded` variant: `[x0, x1] x [y0, y1]` at height `z`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -151,8 +180,7 @@ pub struct CheckerDirect {
 impl CheckerDirect {
     /// Builds a variant; parameter `resolution` (default 48) sets the square image size.
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown("checker-direct", &["resolution"])?;
-        let size = params.count("resolution", 48, 512)?;
+        let size = parse::<CheckerDirectParams>("checker-direct", params)?.resolution;
         let geometry = CheckerGeometry::new(variant)?;
         let mut points = Vec::with_capacity(size * size);
         for py in 0..size {

@@ -15,19 +15,24 @@
 //!
 //! Reference: stored long-run values with standard errors (no closed form: the footprint
 //! integral of a glossy checkerboard under area lights), made by `mcbench reference
-//! checker-image --variant V` ([`super::checker_image_reference`]) and read from
-//! `results/references/checker-image_V.json` with the resolution it was made for.
+//! checker-image --variant V` ([`super::checker_image_reference`]) and looked up by variant and
+//! resolution in the reference source the caller gives.
 
 use super::checker::{CheckerGeometry, ENTRY as DIRECT};
 use crate::error::ConfigError;
 use crate::lighting::{light_selection, mis_round, MisStrategy};
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::registry::TestBedEntry;
+use crate::params::{check_count, parse, ParamSet, ParamSpec, Params};
+use crate::references::{ReferenceKey, ReferenceSource};
+use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::rng::StreamRng;
 use crate::testbed::{ImagePlaneScene, Needs, Reference, ShadingPoint, TestBed};
-use serde::Deserialize;
-use std::path::PathBuf;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// The image part of the `unbiasedness` experiment: PMC-IP's 2 + 4 + 4 schedule (10 samples per
+/// pixel), 32 repetitions (quick) or 256 (full).
+const IMAGE_PART: CaseRole = CaseRole::Unbiasedness { samples: 10, reps: (32, 256) };
 
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
@@ -35,12 +40,38 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     variants: &["default", "occluded"],
     provides: Needs::IMAGE_PLANE,
     summary: "checker scene, pixel-footprint integrals; a pixel sample = jittered position + MIS with 8 light samples (paper 003 Table 1)",
-    build: |variant, params| Ok(Box::new(CheckerImage::new(variant, params)?)),
+    build: |variant, params, refs| Ok(Box::new(CheckerImage::new(variant, params, refs)?)),
     compute_reference: Some(super::checker_image_reference::compute_reference),
+    params: ParamSpec::of::<CheckerImageParams>(),
+    cases: &[
+        BedCase { variant: "default", params: &[], role: CaseRole::Check },
+        BedCase { variant: "default", params: &[], role: IMAGE_PART },
+        BedCase { variant: "occluded", params: &[], role: IMAGE_PART },
+    ],
 };
 
-/// Parameters the test bed accepts.
-pub const PARAMS: &[&str] = &["resolution", "light_samples"];
+/// Parameters of `checker-image`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct CheckerImageParams {
+    /// Side of the square image in pixels (1 to 512; the stored references are 48).
+    pub resolution: usize,
+    /// MIS light samples of one pixel sample (1 to 1024; paper 003's Buddha: 8).
+    pub light_samples: usize,
+}
+
+impl Default for CheckerImageParams {
+    fn default() -> Self {
+        CheckerImageParams { resolution: 48, light_samples: 8 }
+    }
+}
+
+impl ParamSet for CheckerImageParams {
+    fn validate(&self) -> Result<(), ConfigError> {
+        check_count("resolution", self.resolution, 512)?;
+        check_count("light_samples", self.light_samples, 1024).map(|_| ())
+    }
+}
 
 /// The `checker-image` scene.
 pub struct CheckerImage {
@@ -52,36 +83,25 @@ pub struct CheckerImage {
     reference: Reference,
 }
 
-/// A stored reference file (written by the CLI's `reference` command).
-#[derive(Deserialize)]
-struct StoredFile {
-    resolution: (usize, usize),
-    reference: Reference,
-}
-
-/// Where the stored reference of a variant lives.
-pub fn stored_path(variant: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../results/references")
-        .join(format!("checker-image_{variant}.json"))
-}
-
 impl CheckerImage {
-    /// Builds a variant with its stored reference. Parameters: `resolution` (square image side,
-    /// default 48; the stored reference loads only at the resolution it was made for) and
-    /// `light_samples` (MIS light samples per pixel sample, default 8; the reference does not
-    /// depend on it).
-    pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+    /// Builds a variant with the stored reference `refs` holds for its
+    /// [`CheckerImage::reference_key`] (variant and resolution; the light samples of one pixel
+    /// sample change its variance, not its expectation).
+    pub fn new(variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let bed = Self::without_reference(variant, params)?;
-        let reference = bed.load_stored()?;
+        let reference = crate::references::load(refs, &bed.reference_key(), bed.size * bed.size)?;
         Ok(CheckerImage { reference, ..bed })
+    }
+
+    /// What the stored reference is looked up by: variant and resolution.
+    pub fn reference_key(&self) -> ReferenceKey {
+        ReferenceKey::new(ENTRY.id, &self.variant, &[("resolution", self.size.into())], self.size == 48)
     }
 
     /// The scene with an empty reference (the reference computation and the tests sample it).
     pub fn without_reference(variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown("checker-image", PARAMS)?;
-        let size = params.count("resolution", 48, 512)?;
-        let light_samples = params.count("light_samples", 8, 1024)?;
+        let p = parse::<CheckerImageParams>("checker-image", params)?;
+        let (size, light_samples) = (p.resolution, p.light_samples);
         let geometry = CheckerGeometry::new(variant).map_err(|_| {
             ConfigError::unknown("variant", &format!("{}/{variant}", ENTRY.id), DIRECT.variants.iter().copied())
         })?;
@@ -94,28 +114,6 @@ impl CheckerImage {
             select,
             reference: Reference::empty(),
         })
-    }
-
-    fn load_stored(&self) -> Result<Reference, ConfigError> {
-        let path = stored_path(&self.variant);
-        let hint = format!("run `mcbench reference checker-image --variant {}`", self.variant);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            ConfigError::invalid("reference", path.display(), format!("no stored reference ({e}); {hint}"))
-        })?;
-        let file: StoredFile = serde_json::from_str(&text)
-            .map_err(|e| ConfigError::invalid("reference", path.display(), format!("malformed ({e}); {hint}")))?;
-        let n = self.size * self.size;
-        if file.resolution != (self.size, self.size)
-            || file.reference.value.len() != n
-            || file.reference.std_err.len() != n
-        {
-            let msg = format!("the stored reference is for {:?} pixels; use that resolution", file.resolution);
-            return Err(ConfigError::invalid("resolution", self.size, msg));
-        }
-        file.reference
-            .check(n)
-            .map_err(|e| ConfigError::invalid("reference", path.display(), format!("malformed ({e}); {hint}")))?;
-        Ok(file.reference)
     }
 
     /// The scene geometry (shared with `checker-direct`).
@@ -131,6 +129,9 @@ impl CheckerImage {
 }
 
 impl TestBed for CheckerImage {
+    fn reference_key(&self) -> Option<ReferenceKey> {
+        Some(CheckerImage::reference_key(self))
+    }
     fn id(&self) -> &'static str {
         ENTRY.id
     }
@@ -229,7 +230,14 @@ mod tests {
         assert!(e.err().unwrap().to_string().contains("checker-image/nope"));
         // No reference is stored at resolution 7 (the error names the resolution, or the missing
         // file when no reference is stored at all).
-        let e = CheckerImage::new("default", &Params::new().with("resolution", 7.0)).err().unwrap().to_string();
+        let e = CheckerImage::new(
+            "default",
+            &Params::new().with("resolution", 7.0),
+            &crate::references::repository::Repository,
+        )
+        .err()
+        .unwrap()
+        .to_string();
         assert!(e.contains("resolution") || e.contains("checker-image_default.json"), "{e}");
     }
 }

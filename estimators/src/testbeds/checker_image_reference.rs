@@ -7,6 +7,7 @@ use super::checker_image::CheckerImage;
 use crate::error::ConfigError;
 use crate::math::Rgb;
 use crate::params::Params;
+use crate::references::{ReferenceKey, StoredReference};
 use crate::rng::StreamKey;
 use crate::stats::Moments;
 use crate::testbed::{ImagePlaneScene, Reference, ReferenceKind, TestBed};
@@ -20,20 +21,19 @@ pub const SEED: u64 = 1;
 /// the standard error of one 32-spp estimate, the largest budget `pmc-ip` runs.
 pub const DEFAULT_SAMPLES: u64 = 1 << 16;
 
-/// Computes the reference of `variant` (`params`: the test bed's plus `samples`, pixel samples
-/// per pixel) on `threads` threads; the result does not depend on the thread count.
+/// Computes the reference of `variant` with the test bed's `params` and `samples` pixel samples per
+/// pixel (default [`DEFAULT_SAMPLES`]) on `threads` threads; the result does not depend on the
+/// thread count.
 pub fn compute_reference(
     variant: &str,
     params: &Params,
+    samples: Option<u64>,
     threads: usize,
-) -> Result<(Reference, (usize, usize)), ConfigError> {
-    let mut bed_params = params.clone();
-    let samples = match bed_params.0.remove("samples") {
-        Some(_) => params.count("samples", 0, 1 << 40)? as u64,
-        None => DEFAULT_SAMPLES,
-    };
+) -> Result<(ReferenceKey, StoredReference), ConfigError> {
+    let samples = samples.unwrap_or(DEFAULT_SAMPLES);
     let per_batch = samples.div_ceil(BATCHES).max(1);
-    let bed = CheckerImage::without_reference(variant, &bed_params)?;
+    let bed = CheckerImage::without_reference(variant, params)?;
+    let key = bed.reference_key();
     let n = bed.integrals();
     let label = format!("checker-image/{variant}/reference");
     let pixel = |i: usize| {
@@ -66,13 +66,24 @@ pub fn compute_reference(
     }
     let (w, h) = bed.resolution();
     let command = format!(
-        "mcbench reference checker-image --variant {variant} --samples {} (resolution {w}, seed {SEED}, {BATCHES} batches of {per_batch} uniform pixel samples per pixel)",
+        "{} --samples {} (resolution {w}, seed {SEED}, {BATCHES} batches of {per_batch} uniform pixel samples per pixel)",
+        key.command(),
         per_batch * BATCHES
     );
     let reference = Reference {
-        kind: ReferenceKind::Stored { command, samples: BATCHES },
+        kind: ReferenceKind::Stored { command: command.clone(), samples: BATCHES },
         value: results.iter().map(|r| r.0).collect(),
         std_err: results.iter().map(|r| r.1).collect(),
     };
-    Ok((reference, (w, h)))
+    Ok((
+        key.clone(),
+        StoredReference {
+            testbed: key.testbed,
+            variant: key.variant,
+            params: key.params,
+            command,
+            resolution: (w, h),
+            reference,
+        },
+    ))
 }

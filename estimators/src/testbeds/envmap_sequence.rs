@@ -19,10 +19,16 @@ use crate::envmap::sky::Sky;
 use crate::envmap::{EnvFrame, EnvMap};
 use crate::error::ConfigError;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::registry::TestBedEntry;
+use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
+use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::testbed::{EnvQuantity, EnvSequenceScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
 use rayon::prelude::*;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// The environment-map part of the `unbiasedness` experiment: 4 particles per frame, 1500
+/// repetitions (quick) or 20000 (full).
+const ENVMAP_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1500, 20_000) };
 
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
@@ -33,9 +39,76 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     provides: Needs::ENV_SEQUENCE,
     summary:
         "Phong sphere under a rotating HDR sky, L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
-    build: |variant, params| Ok(Box::new(EnvmapSequence::new(variant, params)?)),
+    build: |variant, params, _| Ok(Box::new(EnvmapSequence::new(variant, params)?)),
     compute_reference: None,
+    params: ParamSpec::of::<EnvmapSequenceParams>(),
+    cases: &[
+        BedCase {
+            variant: "mixed",
+            params: &[("resolution", 2.0), ("frames", 2.0), ("sun", 1e6)],
+            role: CaseRole::Stability,
+        },
+        BedCase { variant: "mixed", params: &[("resolution", 2.0), ("frames", 2.0)], role: CaseRole::Check },
+        BedCase { variant: "specular", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "mixed", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "specular-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "mixed-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+    ],
 };
+
+/// Parameters of `envmap-sequence` (SPEC §3.7).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct EnvmapSequenceParams {
+    /// Side of the square image of the sphere in pixels (1 to 512).
+    pub resolution: usize,
+    /// Frames per pixel (1 to 1000).
+    pub frames: usize,
+    /// Rotation of the map about +z per frame, in degrees (-360 to 360).
+    pub rotation: f64,
+    /// Peak radiance of the sun lobe (0 to 1e12; the sky's dynamic range follows it).
+    pub sun: f64,
+    /// 1: the sky's intensity changes slowly over the frames (dawn to dusk); 0: constant.
+    pub dawn_dusk: f64,
+    /// Width of the lat-long map in texels (4 to 8192).
+    pub env_width: usize,
+    /// Height of the lat-long map in texels (even, 2 to 4096).
+    pub env_height: usize,
+}
+
+impl Default for EnvmapSequenceParams {
+    fn default() -> Self {
+        EnvmapSequenceParams {
+            resolution: 32,
+            frames: 10,
+            rotation: 1.5,
+            sun: 1e3,
+            dawn_dusk: 0.0,
+            env_width: 256,
+            env_height: 128,
+        }
+    }
+}
+
+impl ParamSet for EnvmapSequenceParams {
+    fn validate(&self) -> Result<(), ConfigError> {
+        check_count("resolution", self.resolution, 512)?;
+        check_count("frames", self.frames, 1000)?;
+        check_range("rotation", self.rotation, -360.0, 360.0)?;
+        check_range("sun", self.sun, 0.0, 1e12)?;
+        check_range("dawn_dusk", self.dawn_dusk, 0.0, 1.0)?;
+        check_count("env_width", self.env_width, 8192)?;
+        check_count("env_height", self.env_height, 4096)?;
+        if !self.env_height.is_multiple_of(2) || self.env_width < 4 || self.env_height < 2 {
+            return Err(ConfigError::invalid(
+                "env_height",
+                self.env_height,
+                "must be even (the horizon is a row edge) with env_width >= 4",
+            ));
+        }
+        Ok(())
+    }
+}
 
 /// Half-width of the orthographic image (inside the unit disc's inscribed square).
 const HALF_WIDTH: f64 = 0.7;
@@ -69,24 +142,9 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
 impl EnvmapSequence {
     /// Builds a variant and computes its exact reference (parallel over pixels).
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown(
-            "envmap-sequence",
-            &["resolution", "frames", "rotation", "sun", "dawn_dusk", "env_width", "env_height"],
-        )?;
-        let size = params.count("resolution", 32, 512)?;
-        let frames = params.count("frames", 10, 1000)?;
-        let rotation = params.f64_in("rotation", 1.5, -360.0, 360.0)?.to_radians();
-        let sun = params.f64_in("sun", 1e3, 0.0, 1e12)?;
-        let dawn_dusk = params.f64_in("dawn_dusk", 0.0, 0.0, 1.0)? != 0.0;
-        let ew = params.count("env_width", 256, 8192)?;
-        let eh = params.count("env_height", 128, 4096)?;
-        if eh % 2 != 0 || ew < 4 || eh < 2 {
-            return Err(ConfigError::invalid(
-                "env_height",
-                eh,
-                "must be even (the horizon is a row edge) with env_width >= 4",
-            ));
-        }
+        let p = parse::<EnvmapSequenceParams>("envmap-sequence", params)?;
+        let (size, frames, rotation, sun) = (p.resolution, p.frames, p.rotation.to_radians(), p.sun);
+        let (dawn_dusk, ew, eh) = (p.dawn_dusk != 0.0, p.env_width, p.env_height);
         let (brdf, quantity) = variant_setup(variant)?;
         let sky = Sky::default_with_sun(sun);
         let maps = if dawn_dusk {

@@ -11,9 +11,9 @@
 //! (`sigma_t = 1e4`, albedo 0.8: the optically thick stability case, SPEC §10).
 //!
 //! References of the other variants are stored long-run Monte Carlo values made by
-//! `mcbench reference gradient-box --variant V` ([`compute_reference`]) and read from
-//! `results/references/gradient-box_V.json` together with the resolution and `sigma_t` they were
-//! made for.
+//! `mcbench reference gradient-box --variant V` ([`compute_reference`]) and looked up by variant,
+//! resolution and `sigma_t` ([`GradientBox::reference_key`]) in the reference source the caller
+//! gives.
 //!
 //! The whole image is one sequence ([`TestBed::sequence_length`] = pixels): estimators that share
 //! one adaptive structure across the image (paper 000 §4.3) get every pixel's task at once.
@@ -21,12 +21,17 @@
 use crate::error::ConfigError;
 use crate::lighting::Gradient;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
+use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
 use crate::phase::Phase;
-use crate::registry::TestBedEntry;
+use crate::references::{ReferenceKey, ReferenceSource};
+use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, ReferenceKind, TestBed};
-use serde::Deserialize;
-use std::path::PathBuf;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// The gradient-box part of the `unbiasedness` experiment: 16 paths per pixel over the whole image,
+/// 256 repetitions (quick, enough for the marching control on `albedo-1`) or 1024 (full).
+const BOX_PART: CaseRole = CaseRole::Unbiasedness { samples: 16, reps: (256, 1024) };
 
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
@@ -34,12 +39,45 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     variants: &["albedo-0.8", "albedo-1", "albedo-0.5", "hg-0.1", "furnace", "albedo-0", "thick"],
     provides: Needs::MEDIUM,
     summary: "homogeneous box under a gradient sky, orthographic 16x16, stored MC reference (paper 000 §5)",
-    build: |variant, params| Ok(Box::new(GradientBox::new(variant, params)?)),
+    build: |variant, params, refs| Ok(Box::new(GradientBox::new(variant, params, refs)?)),
     compute_reference: Some(super::gradient_box_reference::compute_reference),
+    params: ParamSpec::of::<GradientBoxParams>(),
+    cases: &[
+        BedCase { variant: "furnace", params: &[("resolution", 2.0)], role: CaseRole::Stability },
+        BedCase { variant: "albedo-0", params: &[("resolution", 2.0)], role: CaseRole::Stability },
+        BedCase { variant: "thick", params: &[], role: CaseRole::Stability },
+        BedCase { variant: "furnace", params: &[("resolution", 2.0)], role: CaseRole::Check },
+        BedCase { variant: "albedo-0.8", params: &[], role: BOX_PART },
+        BedCase { variant: "albedo-1", params: &[], role: BOX_PART },
+        BedCase { variant: "albedo-0.5", params: &[], role: BOX_PART },
+        BedCase { variant: "hg-0.1", params: &[], role: BOX_PART },
+        BedCase { variant: "furnace", params: &[], role: BOX_PART },
+        BedCase { variant: "albedo-0", params: &[], role: BOX_PART },
+        BedCase { variant: "thick", params: &[], role: BOX_PART },
+    ],
 };
 
-/// The parameters the test bed accepts.
-pub const PARAMS: &[&str] = &["resolution", "sigma_t"];
+/// Parameters of `gradient-box`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct GradientBoxParams {
+    /// Side of the square image in pixels (1 to 256; unset: 16, and 4 for `thick`).
+    pub resolution: Option<usize>,
+    /// Extinction of the box (1e-6 to 1e6; unset: 2, and 1e4 for `thick`).
+    pub sigma_t: Option<f64>,
+}
+
+impl ParamSet for GradientBoxParams {
+    fn validate(&self) -> Result<(), ConfigError> {
+        if let Some(r) = self.resolution {
+            check_count("resolution", r, 256)?;
+        }
+        if let Some(s) = self.sigma_t {
+            check_range("sigma_t", s, 1e-6, 1e6)?;
+        }
+        Ok(())
+    }
+}
 
 /// What a variant fixes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,24 +122,10 @@ pub struct GradientBox {
     reference: Reference,
 }
 
-/// A stored reference file (written by the CLI's `reference` command).
-#[derive(Deserialize)]
-struct StoredFile {
-    resolution: (usize, usize),
-    reference: Reference,
-    #[serde(default)]
-    sigma_t: Option<f64>,
-}
-
-/// Where the stored reference of a variant lives.
-pub fn stored_path(variant: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../results/references").join(format!("gradient-box_{variant}.json"))
-}
-
 impl GradientBox {
-    /// Builds a variant with its reference (exact, or loaded from the stored file). Parameters:
-    /// `resolution` (image side, default 16, thick: 4) and `sigma_t` (default 2, thick: 1e4).
-    pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+    /// Builds a variant with its reference (exact, or the stored one `refs` holds for its
+    /// [`GradientBox::reference_key`]).
+    pub fn new(variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let bed = Self::without_reference(variant, params)?;
         let reference = match variant {
             "furnace" => bed.exact(bed.setup.background.c0, "white furnace: every path returns c0"),
@@ -109,19 +133,31 @@ impl GradientBox {
                 let t = (-bed.setup.sigma_t).exp();
                 bed.exact(bed.setup.background.c0 * t, "no scattering: exp(-sigma_t) L_b(+y)")
             }
-            _ => bed.load_stored()?,
+            _ => crate::references::load(refs, &bed.reference_key(), bed.size * bed.size)?,
         };
         Ok(GradientBox { reference, ..bed })
     }
 
     /// The scene with an empty reference (the reference computation runs estimators on it).
     pub fn without_reference(variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown("gradient-box", PARAMS)?;
+        let p = parse::<GradientBoxParams>("gradient-box", params)?;
         let mut setup = variant_setup(variant)?;
-        let default_size = if variant == "thick" { 4 } else { 16 };
-        let size = params.count("resolution", default_size, 256)?;
-        setup.sigma_t = params.f64_in("sigma_t", setup.sigma_t, 1e-6, 1e6)?;
+        let size = p.resolution.unwrap_or(if variant == "thick" { 4 } else { 16 });
+        setup.sigma_t = p.sigma_t.unwrap_or(setup.sigma_t);
         Ok(GradientBox { variant: variant.to_string(), size, setup, reference: Reference::empty() })
+    }
+
+    /// What the stored reference of this scene is looked up by: variant, resolution and `sigma_t`.
+    pub fn reference_key(&self) -> ReferenceKey {
+        let default_size = if self.variant == "thick" { 4 } else { 16 };
+        let default = variant_setup(&self.variant).map(|s| s.sigma_t == self.setup.sigma_t).unwrap_or(false)
+            && self.size == default_size;
+        ReferenceKey::new(
+            ENTRY.id,
+            &self.variant,
+            &[("resolution", self.size.into()), ("sigma_t", self.setup.sigma_t.into())],
+            default,
+        )
     }
 
     /// The variant's setup.
@@ -139,30 +175,6 @@ impl GradientBox {
             value: vec![v; n],
             std_err: vec![Rgb::ZERO; n],
         }
-    }
-
-    fn load_stored(&self) -> Result<Reference, ConfigError> {
-        let path = stored_path(&self.variant);
-        let hint = format!("run `mcbench reference gradient-box --variant {}`", self.variant);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            ConfigError::invalid("reference", path.display(), format!("no stored reference ({e}); {hint}"))
-        })?;
-        let file: StoredFile = serde_json::from_str(&text)
-            .map_err(|e| ConfigError::invalid("reference", path.display(), format!("malformed ({e}); {hint}")))?;
-        let default_sigma = variant_setup(&self.variant)?.sigma_t;
-        let sigma_ok = file.sigma_t.unwrap_or(default_sigma) == self.setup.sigma_t;
-        if file.resolution != (self.size, self.size) || !sigma_ok || file.reference.value.len() != self.size * self.size
-        {
-            let msg = format!(
-                "stored for {:?} pixels and sigma_t {:?}; {hint} with matching parameters",
-                file.resolution, file.sigma_t
-            );
-            return Err(ConfigError::invalid("reference", path.display(), msg));
-        }
-        file.reference
-            .check(self.size * self.size)
-            .map_err(|e| ConfigError::invalid("reference", path.display(), format!("malformed ({e}); {hint}")))?;
-        Ok(file.reference)
     }
 
     /// The unit direction of the camera rays.
@@ -229,6 +241,9 @@ impl MediumScene for GradientBox {
 }
 
 impl TestBed for GradientBox {
+    fn reference_key(&self) -> Option<ReferenceKey> {
+        Some(GradientBox::reference_key(self))
+    }
     fn id(&self) -> &'static str {
         ENTRY.id
     }

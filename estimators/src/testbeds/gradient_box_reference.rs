@@ -11,6 +11,7 @@ use crate::estimator::Estimator;
 use crate::math::Rgb;
 use crate::media_smc::PathTracer;
 use crate::params::Params;
+use crate::references::{ReferenceKey, StoredReference};
 use crate::rng::StreamKey;
 use crate::stats::Moments;
 use crate::task::Task;
@@ -30,20 +31,19 @@ pub fn default_samples(variant: &str) -> u64 {
     }
 }
 
-/// Computes the reference of `variant` (`params`: the test bed's plus `samples`, paths per pixel)
-/// on `threads` threads; the result does not depend on the thread count.
+/// Computes the reference of `variant` with the test bed's `params` and `samples` paths per pixel
+/// (default [`default_samples`]) on `threads` threads; the result does not depend on the thread
+/// count.
 pub fn compute_reference(
     variant: &str,
     params: &Params,
+    samples: Option<u64>,
     threads: usize,
-) -> Result<(Reference, (usize, usize)), ConfigError> {
-    let mut bed_params = params.clone();
-    let samples = match bed_params.0.remove("samples") {
-        Some(_) => params.count("samples", 0, 1 << 40)? as u64,
-        None => default_samples(variant),
-    };
+) -> Result<(ReferenceKey, StoredReference), ConfigError> {
+    let samples = samples.unwrap_or_else(|| default_samples(variant));
     let per_batch = samples.div_ceil(BATCHES).max(1);
-    let bed = GradientBox::without_reference(variant, &bed_params)?;
+    let bed = GradientBox::without_reference(variant, params)?;
+    let key = bed.reference_key();
     let n = bed.integrals();
     let label = format!("gradient-box/{variant}/reference");
     let budget = Budget::samples(per_batch).map_err(|e| ConfigError::invalid("samples", samples, e.to_string()))?;
@@ -72,13 +72,24 @@ pub fn compute_reference(
     let (w, h) = bed.resolution();
     let sigma_t = bed.setup().sigma_t;
     let command = format!(
-        "mcbench reference gradient-box --variant {variant} --samples {} (resolution {w}, sigma_t {sigma_t}, seed {SEED}, {BATCHES} batches of {per_batch} is0_cv0 paths per pixel)",
+        "{} --samples {} (resolution {w}, sigma_t {sigma_t}, seed {SEED}, {BATCHES} batches of {per_batch} is0_cv0 paths per pixel)",
+        key.command(),
         per_batch * BATCHES
     );
     let reference = Reference {
-        kind: ReferenceKind::Stored { command, samples: BATCHES },
+        kind: ReferenceKind::Stored { command: command.clone(), samples: BATCHES },
         value: results.iter().map(|r| r.0).collect(),
         std_err: results.iter().map(|r| r.1).collect(),
     };
-    Ok((reference, (w, h)))
+    Ok((
+        key.clone(),
+        StoredReference {
+            testbed: key.testbed,
+            variant: key.variant,
+            params: key.params,
+            command,
+            resolution: (w, h),
+            reference,
+        },
+    ))
 }

@@ -12,9 +12,15 @@ use crate::brdf::Phong;
 use crate::error::ConfigError;
 use crate::lighting::Gradient;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::registry::TestBedEntry;
+use crate::params::{check_count, parse, ParamSet, ParamSpec, Params};
+use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::testbed::{HemisphereScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// The surface part of the `unbiasedness` experiment: 64 samples per estimate, 512 repetitions
+/// (quick) or 8192 (full).
+pub const SURFACE_PART: CaseRole = CaseRole::Unbiasedness { samples: 64, reps: (512, 8192) };
 
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
@@ -22,9 +28,38 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     variants: &["default", "diffuse", "glossy", "stiff"],
     provides: Needs::SURFACE,
     summary: "Phong plane under a gradient sky, pinhole 32x32, exact reference (paper 001 §5)",
-    build: |variant, params| Ok(Box::new(GradientPlane::new(variant, params)?)),
+    build: |variant, params, _| Ok(Box::new(GradientPlane::new(variant, params)?)),
     compute_reference: None,
+    params: ParamSpec::of::<GradientPlaneParams>(),
+    cases: &[
+        BedCase { variant: "stiff", params: &[("resolution", 2.0)], role: CaseRole::Stability },
+        BedCase { variant: "default", params: &[("resolution", 2.0)], role: CaseRole::Check },
+        BedCase { variant: "default", params: &[("resolution", 4.0)], role: SURFACE_PART },
+        BedCase { variant: "diffuse", params: &[("resolution", 4.0)], role: SURFACE_PART },
+        BedCase { variant: "glossy", params: &[("resolution", 4.0)], role: SURFACE_PART },
+        BedCase { variant: "stiff", params: &[("resolution", 4.0)], role: SURFACE_PART },
+    ],
 };
+
+/// Parameters of `gradient-plane`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct GradientPlaneParams {
+    /// Side of the square image in pixels (1 to 512); every primary ray hits the plane.
+    pub resolution: usize,
+}
+
+impl Default for GradientPlaneParams {
+    fn default() -> Self {
+        GradientPlaneParams { resolution: 32 }
+    }
+}
+
+impl ParamSet for GradientPlaneParams {
+    fn validate(&self) -> Result<(), ConfigError> {
+        check_count("resolution", self.resolution, 512).map(|_| ())
+    }
+}
 
 /// Relative tolerance of the glossy quadrature (the test bed promises 1e-9).
 const LOBE_REL_TOL: f64 = 1e-11;
@@ -53,8 +88,7 @@ pub fn variant_brdf(variant: &str) -> Result<Phong, ConfigError> {
 impl GradientPlane {
     /// Builds a variant; parameter `resolution` (default 32) sets the square image size.
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown("gradient-plane", &["resolution"])?;
-        let size = params.count("resolution", 32, 512)?;
+        let size = parse::<GradientPlaneParams>("gradient-plane", params)?.resolution;
         let brdf = variant_brdf(variant)?;
         let background = Gradient::papers();
         let camera = Pinhole::look_at(Vec3::new(0.0, -3.0, 2.0), Vec3::default(), Vec3::Z, 40.0);

@@ -14,7 +14,7 @@ use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::EstimateMoments;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::Task;
@@ -45,6 +45,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             }),
         )
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

@@ -12,7 +12,7 @@ use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::EstimateMoments;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::Task;
@@ -38,6 +38,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         }
         Ok(Box::new(DoubleParticle { sigma_samp, control, spacing }))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

@@ -8,7 +8,7 @@ use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::EstimateMoments;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::Task;
@@ -27,6 +27,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         p.reject_unknown("ratio_tracking", &["sigma_samp", "sigma_samp_ratio"])?;
         Ok(Box::new(RatioTracking { sigma_samp: SigmaSamp::from_params(p, "ratio_tracking", SigmaSamp::Majorant)? }))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

@@ -14,7 +14,7 @@ use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::{Rgb, Vec3};
 use crate::params::Params;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::{Interp, SamplingDensity};
 use crate::task::{MediumProbe, Task};
@@ -34,6 +34,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         p.reject_unknown("residual_ratio_tracking", ResidualRatioTracking::PARAMS)?;
         Ok(Box::new(ResidualRatioTracking::from_params(p, "residual_ratio_tracking")?))
     },
+    checks: Checks::DEFAULT,
 };
 
 /// The estimator.

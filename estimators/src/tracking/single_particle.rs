@@ -12,7 +12,7 @@ use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::EstimateMoments;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::Task;
@@ -28,6 +28,7 @@ pub static TERMINATING: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "single particle model, terminating (Eq. 9, 19): refuses r > 2/(a+1) or r < 0",
     build: |p| build(p, "single_particle_terminating", true),
+    checks: Checks::DEFAULT,
 };
 
 /// `single_particle_nonterminating` registry entry.
@@ -40,6 +41,7 @@ pub static NONTERMINATING: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "single particle model, non-terminating (Eq. 12, 20), any r",
     build: |p| build(p, "single_particle_nonterminating", false),
+    checks: Checks::DEFAULT,
 };
 
 fn build(p: &crate::params::Params, id: &str, terminating: bool) -> Result<Box<dyn Estimator>, ConfigError> {

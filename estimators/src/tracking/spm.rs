@@ -13,7 +13,7 @@ use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::phase::Phase;
-use crate::registry::EstimatorEntry;
+use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::rayleigh;
 use crate::task::{MediumProbe, Task};
@@ -103,6 +103,7 @@ macro_rules! spm_entry {
                 p.reject_unknown($id, &["sigma_samp"])?;
                 Ok(Box::new(Spm { sigma_samp: sigma_samp_param(p, $id)?.unwrap_or(1.0), mode: $mode }))
             },
+            checks: Checks::DEFAULT,
         };
     };
 }

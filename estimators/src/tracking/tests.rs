@@ -41,8 +41,20 @@ fn holm_p(bed: &MediumBed, est: &dyn Estimator, reps: usize, spp: u64, seed: u64
 /// coarse ray-marching control is flagged.
 #[test]
 fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
-    let eq21 = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 8.0)).unwrap();
-    let perlin = MediumBed::new(Field::Perlin, "central-ray", &Params::new().with("points", 4.0)).unwrap();
+    let eq21 = MediumBed::new(
+        Field::Eq21,
+        "central-ray",
+        &Params::new().with("points", 8.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
+    let perlin = MediumBed::new(
+        Field::Perlin,
+        "central-ray",
+        &Params::new().with("points", 4.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
     let s = |v: f64| Params::new().with("sigma_samp", v);
     let cases: Vec<(&MediumBed, &str, Params)> = vec![
         (&eq21, "delta_tracking", Params::new()),
@@ -74,7 +86,13 @@ fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
 /// run, naming the field; at run time an out-of-range r is refused, never silently used.
 #[test]
 fn invalid_terminating_configurations_are_refused() {
-    let bed = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 4.0)).unwrap();
+    let bed = MediumBed::new(
+        Field::Eq21,
+        "central-ray",
+        &Params::new().with("points", 4.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
     let err = build("single_particle_terminating", Params::new().with("sigma_samp", 0.4))
         .validate(&bed)
         .unwrap_err()
@@ -140,21 +158,38 @@ fn particle_models_agree_with_delta_tracking() {
 /// with non-terminating weights: finite results (or a refusal), and no endless loop.
 #[test]
 fn stability_cases_are_finite() {
-    let short = MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 200.0)).unwrap();
+    let short = MediumBed::new(
+        Field::Eq21,
+        "central-ray",
+        &Params::new().with("points", 200.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
     for sigma in [1e-6, 1e6] {
         let est = build("double_particle", Params::new().with("sigma_samp", sigma));
         let task = Task::new(&short, 0, Budget::samples(4).unwrap());
         assert!(est.estimate(&task, &mut stream(1, "stab")).unwrap().is_finite());
     }
-    let thick =
-        MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 2.0).with("scale", 1500.0)).unwrap();
+    let thick = MediumBed::new(
+        Field::Eq21,
+        "central-ray",
+        &Params::new().with("points", 2.0).with("scale", 1500.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
     assert!(thick.reference().value[1][0] == 0.0 || thick.reference().value[1][0] < 1e-300);
     for id in ["ratio_tracking", "delta_tracking", "residual_ratio_tracking", "ray_marching"] {
         let task = Task::new(&thick, 1, Budget::samples(2).unwrap());
         assert!(build(id, Params::new()).estimate(&task, &mut stream(2, id)).unwrap().is_finite(), "{id}");
     }
     // The corner pixel's ray misses the sphere: exact, one sample, even under a fetch budget.
-    let image = MediumBed::new(Field::Eq21, "transmittance", &Params::new().with("resolution", 4.0)).unwrap();
+    let image = MediumBed::new(
+        Field::Eq21,
+        "transmittance",
+        &Params::new().with("resolution", 4.0),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
     for id in ["ratio_tracking", "residual_ratio_tracking", "ray_marching", "delta_tracking"] {
         let task = Task::new(&image, 0, Budget::new(BudgetKind::Fetches, 10).unwrap());
         let v = build(id, Params::new()).estimate(&task, &mut stream(4, id)).unwrap();
