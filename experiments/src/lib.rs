@@ -33,16 +33,11 @@ pub mod stability_numeric;
 pub mod surface_smc;
 pub mod transmittance;
 pub mod transmittance_post;
-pub mod unbiasedness;
-pub mod unbiasedness_reps;
-pub mod unbiasedness_run;
-pub mod unbiasedness_stats;
-pub mod unbiasedness_table;
 pub mod variance_claims;
 
 use mcbench::config::{EstimatorSpec, Mode, Sweep};
 use mcbench::output::{Claim, RunReport};
-use mcbench::registry::{Experiment, PostFn, Registry};
+use mcbench::registry::{Experiment, PostFn, Registry, Sweeps};
 
 /// A named experiment of the suite, as a static definition (see [`Experiment`]).
 pub struct ExperimentDef {
@@ -70,10 +65,13 @@ impl ExperimentDef {
             name: self.name.into(),
             reproduces: self.reproduces.into(),
             summary: self.summary.into(),
-            quick: (self.sweep)(Mode::Quick),
-            full: (self.sweep)(Mode::Full),
+            sweeps: Sweeps::Fixed {
+                quick: Box::new((self.sweep)(Mode::Quick)),
+                full: Box::new((self.sweep)(Mode::Full)),
+            },
             claims: Some(self.claims),
             post: self.post,
+            preflight: None,
         }
     }
 }
@@ -89,14 +87,17 @@ pub static EXPERIMENTS: &[&ExperimentDef] = &[
     &envmap_smc::DEF,
     &single_scatter::DEF,
     &canonical_sweep::DEF,
-    &unbiasedness::DEF,
     &stability::DEF,
 ];
 
-/// The built-in estimators and test beds with every experiment of the suite: what the `mcbench`
+/// The built-in estimators and test beds with every experiment of the suite, in the order the
+/// default suite runs them (the harness's `unbiasedness` before `stability`): what the `mcbench`
 /// binary runs.
 pub fn registry() -> Registry {
-    EXPERIMENTS.iter().fold(Registry::builtin(), |r, d| r.with_experiment(d.experiment()))
+    let (papers, last) = EXPERIMENTS.split_at(EXPERIMENTS.len() - 1);
+    let r = papers.iter().fold(Registry::builtin().without_experiments(), |r, d| r.with_experiment(d.experiment()));
+    let r = r.with_experiment(mcbench::unbiasedness::experiment());
+    last.iter().fold(r, |r, d| r.with_experiment(d.experiment()))
 }
 
 /// The registry for the crate's own tests: [`registry`] reading the repository's stored

@@ -292,7 +292,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     } else {
         for name in names {
             let def = registry.experiment(name)?;
-            let sweep = def.sweep(mode);
+            let sweep = def.sweep(registry, mode);
             let sweep = match &file {
                 Some(f) => f.clone().apply(Some(sweep), mode)?,
                 None => sweep,
@@ -322,10 +322,10 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     };
     // Everything every experiment of the call will read is checked before the first one writes.
     let mut checked = Vec::new();
-    for (_, plan) in &prepared {
+    for (def, plan) in &prepared {
         checked.push(match args.shard {
             Some(shard) => Checked::Shard(crate::shard::preflight(plan, shard, &args.results)?),
-            None => Checked::Run(execute::preflight(plan, &opts)?),
+            None => Checked::Run(execute::preflight(plan, *def, &opts)?),
         });
     }
     let started = Instant::now();

@@ -55,19 +55,23 @@ pub struct Preflight {
 
 /// Everything a run checks before it writes anything (after [`prepare`] checked the plan): the
 /// output folders are folders or can be made, and every stored cell it will read is well formed.
-pub fn preflight(plan: &Plan, opts: &ExecOptions<'_>) -> Result<Preflight> {
+pub fn preflight(plan: &Plan, def: Option<&Experiment>, opts: &ExecOptions<'_>) -> Result<Preflight> {
     let results_dir = opts.results_root.join(&plan.sweep.experiment);
     check_output_dir("--results", &results_dir)?;
     if opts.plots {
         check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
     }
-    let stored = runner::preload(plan, Some(&results_dir.join("cells")))?;
+    let cells = results_dir.join("cells");
+    let stored = runner::preload(plan, Some(&cells))?;
+    if let Some(check) = def.and_then(|d| d.preflight) {
+        check(opts.registry, &plan.sweep, &cells)?;
+    }
     Ok(Preflight { stored })
 }
 
 /// Runs a prepared plan and writes every output ([`preflight`], then [`execute_checked`]).
 pub fn execute(plan: &Plan, def: Option<&Experiment>, opts: &ExecOptions<'_>) -> Result<Outcome> {
-    let checked = preflight(plan, opts)?;
+    let checked = preflight(plan, def, opts)?;
     execute_checked(plan, def, opts, checked)
 }
 

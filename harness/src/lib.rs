@@ -80,6 +80,7 @@ pub mod registry;
 pub mod report;
 pub mod runner;
 pub mod shard;
+pub mod unbiasedness;
 
 pub use estimators;
 pub use estimators::error::{ConfigError, EstimateError};

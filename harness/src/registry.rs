@@ -37,6 +37,25 @@ pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &OutputDir, Option<&Pat
 /// The claims of an experiment, judged on a finished run.
 pub type ClaimsFn = fn(&RunReport) -> Vec<Claim>;
 
+/// Checks an experiment's own reads before anything is written: (registry, the sweep as it will
+/// run, the results folder's `cells`). For experiments whose analysis runs further sweeps.
+pub type PreflightFn = fn(&Registry, &Sweep, &Path) -> Result<()>;
+
+/// Where an experiment's sweeps come from.
+#[derive(Clone)]
+pub enum Sweeps {
+    /// Fixed sweeps.
+    Fixed {
+        /// The sweep of `--quick` (the default).
+        quick: Box<Sweep>,
+        /// The sweep of `--full`.
+        full: Box<Sweep>,
+    },
+    /// Derived from the registry the experiment runs in (e.g. `unbiasedness`: every registered
+    /// estimator on every test bed it runs on).
+    Derived(fn(&Registry, Mode) -> Sweep),
+}
+
 /// A named experiment: a sweep for quick and for full mode, the claims it judges, and optionally
 /// an analysis of its own.
 #[derive(Clone)]
@@ -47,22 +66,25 @@ pub struct Experiment {
     pub reproduces: String,
     /// One line for `mcbench list experiments`.
     pub summary: String,
-    /// The sweep of `--quick` (the default).
-    pub quick: Sweep,
-    /// The sweep of `--full`.
-    pub full: Sweep,
+    /// Its sweeps.
+    pub sweeps: Sweeps,
     /// Claims judged on the finished run.
     pub claims: Option<ClaimsFn>,
     /// Analysis after the run.
     pub post: Option<PostFn>,
+    /// Checks of what the analysis will read, before the run writes anything.
+    pub preflight: Option<PreflightFn>,
 }
 
 impl Experiment {
-    /// The sweep for a mode.
-    pub fn sweep(&self, mode: Mode) -> Sweep {
-        match mode {
-            Mode::Quick => self.quick.clone(),
-            Mode::Full => self.full.clone(),
+    /// The sweep for a mode, in `registry`.
+    pub fn sweep(&self, registry: &Registry, mode: Mode) -> Sweep {
+        match &self.sweeps {
+            Sweeps::Fixed { quick, full } => match mode {
+                Mode::Quick => (**quick).clone(),
+                Mode::Full => (**full).clone(),
+            },
+            Sweeps::Derived(f) => f(registry, mode),
         }
     }
 }
@@ -115,13 +137,21 @@ impl Registry {
     }
 
     /// Every estimator and test bed of the `estimators` crate (the five papers' and the biased
-    /// controls), and no named experiment.
+    /// controls), and the harness's own experiment `unbiasedness`, which runs over whatever is
+    /// registered.
     pub fn builtin() -> Self {
         Registry {
             estimators: estimators::registry::ESTIMATORS.to_vec(),
             test_beds: estimators::registry::TESTBEDS.to_vec(),
             ..Registry::default()
         }
+        .with_experiment(crate::unbiasedness::experiment())
+    }
+
+    /// The same without any named experiment (to register them in another order).
+    pub fn without_experiments(mut self) -> Self {
+        self.experiments.clear();
+        self
     }
 
     /// Looks stored references up in `source` (for example a [`ReferenceDir`]).

@@ -2,14 +2,14 @@
 //! tests, judged against what the paper claims (registry [`Bias`]); `unbiasedness.csv`, the
 //! per-row `paper` entries and the per-control claims of summary.json.
 
-pub use crate::unbiasedness_stats::{combined, measured, pooled_over_sequences, reps_for_target, TARGET_REL_BIAS};
+pub use super::stats::{combined, measured, pooled_over_sequences, reps_for_target, TARGET_REL_BIAS};
+use crate::analysis::{unbiasedness, TestRow, UNBIASEDNESS_ALPHA};
+use crate::cell::CellResult;
+use crate::error::Result;
+use crate::folder::OutputDir;
+use crate::output::Claim;
 use estimators::estimator::Bias;
 use estimators::testbed::Reference;
-use mcbench::analysis::{unbiasedness, TestRow, UNBIASEDNESS_ALPHA};
-use mcbench::cell::CellResult;
-use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::output::Claim;
 use serde::Serialize;
 
 /// One row of `unbiasedness.csv`.
@@ -48,38 +48,10 @@ pub struct Row {
     pub agrees: Option<bool>,
     /// How to read the row.
     pub note: String,
-}
-
-/// Where a `Bias::Biased` control is unbiased by construction, and why (decided from the
-/// estimator's definition, not from a run): the self-normalised `bidirectional_is_sn` estimates
-/// `L_ns` (the `-lns` variants) with the unnormalised estimator, only its `L_r` ratio is
-/// self-normalised; ray marching's Jensen bias vanishes where the extinction is constant (the
-/// marched optical depth `h sum sigma_t` is exact: `canonical-1d` `constant-*`, and the
-/// homogeneous `gradient-box` without scattering, `albedo-0`) and is of order `tau^2` where the
-/// optical depth `tau` is 0.01 (`canonical-1d` target T 0.99: reported either way, not required);
-/// `rm_is1_cv2` takes the in-scattered
-/// radiance at the far end of each step, which is exact where that radiance is the same everywhere
-/// (the white furnace, `c0`) and the transmittance of the homogeneous box is exact.
-pub fn control_exemption(estimator: &str, testbed: &str, variant: &str) -> Option<&'static str> {
-    let id = estimator.split('[').next().unwrap_or(estimator);
-    match (id, testbed) {
-        ("bidirectional_is_sn", _) if variant.ends_with("-lns") => {
-            Some("not a control here: its L_ns estimate is the unnormalised (unbiased) one; only L_r is self-normalised")
-        }
-        ("ray_marching", "canonical-1d") if variant.starts_with("constant-") => {
-            Some("not a control here: with constant extinction the marched optical depth is exact")
-        }
-        ("ray_marching", "canonical-1d") if variant.ends_with("-T0.99") => Some(
-            "a weak control here (reported, not required): optical depth 0.01, so the Jensen bias of the marched estimate, about T Var(tau_hat) / 2, is of order 1e-5 relative",
-        ),
-        ("ray_marching" | "rm_is1_cv2", "gradient-box") if variant == "albedo-0" => {
-            Some("not a control here: homogeneous and non-scattering, the marched optical depth is exact")
-        }
-        ("rm_is1_cv2", "gradient-box") if variant == "furnace" => Some(
-            "not a control here: in the white furnace the in-scattered radiance is c0 everywhere, so taking it at the step's end is exact",
-        ),
-        _ => None,
-    }
+    /// For a biased control: why it is not required to be flagged here (its registry entry's
+    /// exemption), if it is not.
+    #[serde(skip)]
+    pub exempt: Option<&'static str>,
 }
 
 /// Sets a test row's claim and whether its verdict agrees with it.
@@ -107,13 +79,25 @@ pub fn tests_of(cell: &CellResult, reference: &Reference, bias: Bias, sequence: 
 }
 
 /// The row of one cell: its SPEC §6 tests (also returned, for summary.json) and the judgement.
-pub fn row(cell: &CellResult, reference: &Reference, bias: Bias, sequence: usize) -> (Row, Vec<TestRow>) {
+pub fn row(
+    cell: &CellResult,
+    reference: &Reference,
+    bias: Bias,
+    sequence: usize,
+    exempt: Option<&'static str>,
+) -> (Row, Vec<TestRow>) {
     let tests = tests_of(cell, reference, bias, sequence);
-    (row_from_tests(cell, reference, bias, &tests), tests)
+    (row_from_tests(cell, reference, bias, &tests, exempt), tests)
 }
 
 /// The row of one cell from its tests (see [`tests_of`]; more may be added, e.g. `pooled_z_rep`).
-pub fn row_from_tests(cell: &CellResult, reference: &Reference, bias: Bias, tests: &[TestRow]) -> Row {
+pub fn row_from_tests(
+    cell: &CellResult,
+    reference: &Reference,
+    bias: Bias,
+    tests: &[TestRow],
+    exempt: Option<&'static str>,
+) -> Row {
     let (rel_bias, rel_bias_se, share) = measured(cell, reference);
     let k = &cell.key;
     let (test, p_value, detectable) = combined(tests);
@@ -140,6 +124,7 @@ pub fn row_from_tests(cell: &CellResult, reference: &Reference, bias: Bias, test
         rel_bias_se,
         agrees: None,
         note: String::new(),
+        exempt,
     };
     r.reps_for_target = reps_for_target(r.detectable_rel_bias, r.reps, share);
     judge(&mut r);
@@ -154,15 +139,15 @@ pub fn row_from_tests(cell: &CellResult, reference: &Reference, bias: Bias, test
 }
 
 fn pct(x: f64) -> String {
-    format!("{}%", mcbench::report::sig(100.0 * x, 2))
+    format!("{}%", crate::report::sig(100.0 * x, 2))
 }
 
 /// Fills `agrees` and `note`: unbiased ids must pass, controls must be flagged (except where
-/// [`control_exemption`] says why they are not a control), consistent ids are reported.
+/// the row's exemption says why they are not a control there), consistent ids are reported.
 pub fn judge(r: &mut Row) {
     let measured = format!("measured relative bias {} ± {}", pct(r.rel_bias), pct(r.rel_bias_se));
     let p = if r.p_value.is_nan() { "-".to_string() } else { format!("{:.2e}", r.p_value) };
-    let exempt = control_exemption(&r.estimator, &r.testbed, &r.variant);
+    let exempt = r.exempt;
     let weak = exempt.is_some_and(|w| w.starts_with("a weak control"));
     // Exempt controls are expected to pass (unbiased by construction there), weak ones either way.
     let expect = match (r.paper_bias.as_str(), exempt) {
@@ -197,7 +182,7 @@ pub fn judge(r: &mut Row) {
             "0.1% resolved".to_string()
         } else {
             match r.reps_for_target {
-                Some(n) => format!("0.1% not resolved: needs about {} reps", mcbench::report::sig(n, 2)),
+                Some(n) => format!("0.1% not resolved: needs about {} reps", crate::report::sig(n, 2)),
                 None => "0.1% not resolvable: the stored reference's own error is larger".to_string(),
             }
         };
@@ -208,7 +193,14 @@ pub fn judge(r: &mut Row) {
 }
 
 /// A row for a pair that was not run, with the reason.
-pub fn not_run(estimator: &str, testbed: &str, variant: &str, bias: Bias, reason: &str) -> Row {
+pub fn not_run(
+    estimator: &str,
+    testbed: &str,
+    variant: &str,
+    bias: Bias,
+    reason: &str,
+    exempt: Option<&'static str>,
+) -> Row {
     let mut r = Row {
         estimator: estimator.into(),
         testbed: testbed.into(),
@@ -225,6 +217,7 @@ pub fn not_run(estimator: &str, testbed: &str, variant: &str, bias: Bias, reason
         rel_bias_se: f64::NAN,
         agrees: None,
         note: format!("not run: {reason}"),
+        exempt,
     };
     judge(&mut r);
     r
@@ -235,9 +228,9 @@ pub fn write_csv(dir: &OutputDir, name: &str, rows: &[Row]) -> Result<()> {
     let path = dir.join(name);
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {
-        w.serialize(r).map_err(|e| mcbench::error::HarnessError::write(&path, e))?;
+        w.serialize(r).map_err(|e| crate::error::HarnessError::write(&path, e))?;
     }
-    let bytes = w.into_inner().map_err(|e| mcbench::error::HarnessError::write(&path, e))?;
+    let bytes = w.into_inner().map_err(|e| crate::error::HarnessError::write(&path, e))?;
     dir.write(name, &bytes).map(|_| ())
 }
 
@@ -262,12 +255,8 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
         }
     }
     for c in controls {
-        let mine: Vec<&Row> = rows
-            .iter()
-            .filter(|r| {
-                r.estimator == c && r.verdict != "not-run" && control_exemption(c, &r.testbed, &r.variant).is_none()
-            })
-            .collect();
+        let mine: Vec<&Row> =
+            rows.iter().filter(|r| r.estimator == c && r.verdict != "not-run" && r.exempt.is_none()).collect();
         let missed: Vec<String> =
             mine.iter().filter(|r| r.agrees != Some(true)).map(|r| format!("{}/{}", r.testbed, r.variant)).collect();
         out.push(Claim {
@@ -313,7 +302,7 @@ pub fn markdown(rows: &[Row]) -> String {
     let body: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
-            let num = |x: f64| if x.is_nan() { "-".to_string() } else { mcbench::report::sig(x, 2) };
+            let num = |x: f64| if x.is_nan() { "-".to_string() } else { crate::report::sig(x, 2) };
             vec![
                 r.estimator.clone(),
                 format!("{}/{}", r.testbed, r.variant),
@@ -346,9 +335,9 @@ pub fn markdown(rows: &[Row]) -> String {
         "agrees",
         "note",
     ];
-    mcbench::report::markdown_table(&header, &body)
+    crate::report::markdown_table(&header, &body)
 }
 
 #[cfg(test)]
-#[path = "unbiasedness_tests.rs"]
+#[path = "table_tests.rs"]
 mod tests;

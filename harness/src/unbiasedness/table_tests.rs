@@ -3,7 +3,7 @@
 use super::*;
 
 fn row(paper: &str, verdict: &str, p: f64) -> Row {
-    let mut r = not_run("e", "t", "v", Bias::Unbiased, "x");
+    let mut r = not_run("e", "t", "v", Bias::Unbiased, "x", None);
     r.paper_bias = paper.into();
     r.verdict = verdict.into();
     r.test = "holm_t".into();
@@ -40,16 +40,21 @@ fn verdicts_follow_the_papers_claims() {
 fn exempt_controls_are_expected_to_pass() {
     let mut r = row("biased", "pass", 0.5);
     r.estimator = "bidirectional_is_sn[candidates=2]".into();
+    r.testbed = "envmap-sequence".into();
     r.variant = "mixed-lns".into();
+    let registry = crate::registry::Registry::builtin();
+    r.exempt = super::super::run::exemption(&registry, "bidirectional_is_sn", &r.testbed, &r.variant);
     judge(&mut r);
     assert_eq!(r.agrees, Some(true));
     assert!(r.note.starts_with("not a control here"), "{}", r.note);
     r.verdict = "biased".into();
     judge(&mut r);
     assert_eq!(r.agrees, Some(false), "an exempt control flagged is a finding, not a pass");
-    assert!(control_exemption("ray_marching[step=5]", "canonical-1d", "constant-T0.5").is_some());
-    assert!(control_exemption("ray_marching[step=5]", "canonical-1d", "cosine-T0.5").is_none());
-    assert!(control_exemption("rm_is1_cv2", "gradient-box", "albedo-0.8").is_none());
+    let exemption = |id, bed, variant| super::super::run::exemption(&registry, id, bed, variant);
+    assert!(exemption("ray_marching", "canonical-1d", "constant-T0.5").is_some());
+    assert!(exemption("ray_marching", "canonical-1d", "cosine-T0.99").is_some());
+    assert!(exemption("ray_marching", "canonical-1d", "cosine-T0.5").is_none());
+    assert!(exemption("rm_is1_cv2", "gradient-box", "albedo-0.8").is_none());
 }
 
 #[test]
@@ -121,11 +126,11 @@ fn the_holm_and_pooled_tests_combine_by_bonferroni() {
 /// flagged, and the pooled test over sequences is never less conservative than the independent one.
 #[test]
 fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
+    use crate::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
+    use crate::plan::Plan;
+    use crate::runner::{run, RunOptions, Silent};
     use estimators::budget::Budget;
     use estimators::params::Params;
-    use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
-    use mcbench::plan::Plan;
-    use mcbench::runner::{run, RunOptions, Silent};
     let sweep = Sweep {
         experiment: "unbiasedness-test".into(),
         testbeds: vec![TestBedSpec {
@@ -140,13 +145,20 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
         mode: Mode::Quick,
         baseline: None,
     };
-    let plan = Plan::prepare(sweep, &crate::test_registry()).unwrap();
+    let plan = Plan::prepare(
+        sweep,
+        &crate::registry::Registry::builtin().with_references(crate::references::ReferenceDir::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../results/references"
+        ))),
+    )
+    .unwrap();
     let results = run(&plan, &RunOptions { threads: Some(1), cell_dir: None, observer: &Silent }).unwrap();
     let reference = plan.beds[0].bed.reference();
     let rows: Vec<Row> = results
         .cells
         .iter()
-        .map(|(_, ei, cell)| super::row(cell, reference, plan.estimators[*ei].entry.bias, 1).0)
+        .map(|(_, ei, cell)| super::row(cell, reference, plan.estimators[*ei].entry.bias, 1, None).0)
         .collect();
     assert_eq!((rows[0].verdict.as_str(), rows[0].agrees), ("pass", Some(true)), "{:?}", rows[0]);
     assert_eq!((rows[1].verdict.as_str(), rows[1].agrees), ("biased", Some(true)), "{:?}", rows[1]);
@@ -157,21 +169,15 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
     assert!(whole.detectable_rel_bias > independent.detectable_rel_bias);
 }
 
+/// Every variant of every built-in test bed is in some part (each declares an unbiasedness case
+/// for each of its variants).
 #[test]
-fn every_registered_estimator_is_in_a_part() {
-    use crate::unbiasedness::{parts, IDS};
-    use mcbench::config::Mode;
-    let mut ids: Vec<&str> = IDS.to_vec();
-    let mut registered: Vec<&str> = estimators::registry::ESTIMATORS.iter().map(|e| e.id).collect();
-    ids.sort();
-    registered.sort();
-    assert_eq!(ids, registered, "IDS must list every registered estimator");
-    let all = parts(Mode::Quick);
-    for id in IDS {
-        assert!(all.iter().any(|p| p.sweep.estimators.iter().any(|e| e.id == *id)), "{id} is in no part");
-    }
-    // Every variant of every test bed is in some part.
-    for t in estimators::registry::TESTBEDS {
+fn every_built_in_variant_is_in_a_part() {
+    use crate::config::Mode;
+    use crate::unbiasedness::parts;
+    let registry = crate::registry::Registry::builtin();
+    let all = parts(&registry, Mode::Quick);
+    for t in registry.test_beds() {
         for v in t.variants {
             let covered =
                 all.iter().any(|p| p.sweep.testbeds.iter().any(|b| b.id == t.id && b.variant.as_deref() == Some(*v)));

@@ -2,11 +2,11 @@
 //! pooled test over shared-state sequences, the measured relative bias, and the repetitions that
 //! would resolve a 0.1% relative bias.
 
+use crate::analysis::{unbiasedness, TestRow, POWER, UNBIASEDNESS_ALPHA};
+use crate::cell::CellResult;
 use estimators::estimator::Bias;
 use estimators::stats::{detectable_shift, z_test};
 use estimators::testbed::{Reference, ReferenceKind};
-use mcbench::analysis::{unbiasedness, TestRow, POWER, UNBIASEDNESS_ALPHA};
-use mcbench::cell::CellResult;
 
 /// The relative bias `--full` aims to resolve (issue 9: 0.1%).
 pub const TARGET_REL_BIAS: f64 = 1e-3;

@@ -11,13 +11,13 @@
 //! runner's own [`sequence_estimates`] (same streams, same tasks: the values are those of the
 //! cell) to get the per-repetition sums; this costs one more pass over these small parts.
 
+use crate::analysis::{TestRow, POWER, UNBIASEDNESS_ALPHA};
+use crate::error::{HarnessError, Result};
+use crate::plan::Plan;
+use crate::runner::sequence_estimates;
 use estimators::budget::BudgetKind;
 use estimators::stats::{detectable_shift, z_test, Moments};
 use estimators::testbed::{Reference, ReferenceKind};
-use mcbench::analysis::{TestRow, POWER, UNBIASEDNESS_ALPHA};
-use mcbench::error::{HarnessError, Result};
-use mcbench::plan::Plan;
-use mcbench::runner::sequence_estimates;
 use rayon::prelude::*;
 
 /// The per-repetition summed deviations of one (test bed, estimator) pair of a one-budget sample
@@ -101,11 +101,11 @@ pub fn pooled_over_repetitions(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
+    use crate::runner::{run, RunOptions, Silent};
     use estimators::budget::Budget;
     use estimators::math::Rgb;
     use estimators::params::Params;
-    use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
-    use mcbench::runner::{run, RunOptions, Silent};
 
     /// The recomputed per-repetition deviations are those of the runner's cell (same streams), on a
     /// whole-image sequence (`gradient-box`, one octree per image).
@@ -125,7 +125,14 @@ mod tests {
             mode: Mode::Quick,
             baseline: None,
         };
-        let plan = Plan::prepare(sweep, &crate::test_registry()).unwrap();
+        let plan = Plan::prepare(
+            sweep,
+            &crate::registry::Registry::builtin().with_references(crate::references::ReferenceDir::new(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../results/references"
+            ))),
+        )
+        .unwrap();
         let cells = run(&plan, &RunOptions { threads: Some(2), cell_dir: None, observer: &Silent }).unwrap().cells;
         let d = deviations(&plan, 0, 0, 1).unwrap().unwrap();
         let r = plan.beds[0].bed.reference();

@@ -1,4 +1,4 @@
-//! The post hook of `unbiasedness`: runs the parts after the first (the first is the experiment's
+//! The analysis of `unbiasedness`: runs the parts after the first (the first is the experiment's
 //! own sweep, already run by the harness) into the same results folder (resumable cells), adds their
 //! summary rows, tests and skipped pairs to the report, builds the table of every part, writes
 //! `unbiasedness.csv` and `unbiasedness.md`, and adds the per-row and per-control claims.
@@ -7,25 +7,31 @@
 //! applies to every part when it differs from the first part's default; `--config` changes the
 //! first part only. `--threads` is honoured through the run's thread count (`meta.threads`).
 
-use crate::unbiasedness::{parts, Row};
-use crate::unbiasedness_reps::pooled_over_repetitions;
-use crate::unbiasedness_table as table;
-use mcbench::config::Sweep;
-use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::metrics::summarize;
-use mcbench::output::RunReport;
-use mcbench::plan::Plan;
-use mcbench::progress::Progress;
-use mcbench::registry::Registry;
-use mcbench::runner::{self, RunOptions, RunResults};
+use super::reps::pooled_over_repetitions;
+use super::table;
+use super::{parts, Row};
+use crate::config::Sweep;
+use crate::error::Result;
+use crate::folder::OutputDir;
+use crate::metrics::summarize;
+use crate::output::RunReport;
+use crate::plan::Plan;
+use crate::progress::Progress;
+use crate::registry::Registry;
+use crate::runner::{self, RunOptions, RunResults};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The rows of a finished plan's cells (and their tests, when `with_tests`: the harness already
 /// added the first part's). Whole-image sequences also get `pooled_z_rep`
 /// ([`crate::unbiasedness_reps`]), recomputed on `threads` threads.
-fn rows_of(plan: &Plan, run: &RunResults, report: &mut RunReport, with_tests: bool) -> Result<Vec<Row>> {
+fn rows_of(
+    plan: &Plan,
+    run: &RunResults,
+    report: &mut RunReport,
+    with_tests: bool,
+    registry: &Registry,
+) -> Result<Vec<Row>> {
     let threads = report.meta.threads;
     let mut rows = Vec::new();
     for (bi, ei, cell) in &run.cells {
@@ -39,13 +45,21 @@ fn rows_of(plan: &Plan, run: &RunResults, report: &mut RunReport, with_tests: bo
                 tests.push(t);
             }
         }
-        rows.push(table::row_from_tests(cell, reference, bias, &tests));
+        let exempt = exemption(registry, &plan.estimators[*ei].spec.id, &cell.key.testbed, &cell.key.variant);
+        rows.push(table::row_from_tests(cell, reference, bias, &tests, exempt));
         if with_tests {
             report.rows.push(summarize(cell, reference));
             report.tests.extend(tests);
         }
     }
     Ok(rows)
+}
+
+/// Why a biased control `id` is not required to be flagged on `testbed/variant`, if its registry
+/// entry says so.
+pub fn exemption(registry: &Registry, id: &str, testbed: &str, variant: &str) -> Option<&'static str> {
+    let entry = registry.estimator(id).ok()?;
+    entry.checks.exempt.iter().find(|e| e.covers(testbed, variant)).map(|e| e.reason)
 }
 
 /// The plans of a part's sweep. A pair whose configuration is invalid on a test bed (the terminating
@@ -70,12 +84,45 @@ fn prepare_valid(sweep: Sweep, registry: &Registry) -> Result<(Vec<Plan>, Vec<Ro
                 Err(e) => {
                     let entry = registry.estimator(&est.id)?;
                     let variant = bed.variant.clone().unwrap_or_default();
-                    rows.push(table::not_run(&est.name(), &bed.id, &variant, entry.bias, &e.to_string()));
+                    let exempt = exemption(registry, &est.id, &bed.id, &variant);
+                    rows.push(table::not_run(&est.name(), &bed.id, &variant, entry.bias, &e.to_string(), exempt));
                 }
             }
         }
     }
     Ok((plans, rows))
+}
+
+/// The parts after the first as they run after `first` (the experiment's sweep as it ran): with
+/// its seed, and with its repetitions when they differ from the first part's default; each with a
+/// label for the notes.
+fn other_parts(registry: &Registry, first: &Sweep) -> Vec<(String, Sweep)> {
+    let all = parts(registry, first.mode);
+    let Some(default_reps) = all.first().map(|p| p.sweep.reps) else { return Vec::new() };
+    let reps_override = (first.reps != default_reps).then_some(first.reps);
+    all.into_iter()
+        .skip(1)
+        .map(|part| {
+            let mut sweep = part.sweep;
+            sweep.seed = first.seed;
+            if let Some(r) = reps_override {
+                sweep.reps = r;
+            }
+            let bed = sweep.testbeds.first().map(|t| t.id.clone()).unwrap_or_default();
+            (format!("part {bed}... ({} spp, {} reps)", part.samples, sweep.reps), sweep)
+        })
+        .collect()
+}
+
+/// Checks, before the run writes anything, every stored cell the other parts will read back.
+pub fn preflight(registry: &Registry, first: &Sweep, cells: &Path) -> Result<()> {
+    for (_, sweep) in other_parts(registry, first) {
+        let (plans, _) = prepare_valid(sweep, registry)?;
+        for p in &plans {
+            runner::preload(p, Some(cells))?;
+        }
+    }
+    Ok(())
 }
 
 /// Runs the other parts and writes the table (see the module docs).
@@ -87,17 +134,10 @@ pub fn post(
     _plots: Option<&Path>,
     registry: &Registry,
 ) -> Result<Vec<PathBuf>> {
-    let all = parts(plan.sweep.mode);
-    let reps_override = (plan.sweep.reps != all[0].sweep.reps).then_some(plan.sweep.reps);
-    let mut rows = rows_of(plan, run, report, false)?;
-    let mut notes = vec![format!("part {} ({} reps)", all[0].name, plan.sweep.reps)];
-    for part in all.into_iter().skip(1) {
-        let mut sweep = part.sweep;
-        sweep.seed = plan.sweep.seed;
-        if let Some(r) = reps_override {
-            sweep.reps = r;
-        }
-        let label = format!("part {} ({} reps)", part.name, sweep.reps);
+    let mut rows = rows_of(plan, run, report, false, registry)?;
+    let first_bed = plan.sweep.testbeds.first().map(|t| t.id.clone()).unwrap_or_default();
+    let mut notes = vec![format!("part {first_bed}... ({} reps)", plan.sweep.reps)];
+    for (label, sweep) in other_parts(registry, &plan.sweep) {
         let t0 = Instant::now();
         let (plans, invalid) = prepare_valid(sweep, registry)?;
         rows.extend(invalid);
@@ -110,7 +150,7 @@ pub fn post(
             };
             let r = runner::run(&p, &opts)?;
             progress.finish();
-            rows.extend(rows_of(&p, &r, report, true)?);
+            rows.extend(rows_of(&p, &r, report, true, registry)?);
             report.skipped.extend(p.skipped.iter().cloned());
             for e in &p.estimators {
                 if !report.labels.iter().any(|(n, _)| n == &e.name) {
