@@ -117,6 +117,10 @@ impl<S: Scalar> Grid<S> {
     pub fn pdf_coefficients(&self) -> impl ExactSizeIterator<Item = f64> + Clone + '_ {
         self.pdf.iter().map(|p| p.get())
     }
+    /// The stored PDF coefficients, in cell order.
+    pub fn pdf_slice(&self) -> &[S] {
+        &self.pdf
+    }
     /// The record counter of a cell.
     pub fn count(&self, cell: usize) -> u32 {
         self.count[cell]
