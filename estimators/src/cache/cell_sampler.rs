@@ -37,6 +37,9 @@ pub struct CellSampler {
     cap: u64,
     /// `cap` as a float (exact: a power of two over a power of two).
     cap_f64: f64,
+    /// The root of `blocks`, kept beside the other fields so a draw can start its random number
+    /// before the tree's first line arrives.
+    total: u64,
 }
 
 impl CellSampler {
@@ -47,7 +50,7 @@ impl CellSampler {
 
     /// A sampler over `coefficients` stored as `S`.
     pub fn new<S: Scalar>(coefficients: &[S]) -> Self {
-        let mut s = CellSampler { blocks: PartialSumTree::new(1), block: 1, cells: 0, scale: 1.0, cap: 1, cap_f64: 1.0 };
+        let mut s = CellSampler { blocks: PartialSumTree::new(1), block: 1, cells: 0, scale: 1.0, cap: 1, cap_f64: 1.0, total: 0 };
         s.rebuild(coefficients);
         s
     }
@@ -95,11 +98,12 @@ impl CellSampler {
             sums[b] = chunk.iter().map(|c| self.weight(c.get())).sum();
         }
         self.blocks.rebuild(&sums);
+        self.total = self.blocks.total();
     }
 
     /// The sum of every cell's weight.
     pub fn total(&self) -> u64 {
-        self.blocks.total()
+        self.total
     }
 
     /// The probability of drawing a cell whose coefficient is `coefficient`.
@@ -119,8 +123,9 @@ impl CellSampler {
             return false;
         };
         let b = cell / self.block;
-        let sum = self.blocks.weight(b) - self.weight(old) + q;
-        self.blocks.set(b, sum);
+        let old = self.weight(old);
+        self.blocks.set(b, self.blocks.weight(b) - old + q);
+        self.total = self.total - old + q;
         true
     }
 

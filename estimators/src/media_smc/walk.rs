@@ -163,6 +163,10 @@ impl Vertex {
             Sampling::Uniform => cache.sample_uniform(rng),
             Sampling::Cache => cache.sample(rng),
         };
+        // The reads of `g` (the cells around the drawn one) are issued before the direction's
+        // trigonometry, which does not depend on them and so runs while they load.
+        let g_l = cache.g(cv, draw.st);
+        let big_g = cache.integral(cv) * ISOTROPIC;
         let w = cache.domain().direction(draw.st);
         let v = Vertex {
             pos: x,
@@ -171,8 +175,8 @@ impl Vertex {
             // The cell the record would find (a drawn point at the far edge of its cell may
             // round into the next one).
             cell: cache.grid().cell_at(draw.st),
-            big_g: cache.integral(cv) * ISOTROPIC,
-            g_l: cache.g(cv, draw.st),
+            big_g,
+            g_l,
             pdf: draw.pdf,
             phase: phase.eval(dir.dot(w)),
             factor,
