@@ -31,9 +31,11 @@ enum Sum {
     LastRow = 2,
 }
 
-/// The RGB coefficient and the counter of one cell (16 bytes in single precision, 32 in double:
-/// 28 and 4 of padding).
+/// The RGB coefficient and the counter of one cell: 16 bytes in single precision, 28 in double
+/// (packed to 4-byte alignment, so the double-precision cell keeps paper 001's 36 bytes with its
+/// PDF coefficient; fields are read and written by copy, never by reference).
 #[derive(Clone, Copy, Debug, Default)]
+#[repr(C, packed(4))]
 struct Cell<S: Scalar> {
     rgb: [S; 3],
     count: u32,
@@ -104,9 +106,10 @@ impl<S: Scalar> Grid<S> {
     }
 
     /// The cell containing `st` (the closed upper edges `s = 1`, `t = 1` belong to the last cells).
+    #[inline]
     pub fn cell_at(&self, st: St) -> usize {
-        let i = ((st.s * self.ns as f64) as usize).min(self.ns - 1);
-        let j = ((st.t * self.nt as f64) as usize).min(self.nt - 1);
+        let i = floor_index(st.s * self.ns as f64).min(self.ns - 1);
+        let j = floor_index(st.t * self.nt as f64).min(self.nt - 1);
         j * self.ns + i
     }
     /// Column `i` and row `j` of a cell.
@@ -125,7 +128,7 @@ impl<S: Scalar> Grid<S> {
     /// The RGB coefficient of a cell.
     #[inline]
     pub fn radiance(&self, cell: usize) -> Rgb {
-        let c = &self.cells[cell].rgb;
+        let c = self.cells[cell].rgb;
         Rgb([c[0].get(), c[1].get(), c[2].get()])
     }
     /// The RGB coefficient of column `i` (taken modulo `ns`: periodic in `s`) and row `j`.
@@ -170,14 +173,14 @@ impl<S: Scalar> Grid<S> {
     /// (the mean over channels of `|f - g|`) to the PDF coefficient, then increments the counter.
     /// Returns the new PDF coefficient.
     pub fn record(&mut self, cell: usize, f: Rgb, pdf_sample: f64) -> f64 {
-        let c = self.cells[cell].count;
+        let Cell { mut rgb, count: c } = self.cells[cell];
         let w = 1.0 / (f64::from(c) + 1.0);
         let j = self.row_of(cell);
         let (first, last) = (j == 0, j == self.nt - 1);
         for ch in 0..3 {
-            let old = self.cells[cell].rgb[ch].get();
+            let old = rgb[ch].get();
             let stored = S::put(old + (f[ch] - old) * w);
-            self.cells[cell].rgb[ch] = stored;
+            rgb[ch] = stored;
             let new = stored.get();
             let sums = &mut self.sums;
             sums[Sum::All as usize][ch].add(new);
@@ -194,10 +197,13 @@ impl<S: Scalar> Grid<S> {
         let old = self.pdf[cell].get();
         let new = S::put_positive(old + (pdf_sample - old) * w);
         self.pdf[cell] = new;
-        if c < u32::MAX {
-            self.cells[cell].count = c + 1;
+        let count = if c < u32::MAX {
             self.records += 1;
-        }
+            c + 1
+        } else {
+            c
+        };
+        self.cells[cell] = Cell { rgb, count };
         new.get()
     }
 
@@ -212,8 +218,8 @@ impl<S: Scalar> Grid<S> {
         for j in 0..nt {
             for i in 0..ns {
                 let parent = (j / 2) * self.ns + i / 2;
-                let c = self.cells[parent].count;
-                cells.push(Cell { rgb: self.cells[parent].rgb, count: if c == 0 { 0 } else { (c / divisor).max(1) } });
+                let Cell { rgb, count: c } = self.cells[parent];
+                cells.push(Cell { rgb, count: if c == 0 { 0 } else { (c / divisor).max(1) } });
                 pdf.push(self.pdf[parent]);
             }
         }
@@ -229,7 +235,8 @@ impl<S: Scalar> Grid<S> {
         self.sums = Default::default();
         for (cell, c) in self.cells.iter().enumerate() {
             let j = cell / self.ns;
-            for (ch, v) in c.rgb.iter().map(|x| x.get()).enumerate() {
+            let rgb = c.rgb;
+            for (ch, v) in rgb.iter().map(|x| x.get()).enumerate() {
                 self.sums[Sum::All as usize][ch].add(v);
                 if j == 0 {
                     self.sums[Sum::FirstRow as usize][ch].add(v);
@@ -246,9 +253,11 @@ impl<S: Scalar> Grid<S> {
     pub fn set_radiance(&mut self, cell: usize, v: Rgb) {
         let j = cell / self.ns;
         for ch in 0..3 {
-            let old = self.cells[cell].rgb[ch].get();
-            self.cells[cell].rgb[ch] = S::put(v[ch]);
-            let new = self.cells[cell].rgb[ch].get();
+            let mut rgb = self.cells[cell].rgb;
+            let old = rgb[ch].get();
+            rgb[ch] = S::put(v[ch]);
+            let new = rgb[ch].get();
+            self.cells[cell].rgb = rgb;
             for (which, on) in [(Sum::All, true), (Sum::FirstRow, j == 0), (Sum::LastRow, j == self.nt - 1)] {
                 if on {
                     self.sums[which as usize][ch].add(new);
@@ -259,11 +268,18 @@ impl<S: Scalar> Grid<S> {
     }
 
     /// Bytes of cell storage: RGB, PDF coefficient and counter per cell (the quantity of paper 001
-    /// Table 1): 20 bytes per cell in single precision, 40 in double (36 of data and the 4 bytes
-    /// of padding that keep the counter beside the RGB coefficients).
+    /// Table 1): 36 bytes per cell in double precision, 20 in single.
     pub fn cell_bytes(&self) -> usize {
         self.cells() * (std::mem::size_of::<Cell<S>>() + std::mem::size_of::<S>())
     }
+}
+
+/// `x as usize` (truncation, 0 for negative and NaN, saturating above) for the `x` of a cell
+/// index: the same value below `2^63` in fewer instructions (a signed conversion, no unsigned
+/// fix-up); callers clamp to the grid, where larger values end up too.
+#[inline]
+pub(crate) fn floor_index(x: f64) -> usize {
+    x.max(0.0) as i64 as usize
 }
 
 #[cfg(test)]
@@ -340,6 +356,6 @@ mod tests {
             assert!((kept[ch] - g64.average()[ch]).abs() <= 4.0 * f64::EPSILON * g64.average()[ch].abs());
         }
         assert_eq!(g32.cell_bytes(), 4 * 20);
-        assert_eq!(g64.cell_bytes(), 4 * 40);
+        assert_eq!(g64.cell_bytes(), 4 * 36);
     }
 }

@@ -138,8 +138,13 @@ impl<S: Scalar> RadianceCache<S> {
 
     /// The density of [`RadianceCache::sample`] at `st` per unit solid angle.
     pub fn pdf(&self, st: St) -> f64 {
+        self.pdf_of_cell(self.grid.cell_at(st))
+    }
+
+    /// The density of [`RadianceCache::sample`] per unit solid angle in cell `cell`.
+    pub fn pdf_of_cell(&self, cell: usize) -> f64 {
         match self.tree_active() {
-            Some(tree) => self.cell_density(tree, self.grid.cell_at(st)),
+            Some(tree) => self.cell_density(tree, cell),
             None => 1.0 / self.domain().measure(),
         }
     }
