@@ -6,10 +6,14 @@
 //! ```text
 //! cargo bench -p estimators --bench cpu -- media 1024 is0_cv0 is1_cv2      # gradient-box albedo 0.8, 16x16
 //! cargo bench -p estimators --bench cpu -- surface 1024 brdf_is0_cv0 is1_cv2 brdf_is1_cv2   # gradient-plane 16x16
-//! cargo bench -p estimators --bench cpu -- envmap 10 bidirectional_is smc smc_bridge       # envmap-sequence
+//! cargo bench -p estimators --bench cpu -- envmap 10 bidirectional_is smc smc_bridge   # envmap-sequence mixed 16x16, 10 frames, N = 16
+//! cargo bench -p estimators --bench cpu -- tracking 20000 bare delta_tracking ratio_tracking   # eq21-medium, CPU per fetch
 //! ```
 //! Options after the ids: `storage=f32` (the caches' cell precision), `reps=K` (repeat K times,
-//! each line its own measurement).
+//! each line its own measurement), `res=R` (the image side of gradient-plane and envmap-sequence,
+//! default 16), any other `name=number` (an estimator parameter, e.g.
+//! `candidates=256`). Media report CPU per path, surfaces per sample, envmap per pixel and frame
+//! (with `samples` = target evaluations).
 
 use estimators::budget::Budget;
 use estimators::params::{ParamValue, Params};
@@ -53,8 +57,57 @@ fn run(bed: &dyn TestBed, id: &str, spp: u64, params: &Params, seed: u64) -> Mea
     (cpu, samples, diag, hash)
 }
 
+/// `tracking <estimates> <ids...>`: each tracker's CPU (and, under callgrind, instructions) per
+/// fetch over `estimates` transmittance estimates of 16 rays on eq21-medium's central ray s = 20
+/// (the tracking bench's setup); the id `bare` is the floor, `sigma_t` at 1024 points of that ray
+/// in a tight loop, `estimates x 16` times over, and `bare_chained` the same loop with each point
+/// made dependent on the previous fetch.
+fn tracking(estimates: u64, ids: &[String]) {
+    use rand::Rng;
+    let bed = (registry::testbed("eq21-medium").unwrap().build)("central-ray", &Params::new()).expect("bed");
+    for id in ids {
+        let (t0, fetches) = if id == "bare" || id == "bare_chained" {
+            let scene = bed.medium().expect("medium");
+            let mut rng = stream(7, "bench fetch points");
+            let points: Vec<_> =
+                (0..1024).map(|_| estimators::math::Vec3::new(0.0, 0.0, rng.gen_range(0.0..20.0))).collect();
+            // `bare_chained`: each point depends on the previous fetch's value (by a zero
+            // offset the compiler cannot see through), as a tracker's next point depends on its
+            // last step: the fetches run one after the other instead of overlapping.
+            let chained = id == "bare_chained";
+            let t0 = thread_cpu_seconds();
+            for _ in 0..estimates * 16 {
+                let mut s = 0.0;
+                for p in &points {
+                    let p = if chained { *p + estimators::math::Vec3::new(0.0, 0.0, 0.0 * s) } else { *p };
+                    s += scene.sigma_t(std::hint::black_box(p));
+                }
+                std::hint::black_box(s);
+            }
+            (t0, estimates * 16 * points.len() as u64)
+        } else {
+            let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+            let mut rng = stream(11, id);
+            let mut fetches = 0;
+            let t0 = thread_cpu_seconds();
+            for _ in 0..estimates {
+                let task = Task::new(bed.as_ref(), bed.integrals() - 1, Budget::samples(16).expect("budget"));
+                std::hint::black_box(est.estimate(&task, &mut rng).expect("estimates"));
+                fetches += task.costs().fetches;
+            }
+            (t0, fetches)
+        };
+        let cpu = thread_cpu_seconds() - t0;
+        println!("tracking {id} fetches={fetches} ns_per_fetch={:.3}", cpu * 1e9 / fetches as f64);
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
+    if args.first().map(String::as_str) == Some("tracking") {
+        let n = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1000);
+        return tracking(n, &args[2..]);
+    }
     let Some(mode) = args.first() else {
         eprintln!("usage: cpu <media|surface|envmap> <spp|frames> <ids...> [storage=f32] [reps=K]");
         return;
@@ -62,6 +115,7 @@ fn main() {
     let size: u64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1024);
     let mut params = Params::new();
     let mut reps = 1;
+    let mut res = 16.0;
     let mut ids = Vec::new();
     for a in &args[2..] {
         match a.split_once('=') {
@@ -69,13 +123,15 @@ fn main() {
                 params.0.insert("storage".into(), ParamValue::Text(v.into()));
             }
             Some(("reps", v)) => reps = v.parse().expect("reps"),
-            _ => ids.push(a.clone()),
+            Some(("res", v)) => res = v.parse().expect("res"),
+            Some((k, v)) => params = params.with(k, v.parse::<f64>().expect("a numeric parameter")),
+            None => ids.push(a.clone()),
         }
     }
     let (bed, spp, per): (Box<dyn TestBed>, u64, &str) = match mode.as_str() {
         "media" => (Box::new(GradientBox::without_reference("albedo-0.8", &Params::new()).expect("bed")), size, "path"),
         "surface" => (
-            (registry::testbed("gradient-plane").unwrap().build)("default", &Params::new().with("resolution", 16.0))
+            (registry::testbed("gradient-plane").unwrap().build)("default", &Params::new().with("resolution", res))
                 .expect("bed"),
             size,
             "sample",
@@ -83,25 +139,27 @@ fn main() {
         "envmap" => (
             (registry::testbed("envmap-sequence").unwrap().build)(
                 "mixed",
-                &Params::new().with("resolution", 16.0).with("frames", size as f64),
+                &Params::new().with("resolution", res).with("frames", size as f64),
             )
             .expect("bed"),
-            64,
-            "sample",
+            16,
+            "frame",
         ),
         other => panic!("unknown mode {other}"),
     };
     for rep in 0..reps {
         for id in &ids {
             let (cpu, samples, diag, hash) = run(bed.as_ref(), id, spp, &params, 1 + rep as u64);
+            // Per pixel and frame for the sequences (samples = target evaluations), else per sample.
+            let units = if per == "frame" { bed.integrals() as u64 } else { samples };
             let extra: Vec<String> = diag
                 .iter()
                 .filter(|(k, _)| matches!(*k, "bytes" | "nodes" | "leaves" | "cells" | "cache_bytes"))
                 .map(|(k, v)| format!("{k}={v}"))
                 .collect();
             println!(
-                "{mode} {id} spp={spp} cpu_s={cpu:.4} {per}s={samples} us_per_{per}={:.5} hash={hash:016x} {}",
-                cpu * 1e6 / samples as f64,
+                "{mode} {id} spp={spp} cpu_s={cpu:.4} samples={samples} {per}s={units} us_per_{per}={:.5} hash={hash:016x} {}",
+                cpu * 1e6 / units as f64,
                 extra.join(" ")
             );
         }
