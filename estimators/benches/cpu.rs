@@ -49,9 +49,10 @@ fn run(bed: &dyn TestBed, id: &str, spp: u64, params: &Params, seed: u64) -> Mea
     }
     let cpu = thread_cpu_seconds() - t0;
     // FNV-1a over the bits of every channel of every estimate.
-    let hash = values.iter().flat_map(|v| v.0).fold(0xcbf2_9ce4_8422_2325u64, |h, x| {
-        (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3)
-    });
+    let hash = values
+        .iter()
+        .flat_map(|v| v.0)
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, x| (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3));
     let samples = tasks.iter().map(|t| t.costs().samples).sum();
     let diag = tasks.last().map(|t| t.diagnostics()).unwrap_or_default();
     (cpu, samples, diag, hash)

@@ -14,8 +14,8 @@ use estimators::math::{Rgb, Vec3};
 use estimators::media_smc::octree::Octree;
 use estimators::media_smc::walk::Vertex;
 use estimators::media_smc::{walk, MediaSmc, Sampling};
-use estimators::phase::Phase;
 use estimators::params::Params;
+use estimators::phase::Phase;
 use estimators::rng::stream;
 use estimators::task::Task;
 use estimators::testbeds::gradient_box::GradientBox;
@@ -52,15 +52,23 @@ fn media(c: &mut Criterion) {
         group.bench_function(format!("vertex_is1_cv2_depth{depth}"), |b| {
             b.iter(|| {
                 let p = Vec3::new(r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5);
-                let (v, w) =
-                    Vertex::read(&tree, p, dir, Sampling::Cache, ControlVariate::Bilinear, Phase::Isotropic, 0.8, &mut r);
+                let (v, w) = Vertex::read(
+                    &tree,
+                    p,
+                    dir,
+                    Sampling::Cache,
+                    ControlVariate::Bilinear,
+                    Phase::Isotropic,
+                    0.8,
+                    &mut r,
+                );
                 black_box(v.estimate_and_record(&mut tree, Rgb::splat(0.5 + 0.25 * w.z)))
             })
         });
     }
 
-    let est = MediaSmc::from_params("is1_cv2", Sampling::Cache, ControlVariate::Bilinear, &Params::new())
-            .expect("params");
+    let est =
+        MediaSmc::from_params("is1_cv2", Sampling::Cache, ControlVariate::Bilinear, &Params::new()).expect("params");
     group.throughput(Throughput::Elements(256 * 4));
     group.sample_size(20);
     let mut rng = stream(3, "bench is1_cv2");

@@ -113,7 +113,8 @@ fn smc_frame(c: &mut Criterion) {
         let mut rng = stream(5, id);
         group.bench_function(id, |b| {
             b.iter(|| {
-                let tasks: Vec<Task<'_>> = (first..first + FRAMES).map(|i| Task::new(bed.as_ref(), i, budget)).collect();
+                let tasks: Vec<Task<'_>> =
+                    (first..first + FRAMES).map(|i| Task::new(bed.as_ref(), i, budget)).collect();
                 black_box(est.estimate_sequence(&tasks, &mut rng).expect("estimates"))
             })
         });

@@ -50,7 +50,15 @@ impl CellSampler {
 
     /// A sampler over `coefficients` stored as `S`.
     pub fn new<S: Scalar>(coefficients: &[S]) -> Self {
-        let mut s = CellSampler { blocks: PartialSumTree::new(1), block: 1, cells: 0, scale: 1.0, cap: 1, cap_f64: 1.0, total: 0 };
+        let mut s = CellSampler {
+            blocks: PartialSumTree::new(1),
+            block: 1,
+            cells: 0,
+            scale: 1.0,
+            cap: 1,
+            cap_f64: 1.0,
+            total: 0,
+        };
         s.rebuild(coefficients);
         s
     }
