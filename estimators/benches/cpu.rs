@@ -109,8 +109,10 @@ fn main() {
         let n = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1000);
         return tracking(n, &args[2..]);
     }
-    let Some(mode) = args.first() else {
-        eprintln!("usage: cpu <media|surface|envmap> <spp|frames> <ids...> [storage=f32] [reps=K]");
+    // Run by `cargo bench -p estimators -- <criterion options>` (no mode, or an option's value
+    // first): nothing to measure.
+    let Some(mode) = args.first().filter(|m| ["media", "surface", "envmap"].contains(&m.as_str())) else {
+        eprintln!("usage: cpu <media|surface|envmap|tracking> <spp|frames|estimates> <ids...> [storage=f32] [reps=K]");
         return;
     };
     let size: u64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1024);
