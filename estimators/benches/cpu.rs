@@ -11,7 +11,7 @@
 //! ```
 //! Options after the ids: `storage=f32` (the caches' cell precision), `reps=K` (repeat K times,
 //! each line its own measurement), `res=R` (the image side of gradient-plane and envmap-sequence,
-//! default 16), any other `name=number` (an estimator parameter, e.g.
+//! default 16), `variant=V` (of envmap-sequence, default `mixed`), any other `name=number` (an estimator parameter, e.g.
 //! `candidates=256`). Media report CPU per path, surfaces per sample, envmap per pixel and frame
 //! (with `samples` = target evaluations).
 
@@ -119,6 +119,7 @@ fn main() {
     let mut params = Params::new();
     let mut reps = 1;
     let mut res = 16.0;
+    let mut variant = "mixed".to_string();
     let mut ids = Vec::new();
     for a in &args[2..] {
         match a.split_once('=') {
@@ -127,6 +128,7 @@ fn main() {
             }
             Some(("reps", v)) => reps = v.parse().expect("reps"),
             Some(("res", v)) => res = v.parse().expect("res"),
+            Some(("variant", v)) => variant = v.to_string(),
             Some((k, v)) => params = params.with(k, v.parse::<f64>().expect("a numeric parameter")),
             None => ids.push(a.clone()),
         }
@@ -141,7 +143,7 @@ fn main() {
         ),
         "envmap" => (
             (registry::testbed("envmap-sequence").unwrap().build)(
-                "mixed",
+                &variant,
                 &Params::new().with("resolution", res).with("frames", size as f64),
             )
             .expect("bed"),

@@ -163,7 +163,7 @@ impl Vertex {
             Sampling::Uniform => cache.sample_uniform(rng),
             Sampling::Cache => cache.sample(rng),
         };
-        // The reads of `g` (the cells around the drawn one) are issued before the direction's
+        // The reads of `g` (the cells around the drawn one) start before the direction's
         // trigonometry, which does not depend on them and so runs while they load.
         let g_l = cache.g(cv, draw.st);
         let big_g = cache.integral(cv) * ISOTROPIC;
