@@ -1,16 +1,21 @@
-//! Criterion benches of the medium SMC hot paths (SPEC §11, issue 4): one independent path in the
-//! gradient box (free flights + phase sampling), one octree leaf lookup at depth 3, and one
-//! `is1_cv2` estimate of a 16 x 16 gradient-box image at 4 spp (shared octree, 1024 paths).
-//! Run with `cargo bench -p estimators --bench media`.
+//! Criterion benches of the medium SMC hot paths (SPEC §11): one independent path in the
+//! gradient box (free flights + phase sampling), one octree leaf lookup at depth 3, one path
+//! vertex of the octree cache (`is1_cv2`: leaf lookup, cell sample, `G` and the bilinear `g`, the
+//! estimate and the record; paper 000 Fig. 2) on a full octree of depth 3 (512 leaves, 65 536
+//! cells: the structure of a 16x16 image at 1024 spp) and depth 4 (4096 leaves, 2.1 M cells: at
+//! 16 384 spp), and one `is1_cv2` estimate of a 16 x 16 gradient-box image at 4 spp (shared
+//! octree, 1024 paths). Run with `cargo bench -p estimators --bench media`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use estimators::budget::Budget;
-use estimators::cache::{CacheConfig, Domain};
+use estimators::cache::{CacheConfig, ControlVariate, Domain};
 use estimators::estimator::Estimator;
 use estimators::math::{Rgb, Vec3};
 use estimators::media_smc::octree::Octree;
+use estimators::media_smc::walk::Vertex;
 use estimators::media_smc::{walk, MediaSmc, Sampling};
 use estimators::params::Params;
+use estimators::phase::Phase;
 use estimators::rng::stream;
 use estimators::task::Task;
 use estimators::testbeds::gradient_box::GradientBox;
@@ -40,9 +45,30 @@ fn media(c: &mut Criterion) {
         })
     });
 
+    for depth in [3u32, 4] {
+        let mut tree = full_octree(depth);
+        let mut r = stream(4, "bench vertex");
+        let dir = Vec3::new(0.0, 1.0, 0.0);
+        group.bench_function(format!("vertex_is1_cv2_depth{depth}"), |b| {
+            b.iter(|| {
+                let p = Vec3::new(r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5);
+                let (v, w) = Vertex::read(
+                    &tree,
+                    p,
+                    dir,
+                    Sampling::Cache,
+                    ControlVariate::Bilinear,
+                    Phase::Isotropic,
+                    0.8,
+                    &mut r,
+                );
+                black_box(v.estimate_and_record(&mut tree, Rgb::splat(0.5 + 0.25 * w.z)))
+            })
+        });
+    }
+
     let est =
-        MediaSmc::from_params("is1_cv2", Sampling::Cache, estimators::cache::ControlVariate::Bilinear, &Params::new())
-            .expect("params");
+        MediaSmc::from_params("is1_cv2", Sampling::Cache, ControlVariate::Bilinear, &Params::new()).expect("params");
     group.throughput(Throughput::Elements(256 * 4));
     group.sample_size(20);
     let mut rng = stream(3, "bench is1_cv2");
@@ -53,6 +79,24 @@ fn media(c: &mut Criterion) {
         })
     });
     group.finish();
+}
+
+/// An octree split down to `depth` everywhere (criterion 1, `max_depth = depth`, so the vertex
+/// bench's records no longer refine it), with smooth records in every cell.
+fn full_octree(depth: u32) -> Octree<f64> {
+    let config =
+        CacheConfig { domain: Domain::Sphere, criterion: 1.0, max_depth: depth, counter_divisor: 32, importance: true };
+    let mut tree = Octree::<f64>::new(Vec3::default(), 0.5, config);
+    let mut r = stream(5, "bench full octree");
+    let leaves = 8usize.pow(depth);
+    while tree.stats().leaves < leaves {
+        for _ in 0..4096 {
+            let p = Vec3::new(r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5);
+            let st = estimators::cache::St { s: r.gen(), t: r.gen() };
+            tree.add_record(p, st, Rgb::splat(1.0 + st.t), Rgb::splat(0.5));
+        }
+    }
+    tree
 }
 
 criterion_group!(benches, media);

@@ -1,4 +1,4 @@
-//! Criterion bench of the single-scatter estimators (paper 002 §4.3, issue 6): one estimate of a
+//! Criterion bench of the single-scatter estimators (paper 002 §4.3): one estimate of a
 //! pixel near the light (4 spp, i.e. 4 primary rays) of `eq21-medium/single-scatter` by each of
 //! the seven ids of Fig. 12, and the nested-quadrature reference of that pixel.
 //! Run with `cargo bench -p estimators --bench single_scatter`.

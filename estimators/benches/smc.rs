@@ -1,9 +1,11 @@
-//! Criterion benches of the remaining SPEC §11 hot paths (issue 10 item 1): one partial-sum-tree
+//! Criterion benches of the remaining SPEC §11 hot paths: one partial-sum-tree
 //! sample and update (1024 leaves), one Metropolis-Hastings move of paper 004's mixture kernel on
 //! an environment map x Phong target, one resampling of N = 16 and N = 1024 particles (each
 //! scheme, from log weights: normalisation + ancestor draw), and one PMC-HI iteration (paper 003:
 //! a `pmc_hi` estimate whose budget is exactly one population of `2 m` samples on
-//! `checker-direct`). Run with `cargo bench -p estimators --bench smc`.
+//! `checker-direct`), and one frame of one pixel of the paper 004 estimators (`bidirectional_is`,
+//! `smc`, `smc_bridge`, `smc_path` at their defaults, N = 16: a 10-frame sequence of one pixel of
+//! `envmap-sequence` `mixed`, reported per frame). Run with `cargo bench -p estimators --bench smc`.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use estimators::brdf::Phong;
@@ -97,5 +99,29 @@ fn pmc_hi_iteration(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, partial_sum_tree, mh_move, resampling, pmc_hi_iteration);
+fn smc_frame(c: &mut Criterion) {
+    const FRAMES: usize = 10;
+    let entry = registry::testbed("envmap-sequence").expect("registered");
+    let params = Params::new().with("resolution", 4.0).with("frames", FRAMES as f64);
+    let bed = (entry.build)("mixed", &params).expect("bed");
+    let budget = Budget::samples(16).expect("budget");
+    // The sequence of the pixel at the image centre (integrals are pixel-major, frames inner).
+    let first = (2 * 4 + 2) * FRAMES;
+    let mut group = c.benchmark_group("smc_frame_one_pixel");
+    group.throughput(Throughput::Elements(FRAMES as u64));
+    for id in ["bidirectional_is", "smc", "smc_bridge", "smc_path"] {
+        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let mut rng = stream(5, id);
+        group.bench_function(id, |b| {
+            b.iter(|| {
+                let tasks: Vec<Task<'_>> =
+                    (first..first + FRAMES).map(|i| Task::new(bed.as_ref(), i, budget)).collect();
+                black_box(est.estimate_sequence(&tasks, &mut rng).expect("estimates"))
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, partial_sum_tree, mh_move, resampling, pmc_hi_iteration, smc_frame);
 criterion_main!(benches);

@@ -2,11 +2,15 @@
 //!
 //! A regular `ns x nt` grid over the `(s, t)` square of a [`Domain`] (cells of equal solid angle),
 //! cell `j * ns + i` covering `s in [i, i + 1) / ns`, `t in [j, j + 1) / nt`; row 0 touches the
-//! pole `t = 0`. Per cell (structure of arrays):
+//! pole `t = 0`. Per cell:
 //! - the RGB running mean of the cached integrand samples, the B-spline coefficients of `g`
 //!   (weights `1/(C+1)` and `C/(C+1)`, §4.1);
 //! - the scalar PDF coefficient, the running mean of the mean over channels of `|f - g|` (§4.2);
 //! - the record counter `C` (`u32`, saturating: 1e7 records into one cell are far from overflow).
+//!
+//! Layout: the RGB coefficients and the counter of a cell sit together (one [`Cell`]: a record
+//! reads and writes both, and `g` reads the RGB of the cells around the drawn one), the PDF
+//! coefficients in an array of their own (the cell sampler scans runs of them).
 //!
 //! The sum of all coefficients and the sums of the first and last rows (the polar values, §4.1)
 //! are kept current on every write with compensated sums (adding the new value and subtracting the
@@ -27,6 +31,16 @@ enum Sum {
     LastRow = 2,
 }
 
+/// The RGB coefficient and the counter of one cell: 16 bytes in single precision, 28 in double
+/// (packed to 4-byte alignment, so the double-precision cell keeps paper 001's 36 bytes with its
+/// PDF coefficient; fields are read and written by copy, never by reference).
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, packed(4))]
+struct Cell<S: Scalar> {
+    rgb: [S; 3],
+    count: u32,
+}
+
 /// The cells of one directional cache.
 #[derive(Clone, Debug)]
 pub struct Grid<S: Scalar> {
@@ -34,9 +48,10 @@ pub struct Grid<S: Scalar> {
     ns: usize,
     nt: usize,
     refinements: u32,
-    rgb: Vec<[S; 3]>,
+    /// `log2(ns)` when `ns` is a power of two (always, for the domains' grids): rows by shifts.
+    ns_shift: Option<u32>,
+    cells: Vec<Cell<S>>,
     pdf: Vec<S>,
-    count: Vec<u32>,
     records: u64,
     sums: [[NeumaierSum; 3]; 3],
 }
@@ -57,9 +72,9 @@ impl<S: Scalar> Grid<S> {
             ns,
             nt,
             refinements: 0,
-            rgb: vec![[S::default(); 3]; n],
+            ns_shift: ns.is_power_of_two().then(|| ns.trailing_zeros()),
+            cells: vec![Cell::default(); n],
             pdf: vec![S::default(); n],
-            count: vec![0; n],
             records: 0,
             sums: Default::default(),
         }
@@ -91,18 +106,29 @@ impl<S: Scalar> Grid<S> {
     }
 
     /// The cell containing `st` (the closed upper edges `s = 1`, `t = 1` belong to the last cells).
+    #[inline]
     pub fn cell_at(&self, st: St) -> usize {
-        let i = ((st.s * self.ns as f64) as usize).min(self.ns - 1);
-        let j = ((st.t * self.nt as f64) as usize).min(self.nt - 1);
+        let i = floor_index(st.s * self.ns as f64).min(self.ns - 1);
+        let j = floor_index(st.t * self.nt as f64).min(self.nt - 1);
         j * self.ns + i
     }
     /// Column `i` and row `j` of a cell.
+    #[inline]
     pub fn cell_ij(&self, cell: usize) -> (usize, usize) {
-        (cell % self.ns, cell / self.ns)
+        let j = self.row_of(cell);
+        (cell - j * self.ns, j)
+    }
+    #[inline]
+    fn row_of(&self, cell: usize) -> usize {
+        match self.ns_shift {
+            Some(k) => cell >> k,
+            None => cell / self.ns,
+        }
     }
     /// The RGB coefficient of a cell.
+    #[inline]
     pub fn radiance(&self, cell: usize) -> Rgb {
-        let c = &self.rgb[cell];
+        let c = self.cells[cell].rgb;
         Rgb([c[0].get(), c[1].get(), c[2].get()])
     }
     /// The RGB coefficient of column `i` (taken modulo `ns`: periodic in `s`) and row `j`.
@@ -117,9 +143,13 @@ impl<S: Scalar> Grid<S> {
     pub fn pdf_coefficients(&self) -> impl ExactSizeIterator<Item = f64> + Clone + '_ {
         self.pdf.iter().map(|p| p.get())
     }
+    /// The stored PDF coefficients, in cell order.
+    pub fn pdf_slice(&self) -> &[S] {
+        &self.pdf
+    }
     /// The record counter of a cell.
     pub fn count(&self, cell: usize) -> u32 {
-        self.count[cell]
+        self.cells[cell].count
     }
 
     fn sum(&self, which: Sum) -> Rgb {
@@ -143,14 +173,14 @@ impl<S: Scalar> Grid<S> {
     /// (the mean over channels of `|f - g|`) to the PDF coefficient, then increments the counter.
     /// Returns the new PDF coefficient.
     pub fn record(&mut self, cell: usize, f: Rgb, pdf_sample: f64) -> f64 {
-        let c = self.count[cell];
+        let Cell { mut rgb, count: c } = self.cells[cell];
         let w = 1.0 / (f64::from(c) + 1.0);
-        let j = cell / self.ns;
+        let j = self.row_of(cell);
         let (first, last) = (j == 0, j == self.nt - 1);
         for ch in 0..3 {
-            let old = self.rgb[cell][ch].get();
+            let old = rgb[ch].get();
             let stored = S::put(old + (f[ch] - old) * w);
-            self.rgb[cell][ch] = stored;
+            rgb[ch] = stored;
             let new = stored.get();
             let sums = &mut self.sums;
             sums[Sum::All as usize][ch].add(new);
@@ -167,10 +197,13 @@ impl<S: Scalar> Grid<S> {
         let old = self.pdf[cell].get();
         let new = S::put_positive(old + (pdf_sample - old) * w);
         self.pdf[cell] = new;
-        if c < u32::MAX {
-            self.count[cell] = c + 1;
+        let count = if c < u32::MAX {
             self.records += 1;
-        }
+            c + 1
+        } else {
+            c
+        };
+        self.cells[cell] = Cell { rgb, count };
         new.get()
     }
 
@@ -180,30 +213,30 @@ impl<S: Scalar> Grid<S> {
     pub fn refine(&mut self, divisor: u32) {
         let (ns, nt) = (2 * self.ns, 2 * self.nt);
         let n = ns * nt;
-        let mut rgb = Vec::with_capacity(n);
+        let mut cells = Vec::with_capacity(n);
         let mut pdf = Vec::with_capacity(n);
-        let mut count = Vec::with_capacity(n);
         for j in 0..nt {
             for i in 0..ns {
                 let parent = (j / 2) * self.ns + i / 2;
-                rgb.push(self.rgb[parent]);
+                let Cell { rgb, count: c } = self.cells[parent];
+                cells.push(Cell { rgb, count: if c == 0 { 0 } else { (c / divisor).max(1) } });
                 pdf.push(self.pdf[parent]);
-                let c = self.count[parent];
-                count.push(if c == 0 { 0 } else { (c / divisor).max(1) });
             }
         }
-        (self.ns, self.nt, self.rgb, self.pdf, self.count) = (ns, nt, rgb, pdf, count);
+        (self.ns, self.nt, self.cells, self.pdf) = (ns, nt, cells, pdf);
+        self.ns_shift = ns.is_power_of_two().then(|| ns.trailing_zeros());
         self.refinements += 1;
         self.resync();
     }
 
     /// Recomputes the counter total and the coefficient sums exactly from the cells, `O(N)`.
     pub fn resync(&mut self) {
-        self.records = self.count.iter().map(|&c| u64::from(c)).sum();
+        self.records = self.cells.iter().map(|c| u64::from(c.count)).sum();
         self.sums = Default::default();
-        for (cell, c) in self.rgb.iter().enumerate() {
+        for (cell, c) in self.cells.iter().enumerate() {
             let j = cell / self.ns;
-            for (ch, v) in c.iter().map(|x| x.get()).enumerate() {
+            let rgb = c.rgb;
+            for (ch, v) in rgb.iter().map(|x| x.get()).enumerate() {
                 self.sums[Sum::All as usize][ch].add(v);
                 if j == 0 {
                     self.sums[Sum::FirstRow as usize][ch].add(v);
@@ -220,9 +253,11 @@ impl<S: Scalar> Grid<S> {
     pub fn set_radiance(&mut self, cell: usize, v: Rgb) {
         let j = cell / self.ns;
         for ch in 0..3 {
-            let old = self.rgb[cell][ch].get();
-            self.rgb[cell][ch] = S::put(v[ch]);
-            let new = self.rgb[cell][ch].get();
+            let mut rgb = self.cells[cell].rgb;
+            let old = rgb[ch].get();
+            rgb[ch] = S::put(v[ch]);
+            let new = rgb[ch].get();
+            self.cells[cell].rgb = rgb;
             for (which, on) in [(Sum::All, true), (Sum::FirstRow, j == 0), (Sum::LastRow, j == self.nt - 1)] {
                 if on {
                     self.sums[which as usize][ch].add(new);
@@ -233,10 +268,18 @@ impl<S: Scalar> Grid<S> {
     }
 
     /// Bytes of cell storage: RGB, PDF coefficient and counter per cell (the quantity of paper 001
-    /// Table 1: 36 bytes per cell in double precision, 20 in single).
+    /// Table 1): 36 bytes per cell in double precision, 20 in single.
     pub fn cell_bytes(&self) -> usize {
-        self.cells() * (4 * std::mem::size_of::<S>() + std::mem::size_of::<u32>())
+        self.cells() * (std::mem::size_of::<Cell<S>>() + std::mem::size_of::<S>())
     }
+}
+
+/// `x as usize` (truncation, 0 for negative and NaN, saturating above) for the `x` of a cell
+/// index: the same value below `2^63` in fewer instructions (a signed conversion, no unsigned
+/// fix-up); callers clamp to the grid, where larger values end up too.
+#[inline]
+pub(crate) fn floor_index(x: f64) -> usize {
+    x.max(0.0) as i64 as usize
 }
 
 #[cfg(test)]

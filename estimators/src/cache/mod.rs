@@ -5,23 +5,26 @@
 //! - [`grid`]: the cells (RGB running means, PDF coefficients, counters), the maintained sums and
 //!   refinement;
 //! - [`reconstruction`]: the control variates `g` (cv1, cv2) and their integrals `G`;
-//! - [`partial_sum_tree`]: the flat `2N - 1` tree that samples cells for `is1`;
+//! - [`cell_sampler`]: samples cells for `is1` (sums of blocks of cells in a flat
+//!   [`partial_sum_tree`], the cells' weights recomputed from the coefficients);
 //! - [`domain`]: the equal-solid-angle `(s, t)` parameterisations;
 //! - [`storage`]: the precision switch.
 //!
 //! The cache PDF (`is1`, §4.2) picks a cell with probability proportional to its PDF coefficient
-//! and then a point uniformly inside it (order 0). The tree holds the coefficients quantised to
-//! integers, `q = floor(coefficient * scale) + 1`: integer partial sums are exact, so the
+//! and then a point uniformly inside it (order 0). The [`cell_sampler`] quantises the coefficients
+//! to integers, `q = floor(coefficient * scale) + 1`: integer partial sums are exact, so the
 //! probability the cache reports is exactly the one it samples with, and a positive coefficient
 //! always gives `q >= 1`, so the inheritance rule (§4.3) carries over to the sampled density. The
 //! scale is chosen afresh at every refinement and whenever the coefficients drift far from it.
 
+pub mod cell_sampler;
 pub mod domain;
 pub mod grid;
 pub mod partial_sum_tree;
 pub mod reconstruction;
 pub mod storage;
 
+pub use cell_sampler::CellSampler;
 pub use domain::{Domain, St};
 pub use grid::Grid;
 pub use partial_sum_tree::PartialSumTree;
@@ -67,63 +70,20 @@ pub struct CacheSample {
     pub pdf: f64,
 }
 
-/// The sampling tree with its quantisation of the PDF coefficients.
-#[derive(Clone, Debug)]
-struct Tree {
-    tree: PartialSumTree,
-    scale: f64,
-    /// Largest allowed leaf: keeps the total below 2^62.
-    cap: u64,
-}
-
-impl Tree {
-    /// Headroom (as a power of two) between the largest leaf after a rescale and the cap.
-    const HEADROOM_BITS: u32 = 12;
-    /// A rescale is due when the total falls this many powers of two below the target.
-    const DRIFT_BITS: u32 = 16;
-
-    fn target(&self) -> u64 {
-        self.cap >> Self::HEADROOM_BITS
-    }
-    /// `floor(coefficient * scale) + 1` for a positive coefficient (so never 0), 0 otherwise;
-    /// `None` above the cap.
-    fn quantise(&self, coefficient: f64) -> Option<u64> {
-        if coefficient <= 0.0 {
-            return Some(0);
-        }
-        let x = coefficient * self.scale;
-        (x < self.cap as f64).then(|| x as u64 + 1)
-    }
-    /// Rebuilds from the coefficients with a scale mapping the largest one to the target.
-    fn rebuild(&mut self, coefficients: impl ExactSizeIterator<Item = f64> + Clone) {
-        let n = coefficients.len();
-        if self.tree.leaves() != n {
-            self.tree = PartialSumTree::new(n);
-        }
-        self.cap = (1u64 << 62) / n as u64;
-        let max = coefficients.clone().fold(0.0f64, f64::max);
-        self.scale = if max > 0.0 { self.target() as f64 / max } else { 1.0 };
-        let leaves: Vec<u64> = coefficients.map(|c| self.quantise(c).unwrap_or(self.cap)).collect();
-        self.tree.rebuild(&leaves);
-    }
-}
-
 /// An adaptive directional radiance cache (see the module documentation).
 #[derive(Clone, Debug)]
 pub struct RadianceCache<S: Scalar> {
     config: CacheConfig,
     grid: Grid<S>,
-    tree: Option<Tree>,
+    tree: Option<CellSampler>,
 }
 
 impl<S: Scalar> RadianceCache<S> {
     /// An empty cache at the domain's initial resolution.
     pub fn new(config: CacheConfig) -> Self {
         let grid = Grid::new(config.domain);
-        let tree = config.importance.then(|| Tree { tree: PartialSumTree::new(grid.cells()), scale: 1.0, cap: 1 });
-        let mut cache = RadianceCache { config, grid, tree };
-        cache.rebuild_tree();
-        cache
+        let tree = config.importance.then(|| CellSampler::new(grid.pdf_slice()));
+        RadianceCache { config, grid, tree }
     }
     /// The configuration.
     pub fn config(&self) -> &CacheConfig {
@@ -148,8 +108,8 @@ impl<S: Scalar> RadianceCache<S> {
 
     /// Whether [`RadianceCache::sample`] uses the cache PDF: only with a tree, after the first
     /// refinement (before it "the PDF is not relevant", paper 001 §4.3: uniform sampling).
-    fn tree_active(&self) -> Option<&Tree> {
-        self.tree.as_ref().filter(|t| self.grid.refinements() > 0 && t.tree.total() > 0)
+    fn tree_active(&self) -> Option<&CellSampler> {
+        self.tree.as_ref().filter(|t| self.grid.refinements() > 0 && t.total() > 0)
     }
 
     /// A direction drawn uniformly over the domain.
@@ -164,22 +124,27 @@ impl<S: Scalar> RadianceCache<S> {
         let Some(tree) = self.tree_active() else {
             return self.sample_uniform(rng);
         };
-        let cell = tree.tree.sample(rng).expect("an active tree has a positive total");
+        let cell = tree.sample(self.grid.pdf_slice(), rng).expect("an active tree has a positive total");
         let (i, j) = self.grid.cell_ij(cell);
         let (ns, nt) = self.grid.resolution();
         let st = St { s: (i as f64 + rng.gen::<f64>()) / ns as f64, t: (j as f64 + rng.gen::<f64>()) / nt as f64 };
         CacheSample { st, cell, pdf: self.cell_density(tree, cell) }
     }
 
-    fn cell_density(&self, tree: &Tree, cell: usize) -> f64 {
+    fn cell_density(&self, tree: &CellSampler, cell: usize) -> f64 {
         let (ns, nt) = self.grid.resolution();
-        tree.tree.probability(cell) / self.domain().cell_solid_angle(ns, nt)
+        tree.probability(self.grid.pdf_coefficient(cell)) / self.domain().cell_solid_angle(ns, nt)
     }
 
     /// The density of [`RadianceCache::sample`] at `st` per unit solid angle.
     pub fn pdf(&self, st: St) -> f64 {
+        self.pdf_of_cell(self.grid.cell_at(st))
+    }
+
+    /// The density of [`RadianceCache::sample`] per unit solid angle in cell `cell`.
+    pub fn pdf_of_cell(&self, cell: usize) -> f64 {
         match self.tree_active() {
-            Some(tree) => self.cell_density(tree, self.grid.cell_at(st)),
+            Some(tree) => self.cell_density(tree, cell),
             None => 1.0 / self.domain().measure(),
         }
     }
@@ -190,13 +155,12 @@ impl<S: Scalar> RadianceCache<S> {
     pub fn add_record(&mut self, cell: usize, f: Rgb, g: Rgb) -> bool {
         let d = f - g;
         let pdf_sample = (d[0].abs() + d[1].abs() + d[2].abs()) / 3.0;
+        let old = self.grid.pdf_coefficient(cell);
         let coefficient = self.grid.record(cell, f, pdf_sample);
         if let Some(tree) = &mut self.tree {
             // Rescale when the coefficient overflows the cap or the total drifted far below target.
-            let fits = tree.quantise(coefficient).filter(|_| tree.tree.total() >= tree.target() >> Tree::DRIFT_BITS);
-            match fits {
-                Some(q) => tree.tree.set(cell, q),
-                None => self.rebuild_tree(),
+            if !tree.update(cell, old, coefficient) {
+                self.rebuild_tree();
             }
         }
         self.refine_if_due()
@@ -229,13 +193,13 @@ impl<S: Scalar> RadianceCache<S> {
 
     fn rebuild_tree(&mut self) {
         if let Some(tree) = &mut self.tree {
-            tree.rebuild(self.grid.pdf_coefficients());
+            tree.rebuild(self.grid.pdf_slice());
         }
     }
 
     /// Heap bytes held: the cells plus the tree.
     pub fn bytes(&self) -> usize {
-        self.grid.cell_bytes() + self.tree.as_ref().map_or(0, |t| t.tree.bytes())
+        self.grid.cell_bytes() + self.tree.as_ref().map_or(0, |t| t.bytes())
     }
 }
 

@@ -86,7 +86,12 @@ impl PartialSumTree {
         if total == 0 {
             return None;
         }
-        let mut x = rng.gen_range(0..total);
+        Some(self.find(rng.gen_range(0..total)).0)
+    }
+    /// The leaf whose range of the cumulative sums holds `x < total`, and `x` minus the sum of the
+    /// leaves before it in the descent (the offset inside that leaf's range).
+    #[inline]
+    pub fn find(&self, mut x: u64) -> (usize, u64) {
         let mut k = 0;
         while k < self.leaves - 1 {
             let left = self.nodes[2 * k + 1];
@@ -97,7 +102,7 @@ impl PartialSumTree {
                 k = 2 * k + 2;
             }
         }
-        Some(k - (self.leaves - 1))
+        (k - (self.leaves - 1), x)
     }
     /// Heap bytes held.
     pub fn bytes(&self) -> usize {

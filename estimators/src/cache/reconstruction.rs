@@ -19,7 +19,7 @@
 //! `O(1)` reads.
 
 use super::domain::St;
-use super::grid::Grid;
+use super::grid::{floor_index, Grid};
 use super::storage::Scalar;
 use crate::math::Rgb;
 
@@ -73,7 +73,12 @@ fn bilinear<S: Scalar>(grid: &Grid<S>, st: St) -> Rgb {
     let (ns, nt) = grid.resolution();
     // Columns of the two centres around s, wrapping at the periodic seam (x >= -1/2, no modulo).
     let x = st.s * ns as f64 - 0.5;
-    let (i0, fx) = if x < 0.0 { (ns - 1, x + 1.0) } else { ((x as usize).min(ns - 1), x - (x as usize) as f64) };
+    let (i0, fx) = if x < 0.0 {
+        (ns - 1, x + 1.0)
+    } else {
+        let i = floor_index(x);
+        (i.min(ns - 1), x - i as f64)
+    };
     let i1 = if i0 + 1 == ns { 0 } else { i0 + 1 };
     let row = |j: usize| {
         let base = j * ns;
@@ -90,7 +95,7 @@ fn bilinear<S: Scalar>(grid: &Grid<S>, st: St) -> Rgb {
         let edge = if grid.domain().has_bottom_pole() { grid.last_polar() } else { Rgb::ZERO };
         row(nt - 1) * (1.0 - w) + edge * w
     } else {
-        let j0 = y as usize;
+        let j0 = floor_index(y);
         let fy = y - j0 as f64;
         row(j0) * (1.0 - fy) + row(j0 + 1) * fy
     }

@@ -15,14 +15,15 @@ use crate::math::{Rgb, Vec3};
 /// Counters are divided by the dimensionality of a split: 2 x 2 directional x 8 spatial = 32.
 pub const SPLIT_DIVISOR: u32 = 32;
 
-#[derive(Clone, Debug)]
-struct Node<S: Scalar> {
+/// One node, 32 bytes, so the descent of [`Octree::leaf_of`] walks a compact array (the caches
+/// live apart, in [`Octree::caches`]).
+#[derive(Clone, Copy, Debug)]
+struct Node {
     center: Vec3,
-    half: f64,
-    depth: u32,
     /// Index of the first of eight consecutive children, 0 for a leaf.
-    children: usize,
-    cache: Option<RadianceCache<S>>,
+    children: u32,
+    /// A leaf's cache (index into the caches), unused for an inner node.
+    cache: u32,
 }
 
 /// The size report of paper 000 Table 1.
@@ -43,7 +44,11 @@ pub struct OctreeStats {
 /// The octree of spherical caches over an axis-aligned cube.
 #[derive(Clone, Debug)]
 pub struct Octree<S: Scalar> {
-    nodes: Vec<Node<S>>,
+    nodes: Vec<Node>,
+    /// Depth of each node (root = 0); the half-size is `half / 2^depth`.
+    depths: Vec<u8>,
+    half: f64,
+    caches: Vec<RadianceCache<S>>,
     leaves: usize,
     cells: usize,
     depth: u32,
@@ -57,7 +62,10 @@ impl<S: Scalar> Octree<S> {
         let cache = RadianceCache::new(config);
         let cells = cache.grid().cells();
         Octree {
-            nodes: vec![Node { center, half, depth: 0, children: 0, cache: Some(cache) }],
+            nodes: vec![Node { center, children: 0, cache: 0 }],
+            depths: vec![0],
+            half,
+            caches: vec![cache],
             leaves: 1,
             cells,
             depth: 0,
@@ -67,18 +75,32 @@ impl<S: Scalar> Octree<S> {
     /// The index of the leaf containing `p` (points outside are clamped to the nearest leaf),
     /// `O(depth)`.
     pub fn leaf_of(&self, p: Vec3) -> usize {
-        let mut i = 0;
-        while self.nodes[i].children != 0 {
-            let c = self.nodes[i].center;
+        self.leaf_below(0, p)
+    }
+
+    /// The leaf containing `p` among the descendants of node `i` (which must contain `p`, or be
+    /// the root): the descent from the root passes through `i`, so this is [`Octree::leaf_of`].
+    #[inline]
+    fn leaf_below(&self, mut i: usize, p: Vec3) -> usize {
+        loop {
+            let n = &self.nodes[i];
+            if n.children == 0 {
+                return i;
+            }
+            let c = n.center;
             let k = usize::from(p.x >= c.x) | usize::from(p.y >= c.y) << 1 | usize::from(p.z >= c.z) << 2;
-            i = self.nodes[i].children + k;
+            i = n.children as usize + k;
         }
-        i
+    }
+
+    /// The cache of leaf `leaf`.
+    pub fn cache_of(&self, leaf: usize) -> &RadianceCache<S> {
+        &self.caches[self.nodes[leaf].cache as usize]
     }
 
     /// The cache of the leaf containing `p`.
     pub fn cache_at(&self, p: Vec3) -> &RadianceCache<S> {
-        self.nodes[self.leaf_of(p)].cache.as_ref().expect("leaves hold caches")
+        self.cache_of(self.leaf_of(p))
     }
 
     /// Adds the record of incoming radiance `radiance` from direction `st` at `p`, with `g` the
@@ -87,9 +109,26 @@ impl<S: Scalar> Octree<S> {
     /// refined; returns whether it did.
     pub fn add_record(&mut self, p: Vec3, st: St, radiance: Rgb, g: Rgb) -> bool {
         let leaf = self.leaf_of(p);
-        let cache = self.nodes[leaf].cache.as_mut().expect("leaves hold caches");
+        let cell = self.cache_of(leaf).grid().cell_at(st);
+        self.record_in(leaf, cell, radiance, g)
+    }
+
+    /// [`Octree::add_record`] for a vertex that read its snapshot from leaf `leaf` and drew cell
+    /// `cell` there: when that leaf has not split since, the record goes to the same cell without a
+    /// second descent; otherwise the descent resumes at `leaf` (whose children tile it). The cell
+    /// and leaf are the ones [`Octree::add_record`] finds, so the result is the same.
+    pub fn add_record_from(&mut self, leaf: usize, cell: usize, p: Vec3, st: St, radiance: Rgb, g: Rgb) -> bool {
+        if self.nodes[leaf].children == 0 {
+            return self.record_in(leaf, cell, radiance, g);
+        }
+        let leaf = self.leaf_below(leaf, p);
+        let cell = self.cache_of(leaf).grid().cell_at(st);
+        self.record_in(leaf, cell, radiance, g)
+    }
+
+    fn record_in(&mut self, leaf: usize, cell: usize, radiance: Rgb, g: Rgb) -> bool {
+        let cache = &mut self.caches[self.nodes[leaf].cache as usize];
         let before = cache.grid().cells();
-        let cell = cache.grid().cell_at(st);
         if !cache.add_record(cell, radiance, g) {
             return false;
         }
@@ -98,64 +137,79 @@ impl<S: Scalar> Octree<S> {
         true
     }
 
-    /// Replaces leaf `i` by eight children, each holding a copy of its (already doubled) cache.
+    /// Replaces leaf `i` by eight children, each holding a copy of its (already doubled) cache: the
+    /// first child keeps the leaf's cache, the seven others get clones appended.
     fn split(&mut self, i: usize) {
-        let cache = self.nodes[i].cache.take().expect("leaves hold caches");
-        let (center, half, depth) = (self.nodes[i].center, self.nodes[i].half, self.nodes[i].depth + 1);
+        let slot = self.nodes[i].cache;
+        let (center, depth) = (self.nodes[i].center, self.depths[i] + 1);
         let first = self.nodes.len();
-        let h = half / 2.0;
+        let h = self.half / f64::from(1u32 << depth);
         for k in 0..8 {
             let sign = |bit: usize| if k >> bit & 1 == 1 { h } else { -h };
             let c = Vec3::new(center.x + sign(0), center.y + sign(1), center.z + sign(2));
-            self.nodes.push(Node { center: c, half: h, depth, children: 0, cache: Some(cache.clone()) });
+            let cache = if k == 0 {
+                slot
+            } else {
+                self.caches.push(self.caches[slot as usize].clone());
+                (self.caches.len() - 1) as u32
+            };
+            self.nodes.push(Node { center: c, children: 0, cache });
+            self.depths.push(depth);
         }
-        self.nodes[i].children = first;
+        self.nodes[i].children = u32::try_from(first).expect("fewer than 2^32 nodes");
         self.leaves += 7;
-        self.cells += 7 * cache.grid().cells();
-        self.depth = self.depth.max(depth);
+        self.cells += 7 * self.caches[slot as usize].grid().cells();
+        self.depth = self.depth.max(u32::from(depth));
     }
 
     /// The Table 1 report, `O(1)` except for the bytes (`O(leaves)`).
     pub fn stats(&self) -> OctreeStats {
-        let cache_bytes: usize = self.nodes.iter().filter_map(|n| n.cache.as_ref()).map(|c| c.bytes()).sum();
+        let cache_bytes: usize = self.caches.iter().map(|c| c.bytes() + std::mem::size_of::<RadianceCache<S>>()).sum();
         OctreeStats {
             depth: self.depth,
             nodes: self.nodes.len(),
             leaves: self.leaves,
             cells: self.cells,
-            bytes: cache_bytes + self.nodes.len() * std::mem::size_of::<Node<S>>(),
+            bytes: cache_bytes + self.nodes.len() * (std::mem::size_of::<Node>() + 1),
         }
     }
 
-    /// Checks the structural invariants (tests): children tile their parent, only leaves hold
-    /// caches, a leaf at depth `d` has `2 x 4^d` cells, the counts are consistent.
+    /// Checks the structural invariants (tests): children tile their parent, every leaf owns one
+    /// cache and no two leaves share one, a leaf at depth `d` has `2 x 4^d` cells, the counts are
+    /// consistent.
     pub fn check_invariants(&self) -> Result<(), String> {
         let (mut leaves, mut cells) = (0, 0);
+        let mut owner = vec![usize::MAX; self.caches.len()];
         for (i, n) in self.nodes.iter().enumerate() {
-            match (&n.cache, n.children) {
-                (Some(c), 0) => {
-                    leaves += 1;
-                    cells += c.grid().cells();
-                    if c.grid().cells() != 2 << (2 * n.depth) {
-                        return Err(format!("leaf {i} at depth {} has {} cells", n.depth, c.grid().cells()));
+            let (depth, first) = (u32::from(self.depths[i]), n.children as usize);
+            if first == 0 {
+                let slot = n.cache as usize;
+                if slot >= self.caches.len() || owner[slot] != usize::MAX {
+                    return Err(format!("leaf {i} has cache {slot}, missing or shared"));
+                }
+                owner[slot] = i;
+                leaves += 1;
+                let c = &self.caches[slot];
+                cells += c.grid().cells();
+                if c.grid().cells() != 2 << (2 * depth) {
+                    return Err(format!("leaf {i} at depth {depth} has {} cells", c.grid().cells()));
+                }
+            } else if first > i {
+                let half = self.half / f64::from(1u32 << depth);
+                for k in 0..8 {
+                    let ch = &self.nodes[first + k];
+                    let off = ch.center - n.center;
+                    let ok = u32::from(self.depths[first + k]) == depth + 1
+                        && [off.x, off.y, off.z].iter().all(|o| (o.abs() - half / 2.0).abs() < 1e-15);
+                    if !ok {
+                        return Err(format!("child {k} of node {i} does not tile it"));
                     }
                 }
-                (None, first) if first > i => {
-                    for k in 0..8 {
-                        let ch = &self.nodes[first + k];
-                        let off = ch.center - n.center;
-                        let ok = (ch.half - n.half / 2.0).abs() < 1e-15
-                            && ch.depth == n.depth + 1
-                            && [off.x, off.y, off.z].iter().all(|o| (o.abs() - ch.half).abs() < 1e-15);
-                        if !ok {
-                            return Err(format!("child {k} of node {i} does not tile it"));
-                        }
-                    }
-                }
-                _ => return Err(format!("node {i} is neither a leaf with a cache nor an inner node")),
+            } else {
+                return Err(format!("node {i} points to children before it"));
             }
         }
-        if leaves != self.leaves || cells != self.cells {
+        if leaves != self.leaves || cells != self.cells || leaves != self.caches.len() {
             return Err(format!("counts {leaves}/{cells} vs maintained {}/{}", self.leaves, self.cells));
         }
         Ok(())

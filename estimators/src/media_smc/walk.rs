@@ -12,7 +12,7 @@
 use super::octree::Octree;
 use crate::cache::{ControlVariate, Scalar, St};
 use crate::math::{Rgb, Vec3};
-use crate::phase::ISOTROPIC;
+use crate::phase::{Phase, ISOTROPIC};
 use crate::task::MediumProbe;
 use rand::Rng;
 
@@ -127,6 +127,10 @@ pub enum Sampling {
 pub struct Vertex {
     pos: Vec3,
     st: St,
+    /// The leaf the snapshot was read from and the cell of `st` there (the record goes to the
+    /// same place unless the leaf has split since).
+    leaf: usize,
+    cell: usize,
     /// `G` (cached radiance integral times the isotropic phase).
     big_g: Rgb,
     /// Cached radiance `g_L` at the direction (the control variate is `g_L / 4 pi`).
@@ -134,6 +138,62 @@ pub struct Vertex {
     pdf: f64,
     phase: f64,
     factor: f64,
+}
+
+impl Vertex {
+    /// The forward half of a vertex at collision `x` reached along `dir` (paper 000 Fig. 2,
+    /// lines 5-9): find the leaf, draw the direction from its cache, read the snapshot `G` and
+    /// `g`. `factor` is the albedo weight the vertex's estimate is multiplied by. Returns the
+    /// vertex and the drawn direction.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn read<S: Scalar, R: Rng + ?Sized>(
+        tree: &Octree<S>,
+        x: Vec3,
+        dir: Vec3,
+        sampling: Sampling,
+        cv: ControlVariate,
+        phase: Phase,
+        factor: f64,
+        rng: &mut R,
+    ) -> (Self, Vec3) {
+        let leaf = tree.leaf_of(x);
+        let cache = tree.cache_of(leaf);
+        let draw = match sampling {
+            Sampling::Uniform => cache.sample_uniform(rng),
+            Sampling::Cache => cache.sample(rng),
+        };
+        // The reads of `g` (the cells around the drawn one) start before the direction's
+        // trigonometry, which does not depend on them and so runs while they load.
+        let g_l = cache.g(cv, draw.st);
+        let big_g = cache.integral(cv) * ISOTROPIC;
+        let w = cache.domain().direction(draw.st);
+        let v = Vertex {
+            pos: x,
+            st: draw.st,
+            leaf,
+            // The cell the record would find (a drawn point at the far edge of its cell may
+            // round into the next one).
+            cell: cache.grid().cell_at(draw.st),
+            big_g,
+            g_l,
+            pdf: draw.pdf,
+            phase: phase.eval(dir.dot(w)),
+            factor,
+        };
+        (v, w)
+    }
+
+    /// The backward half (Fig. 2, lines 11-13): the estimate `L_i = G + (f - g) / p` with
+    /// `f = radiance * phase` from the snapshot, then the record of `radiance` in the leaf now
+    /// containing the vertex (which may refine and split). Returns `L_i` times the vertex's factor.
+    #[inline]
+    pub fn estimate_and_record<S: Scalar>(self, tree: &mut Octree<S>, radiance: Rgb) -> Rgb {
+        // `pdf > 0`: uniform, or a cell the sampler can only draw with weight >= 1.
+        let li = self.big_g + (radiance * self.phase - self.g_l * ISOTROPIC) / self.pdf;
+        tree.add_record_from(self.leaf, self.cell, self.pos, self.st, radiance, self.g_l);
+        li * self.factor
+    }
 }
 
 /// One SMC path (paper 000 Fig. 2 with Eq. 7, unrolled so thick media need no deep recursion):
@@ -170,31 +230,15 @@ pub fn smc_path<S: Scalar, R: Rng + ?Sized>(
                     Transport::RayMarching(_) => w,
                 };
 
-                let cache = tree.cache_at(x);
-                let draw = match sampling {
-                    Sampling::Uniform => cache.sample_uniform(rng),
-                    Sampling::Cache => cache.sample(rng),
-                };
-                let w = cache.domain().direction(draw.st);
-                vertices.push(Vertex {
-                    pos: x,
-                    st: draw.st,
-                    big_g: cache.integral(cv) * ISOTROPIC,
-                    g_l: cache.g(cv, draw.st),
-                    pdf: draw.pdf,
-                    phase: phase.eval(dir.dot(w)),
-                    factor,
-                });
+                let (v, w) = Vertex::read(tree, x, dir, sampling, cv, phase, factor, rng);
+                vertices.push(v);
                 pos = x;
                 dir = w;
             }
         }
     };
     while let Some(v) = vertices.pop() {
-        // `pdf > 0`: uniform, or a partial-sum-tree leaf that can only be drawn with weight >= 1.
-        let li = v.big_g + (radiance * v.phase - v.g_l * ISOTROPIC) / v.pdf;
-        tree.add_record(v.pos, v.st, radiance, v.g_l);
-        radiance = li * v.factor;
+        radiance = v.estimate_and_record(tree, radiance);
     }
     radiance
 }

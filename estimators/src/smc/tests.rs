@@ -168,7 +168,7 @@ fn every_incremental_weight_zero_falls_back_without_nan() {
     }
 }
 
-/// SPEC §10 / issue 8 stability: sun dynamic range above 1e6 and 30 degree rotations per frame;
+/// SPEC §10 stability: sun dynamic range above 1e6 and 30 degree rotations per frame;
 /// every estimator returns finite estimates, and the unbiased ones stay unbiased.
 #[test]
 fn stable_under_a_1e6_sun_and_30_degree_rotations() {

@@ -130,13 +130,15 @@ impl SmcSurface {
 
     /// One sample: draw, evaluate, estimate from the snapshot, then record (and maybe refine).
     fn step<S: Scalar>(&self, state: &mut State<S>, probe: &HemisphereProbe<'_>, rng: &mut StreamRng) -> Rgb {
+        if self.sampling == Sampling::BrdfTracked {
+            return self.tracked_step(state, probe, rng);
+        }
         let cache = &mut state.cache;
         let domain = cache.domain();
         let big_g = cache.integral(self.cv);
         let draw = match self.sampling {
             Sampling::Uniform => cache.sample_uniform(rng),
-            Sampling::Cache => cache.sample(rng),
-            Sampling::BrdfTracked => return self.tracked_step(state, probe, rng),
+            _ => cache.sample(rng),
         };
         // `draw.pdf > 0`: uniform, or a tree leaf that can only be drawn when its weight is >= 1.
         let f = probe.integrand(state.frame.to_world(domain.direction(draw.st)));
@@ -164,20 +166,21 @@ impl SmcSurface {
         let brdf = &point.brdf;
         let big_g = cache.integral(self.cv);
         let use_smc = state.tracker.prefers_smc();
+        // The drawn direction, its parameters and cell (the one the record goes to), both pdfs.
         let (w, st, p_cache, p_brdf) = if use_smc {
             let s = cache.sample(rng);
             let w = state.frame.to_world(domain.direction(s.st));
-            (w, Some(s.st), s.pdf, brdf.pdf(w, point.wo, point.normal))
+            (w, Some((s.st, cache.grid().cell_at(s.st))), s.pdf, brdf.pdf(w, point.wo, point.normal))
         } else {
             let d = brdf.sample(point.wo, point.normal, rng);
             // Below the horizon the direction is outside the cache's domain (and f = 0 there).
-            let st = domain.st_of(state.frame.to_local(d.w));
-            (d.w, st, st.map_or(0.0, |st| cache.pdf(st)), d.pdf)
+            let st = domain.st_of(state.frame.to_local(d.w)).map(|st| (st, cache.grid().cell_at(st)));
+            (d.w, st, st.map_or(0.0, |(_, cell)| cache.pdf_of_cell(cell)), d.pdf)
         };
         let f = probe.integrand(w);
         let (smc, g) = match st {
             // p_cache > 0 on the whole hemisphere (uniform, or every tree leaf >= 1).
-            Some(st) if p_cache > 0.0 => {
+            Some((st, _)) if p_cache > 0.0 => {
                 let g = cache.g(self.cv, st);
                 (big_g + (f - g) / p_cache, g)
             }
@@ -189,8 +192,7 @@ impl SmcSurface {
         let chosen = if use_smc { smc } else { mcmc };
         state.tracker.update(smc, mcmc, chosen);
         state.smc_chosen += u64::from(use_smc);
-        if let Some(st) = st {
-            let cell = cache.grid().cell_at(st);
+        if let Some((_, cell)) = st {
             cache.add_record(cell, f, g);
         }
         chosen
