@@ -65,7 +65,12 @@ fn run(bed: &dyn TestBed, id: &str, spp: u64, params: &Params, seed: u64) -> Mea
 /// made dependent on the previous fetch.
 fn tracking(estimates: u64, ids: &[String]) {
     use rand::Rng;
-    let bed = (registry::testbed("eq21-medium").unwrap().build)("central-ray", &Params::new()).expect("bed");
+    let bed = (registry::testbed("eq21-medium").unwrap().build)(
+        "central-ray",
+        &Params::new(),
+        &estimators::references::NoReferences,
+    )
+    .expect("bed");
     for id in ids {
         let (t0, fetches) = if id == "bare" || id == "bare_chained" {
             let scene = bed.medium().expect("medium");
@@ -136,8 +141,12 @@ fn main() {
     let (bed, spp, per): (Box<dyn TestBed>, u64, &str) = match mode.as_str() {
         "media" => (Box::new(GradientBox::without_reference("albedo-0.8", &Params::new()).expect("bed")), size, "path"),
         "surface" => (
-            (registry::testbed("gradient-plane").unwrap().build)("default", &Params::new().with("resolution", res))
-                .expect("bed"),
+            (registry::testbed("gradient-plane").unwrap().build)(
+                "default",
+                &Params::new().with("resolution", res),
+                &estimators::references::NoReferences,
+            )
+            .expect("bed"),
             size,
             "sample",
         ),
@@ -145,6 +154,7 @@ fn main() {
             (registry::testbed("envmap-sequence").unwrap().build)(
                 &variant,
                 &Params::new().with("resolution", res).with("frames", size as f64),
+                &estimators::references::NoReferences,
             )
             .expect("bed"),
             16,

@@ -103,7 +103,7 @@ fn smc_frame(c: &mut Criterion) {
     const FRAMES: usize = 10;
     let entry = registry::testbed("envmap-sequence").expect("registered");
     let params = Params::new().with("resolution", 4.0).with("frames", FRAMES as f64);
-    let bed = (entry.build)("mixed", &params).expect("bed");
+    let bed = (entry.build)("mixed", &params, &estimators::references::NoReferences).expect("bed");
     let budget = Budget::samples(16).expect("budget");
     // The sequence of the pixel at the image centre (integrals are pixel-major, frames inner).
     let first = (2 * 4 + 2) * FRAMES;
