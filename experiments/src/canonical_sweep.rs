@@ -17,11 +17,9 @@
 //! each at every ratio; `residual-cv-linear` / `residual-cv-mean` (residual ratio tracking, its own
 //! adaptive sigma_samp) and `ray-marching` (the biased control, step 0.5) once per test bed.
 
-use crate::{available, ExperimentDef};
-use estimators::budget::{Budget, BudgetKind};
+use crate::ExperimentDef;
 use estimators::params::{ParamValue, Params};
-use estimators::testbeds::canonical_1d::VARIANTS;
-use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
+use mcbench::config::{EstimatorSpec, Mode};
 
 /// Sampling density ratios `sigma_samp / max sigma_t`.
 pub const RATIOS: [f64; 8] = [0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0];
@@ -116,47 +114,9 @@ pub fn sizes(mode: Mode) -> (u64, usize) {
     }
 }
 
-fn sweep(mode: Mode) -> Sweep {
-    let (have, _) = available(IDS);
-    let mut estimators = Vec::new();
-    for f in FAMILIES.iter().filter(|f| have.iter().any(|h| h.id == f.id)) {
-        if !f.swept {
-            estimators.push(spec(f, None));
-            continue;
-        }
-        for r in RATIOS {
-            // Refused before the run (ConfigError) where r can exceed 2/(a+1); the post hook lists
-            // these as skipped with the estimator's own reason.
-            if f.id == "single_particle_terminating" && r < terminating_min_ratio() {
-                continue;
-            }
-            estimators.push(spec(f, Some(r)));
-        }
-    }
-    let testbeds = VARIANTS
-        .iter()
-        .map(|v| TestBedSpec { id: "canonical-1d".into(), variant: Some(v.to_string()), params: Params::new() })
-        .collect();
-    let (rays, reps) = sizes(mode);
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds,
-        estimators,
-        budgets: vec![Budget { kind: BudgetKind::Samples, amount: rays }],
-        reps,
-        seed: 1,
-        mode,
-        baseline: None,
-    }
-}
-
 /// Definition.
 pub static DEF: ExperimentDef = ExperimentDef {
-    name: "canonical-sweep",
-    reproduces: "issue 12: paper 002 Eq. 16-20 over canonical-1d profiles x target T x sigma_samp ratio (beyond Georgiev et al. 2019)",
-    summary: "every transmittance estimator x 7 profiles x 5 T x 8 sigma_samp ratios: variance x cost heat maps, Eq. 16-20 vs measured, tests",
-    ids: IDS,
-    sweep,
+    toml: include_str!("canonical_sweep.toml"),
     claims: |_| Vec::new(),
     post: Some(crate::canonical_sweep_post::post),
 };
@@ -167,7 +127,7 @@ mod tests {
 
     #[test]
     fn the_sweep_names_every_family_and_ratio_once() {
-        let s = sweep(Mode::Quick);
+        let s = DEF.experiment().sweep(&mcbench::Registry::empty(), Mode::Quick);
         assert_eq!(s.testbeds.len(), 35);
         let mut names: Vec<String> = s.estimators.iter().map(|e| e.name()).collect();
         // 6 swept families x 8 ratios + the terminating model at 5 ratios + 3 unswept.

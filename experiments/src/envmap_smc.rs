@@ -13,11 +13,9 @@
 //! Plus `smc_adaptive` (beyond the paper) and the biased control `bidirectional_is_sn`. The
 //! per-frame analysis, plots and the claims that need cells are in [`crate::envmap_smc_post`].
 
-use crate::{available, envmap_smc_post, ExperimentDef};
-use estimators::budget::Budget;
-use estimators::params::Params;
+use crate::{envmap_smc_post, ExperimentDef};
 use mcbench::claims;
-use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
+use mcbench::config::Mode;
 use mcbench::output::{Claim, RunReport};
 
 /// Every id the experiment runs.
@@ -27,15 +25,8 @@ pub const IDS: &[&str] = &["bidirectional_is", "smc", "smc_bridge", "smc_path", 
 pub const N: u64 = 16;
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "envmap-smc",
-    reproduces: "paper 004 Fig. 2-5 and §7 (intermediate distributions, equal-time comparison, share resampled)",
-    summary: "envmap-sequence: SMC (moves, bridges, path sampling, adaptive) vs bidirectional IS over frames",
-    ids: IDS,
-    sweep,
-    claims,
-    post: Some(envmap_smc_post::post),
-};
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("envmap_smc.toml"), claims, post: Some(envmap_smc_post::post) };
 
 /// The P values of the moves / bridges sweep (a) for a mode.
 pub fn p_values(mode: Mode) -> &'static [u32] {
@@ -50,50 +41,6 @@ pub fn m_values(mode: Mode) -> &'static [u32] {
     match mode {
         Mode::Quick => &[32, 64, 128, 256, 512],
         Mode::Full => &[32, 64, 128, 200, 256, 512, 800, 1024],
-    }
-}
-
-fn with(id: &str, k: &str, v: f64) -> EstimatorSpec {
-    EstimatorSpec { id: id.into(), params: Params::new().with(k, v) }
-}
-
-fn sweep(mode: Mode) -> Sweep {
-    let (have, _) = available(IDS);
-    let has = |id: &str| have.iter().any(|e| e.id == id);
-    let mut estimators = Vec::new();
-    for &p in p_values(mode) {
-        for (id, key) in [("smc", "moves"), ("smc_bridge", "bridges"), ("smc_path", "bridges")] {
-            if has(id) {
-                estimators.push(with(id, key, p as f64));
-            }
-        }
-    }
-    if has("bidirectional_is") {
-        estimators.extend(m_values(mode).iter().map(|&m| with("bidirectional_is", "candidates", m as f64)));
-    }
-    for id in ["smc_adaptive", "bidirectional_is_sn"] {
-        if has(id) {
-            estimators.push(EstimatorSpec::new(id));
-        }
-    }
-    let (resolution, frames, reps) = match mode {
-        Mode::Quick => (10.0, 6.0, 12),
-        Mode::Full => (32.0, 10.0, 32),
-    };
-    let bed = |v: &str| TestBedSpec {
-        id: "envmap-sequence".into(),
-        variant: Some(v.into()),
-        params: Params::new().with("resolution", resolution).with("frames", frames),
-    };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds: vec![bed("mixed-lns"), bed("specular"), bed("mixed")],
-        estimators,
-        budgets: vec![Budget { kind: estimators::budget::BudgetKind::Samples, amount: N }],
-        reps,
-        seed: 1,
-        mode,
-        baseline: None,
     }
 }
 

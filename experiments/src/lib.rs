@@ -35,22 +35,14 @@ pub mod transmittance;
 pub mod transmittance_post;
 pub mod variance_claims;
 
-use mcbench::config::{EstimatorSpec, Mode, Sweep};
 use mcbench::output::{Claim, RunReport};
-use mcbench::registry::{Experiment, PostFn, Registry, Sweeps};
+use mcbench::registry::{Experiment, PostFn, Registry};
 
-/// A named experiment of the suite, as a static definition (see [`Experiment`]).
+/// A named experiment of the suite: its sweep as data (a TOML experiment file beside the code,
+/// [`mcbench::declare`]), its claims and, for real figures and tables, its own analysis.
 pub struct ExperimentDef {
-    /// Name (results folder, CLI argument).
-    pub name: &'static str,
-    /// The paper figure or table it reproduces.
-    pub reproduces: &'static str,
-    /// One line for `mcbench list experiments`.
-    pub summary: &'static str,
-    /// Every estimator id it runs.
-    pub ids: &'static [&'static str],
-    /// The sweep for a mode.
-    pub sweep: fn(Mode) -> Sweep,
+    /// The experiment file.
+    pub toml: &'static str,
     /// The paper's claims judged on a finished run.
     pub claims: fn(&RunReport) -> Vec<Claim>,
     /// Optional analysis beyond the summary rows, run after the claims with the cells of the run:
@@ -59,20 +51,15 @@ pub struct ExperimentDef {
 }
 
 impl ExperimentDef {
-    /// The harness's experiment.
+    /// The harness's experiment (the embedded file is checked by a test of this crate).
     pub fn experiment(&self) -> Experiment {
-        Experiment {
-            name: self.name.into(),
-            reproduces: self.reproduces.into(),
-            summary: self.summary.into(),
-            sweeps: Sweeps::Fixed {
-                quick: Box::new((self.sweep)(Mode::Quick)),
-                full: Box::new((self.sweep)(Mode::Full)),
-            },
-            claims: Some(self.claims),
-            post: self.post,
-            preflight: None,
-        }
+        mcbench::declare::experiment(self.toml, Some(self.claims), self.post)
+            .unwrap_or_else(|e| panic!("an experiment file of the suite does not parse: {e}"))
+    }
+
+    /// Its name.
+    pub fn name(&self) -> String {
+        self.experiment().name
     }
 }
 
@@ -110,7 +97,14 @@ pub(crate) fn test_registry() -> Registry {
     )))
 }
 
-/// Estimator specs with default parameters for `ids`.
-pub fn available(ids: &[&str]) -> (Vec<EstimatorSpec>, Vec<String>) {
-    (ids.iter().map(|id| EstimatorSpec::new(id)).collect(), Vec::new())
+#[cfg(test)]
+mod tests {
+    /// Every experiment file parses and gives valid sweeps in both modes.
+    #[test]
+    fn every_experiment_file_parses() {
+        for d in super::EXPERIMENTS {
+            let e = mcbench::declare::experiment(d.toml, Some(d.claims), d.post).expect("parses");
+            assert!(!e.name.is_empty());
+        }
+    }
 }

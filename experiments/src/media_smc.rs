@@ -4,10 +4,8 @@
 //! (criterion, depth, nodes, leaves, cells, bytes) comes from the estimators' diagnostics and is
 //! written to `structure.csv` and the `paper` block by the post hook.
 
-use crate::{available, ExperimentDef};
-use estimators::params::Params;
+use crate::ExperimentDef;
 use mcbench::claims;
-use mcbench::config::{powers_of_four, Mode, Sweep, TestBedSpec};
 use mcbench::output::{Claim, RunReport};
 
 /// Every id the experiment runs.
@@ -17,34 +15,8 @@ pub const IDS: &[&str] = &["is0_cv0", "is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1"
 pub const VARIANTS: &[&str] = &["albedo-1", "albedo-0.8", "albedo-0.5"];
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "media-smc",
-    reproduces: "paper 000 Fig. 3 and Table 1 (slopes 0.62-0.63, 15.3x speed-up at albedo 0.8)",
-    summary: "gradient-box: octree of spherical caches vs the independent path tracer, RMSE and efficiency vs spp",
-    ids: IDS,
-    sweep,
-    claims,
-    post: Some(crate::media_smc_post::post),
-};
-
-fn sweep(mode: Mode) -> Sweep {
-    let (estimators, _) = available(IDS);
-    let bed = |v: &str| TestBedSpec { id: "gradient-box".into(), variant: Some(v.into()), params: Params::new() };
-    let (budgets, reps) = match mode {
-        Mode::Quick => (powers_of_four(1..=5), 8),
-        Mode::Full => (powers_of_four(1..=7), 8),
-    };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds: VARIANTS.iter().map(|v| bed(v)).collect(),
-        estimators,
-        budgets,
-        reps,
-        seed: 1,
-        mode,
-        baseline: Some("is0_cv0".into()),
-    }
-}
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("media_smc.toml"), claims, post: Some(crate::media_smc_post::post) };
 
 fn claims(r: &RunReport) -> Vec<Claim> {
     let mut out = Vec::new();

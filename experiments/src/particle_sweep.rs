@@ -4,10 +4,7 @@
 //! fetch budgets (Fig. 7: 500 fetches per pixel). The terminating model is only run where it is
 //! valid on both media (sigma_samp >= 0.95: r <= 2/(a+1) with a = 0.9); elsewhere it is refused.
 
-use crate::{available, ExperimentDef};
-use estimators::budget::{Budget, BudgetKind};
-use estimators::params::Params;
-use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
+use crate::ExperimentDef;
 use mcbench::output::{Claim, RunReport};
 
 /// The sigma_samp values of the paper's sweep.
@@ -17,49 +14,11 @@ pub const SIGMAS: [f64; 7] = [0.4, 0.5, 0.6, 0.7, 0.8, 1.0, 2.0];
 pub const IDS: &[&str] = &["spm_terminating", "spm_nonterminating", "spm_adaptive", "delta_tracking"];
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "particle-sweep",
-    reproduces: "paper 002 Fig. 6-7 (FoM vs sigma_samp)",
-    summary: "eq21/perlin multiple scattering: spm_* x sigma_samp at equal fetches; error, fetches, FoM",
-    ids: IDS,
-    sweep,
-    claims,
-    post: Some(crate::particle_sweep_post::post),
-};
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("particle_sweep.toml"), claims, post: Some(crate::particle_sweep_post::post) };
 
 fn name(id: &str, s: f64) -> String {
     format!("{id}[sigma_samp={s}]")
-}
-
-fn sweep(mode: Mode) -> Sweep {
-    let (have, _) = available(IDS);
-    let mut estimators = Vec::new();
-    for s in SIGMAS {
-        for e in have.iter().filter(|e| e.id.starts_with("spm_")) {
-            if e.id == "spm_terminating" && s < 0.95 {
-                continue;
-            }
-            estimators.push(EstimatorSpec { id: e.id.clone(), params: Params::new().with("sigma_samp", s) });
-        }
-    }
-    estimators.push(EstimatorSpec::new("delta_tracking"));
-    let testbeds = ["eq21-medium", "perlin-medium"]
-        .iter()
-        .map(|id| TestBedSpec { id: id.to_string(), variant: Some("multiple".into()), params: Params::new() })
-        .collect();
-    let amounts: &[u64] = if mode == Mode::Quick { &[125, 250, 500] } else { &[125, 250, 500, 1000, 2000] };
-    let budgets = amounts.iter().map(|&a| Budget { kind: BudgetKind::Fetches, amount: a }).collect();
-    let reps = if mode == Mode::Quick { 4 } else { 16 };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds,
-        estimators,
-        budgets,
-        reps,
-        seed: 1,
-        mode,
-        baseline: Some("delta_tracking".into()),
-    }
 }
 
 fn fom(r: &RunReport, tb: &str, est: &str, budget: u64) -> Option<f64> {

@@ -2,49 +2,16 @@
 //! paper's soft-shadowed Plant scene) at equal sample counts, MIS vs PMC-HI (and PMC-HI with
 //! feedback), with the perceptual error `Err` and `P-Eff` of SPEC §5 beside our plain efficiency.
 
-use crate::{available, ExperimentDef};
-use estimators::budget::Budget;
-use estimators::params::Params;
+use crate::ExperimentDef;
 use mcbench::claims;
-use mcbench::config::{Mode, Sweep, TestBedSpec};
 use mcbench::output::{Claim, RunReport};
 
 /// Every id the experiment runs.
 pub const IDS: &[&str] = &["mis", "pmc_hi", "pmc_hi_feedback", "clamped_is0_cv0"];
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "pmc-hi",
-    reproduces: "paper 003 Table 2 (PMC-HI vs MIS, P-Eff factors 2.21 and 2.60)",
-    summary: "checker-direct (+ occluded): MIS vs PMC-HI at equal samples, Err, P-Eff and efficiency",
-    ids: IDS,
-    sweep,
-    claims,
-    post: Some(crate::pmc_hi_post::post),
-};
-
-fn sweep(mode: Mode) -> Sweep {
-    let (estimators, _) = available(IDS);
-    let (res, budgets, reps) = match mode {
-        Mode::Quick => (24.0, vec![16, 32, 64, 128], 64),
-        Mode::Full => (48.0, vec![16, 32, 64, 128, 256], 32),
-    };
-    let bed = |v: &str| TestBedSpec {
-        id: "checker-direct".into(),
-        variant: Some(v.into()),
-        params: Params::new().with("resolution", res),
-    };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds: vec![bed("default"), bed("occluded")],
-        estimators,
-        budgets: budgets.into_iter().filter_map(|b| Budget::samples(b).ok()).collect(),
-        reps,
-        seed: 1,
-        mode,
-        baseline: Some("mis".into()),
-    }
-}
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("pmc_hi.toml"), claims, post: Some(crate::pmc_hi_post::post) };
 
 /// "PMC-HI improves P-Eff over MIS by `paper` x at equal samples" on one variant, at the largest
 /// budget; held when our factor is at least half the paper's (scenes, sizes and machines differ).

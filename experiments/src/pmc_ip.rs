@@ -4,11 +4,8 @@
 //! 16 spp), with the perceptual error `Err` and `P-Eff` of SPEC §5 beside our plain efficiency,
 //! and the threshold-stopping control of paper 003 §2 that the unbiasedness test must flag.
 
-use crate::{available, pmc_ip_post, ExperimentDef};
-use estimators::budget::Budget;
-use estimators::params::Params;
+use crate::{pmc_ip_post, ExperimentDef};
 use mcbench::claims;
-use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::metrics::SummaryRow;
 use mcbench::output::{Claim, RunReport};
 
@@ -19,45 +16,11 @@ pub const IDS: &[&str] = &["uniform_image", "pmc_ip", "threshold_image"];
 pub const PMC_IP_4: &str = "pmc_ip[initial=4]";
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "pmc-ip",
-    reproduces: "paper 003 Table 1 and Fig. 4 (PMC-IP vs uniform image-plane sampling, P-Eff factors 5.01 and 2.65)",
-    summary: "checker-image (+ occluded): uniform 10/16/32 spp vs PMC-IP 2+4+4 and 4+6+6, Err, P-Eff, alpha and variance maps",
-    ids: IDS,
-    sweep,
-    claims,
-    post: Some(pmc_ip_post::post),
-};
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("pmc_ip.toml"), claims, post: Some(pmc_ip_post::post) };
 
 /// The image side the stored `checker-image` references are made for.
 pub const RESOLUTION: f64 = 48.0;
-
-fn sweep(mode: Mode) -> Sweep {
-    let (mut estimators, _) = available(IDS);
-    if estimators.iter().any(|e| e.id == "pmc_ip") {
-        let at = estimators.iter().position(|e| e.id == "pmc_ip").map_or(estimators.len(), |i| i + 1);
-        estimators.insert(at, EstimatorSpec { id: "pmc_ip".into(), params: Params::new().with("initial", 4.0) });
-    }
-    let reps = match mode {
-        Mode::Quick => 16,
-        Mode::Full => 64,
-    };
-    let bed = |v: &str| TestBedSpec {
-        id: "checker-image".into(),
-        variant: Some(v.into()),
-        params: Params::new().with("resolution", RESOLUTION),
-    };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds: vec![bed("default"), bed("occluded")],
-        estimators,
-        budgets: [10, 16, 32].into_iter().filter_map(|b| Budget::samples(b).ok()).collect(),
-        reps,
-        seed: 1,
-        mode,
-        baseline: Some("uniform_image".into()),
-    }
-}
 
 /// The row of an estimator at a budget on a variant.
 pub fn row<'a>(r: &'a RunReport, variant: &str, estimator: &str, budget: u64) -> Option<&'a SummaryRow> {

@@ -8,11 +8,8 @@
 //! rays the budget buys, shadow rays, fetches, RMSE, rank) and puts the paper's ordering beside
 //! ours in the `paper` block ([`crate::single_scatter_post`]).
 
-use crate::{available, ExperimentDef};
-use estimators::budget::{Budget, BudgetKind};
-use estimators::params::Params;
+use crate::ExperimentDef;
 use mcbench::claims;
-use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::output::{Claim, RunReport};
 
 /// Every id the experiment runs, in the order of paper 002 Fig. 12.
@@ -30,15 +27,8 @@ pub const IDS: &[&str] = &[
 pub const PAPER_BUDGETS: [u64; 2] = [50, 300];
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "single-scatter",
-    reproduces: "paper 002 Fig. 12 (single scattering of a point light at equal fetches: MIS best, Woodcock worst)",
-    summary: "eq21 (+ perlin 4x4) point-light single scattering: 7 methods at ~50 and ~300 fetches per pixel; primary rays bought, RMSE, ordering",
-    ids: IDS,
-    sweep,
-    claims,
-    post: Some(crate::single_scatter_post::post),
-};
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("single_scatter.toml"), claims, post: Some(crate::single_scatter_post::post) };
 
 /// The paper's "noise free but biased" marcher: one ray spending the budget, offsets fixed at 1/2.
 pub const NOISE_FREE: &str = "ray_marching[jitter=0]";
@@ -47,27 +37,6 @@ pub const NOISE_FREE: &str = "ray_marching[jitter=0]";
 /// fetch budget buys several rays of. The Fig. 12 marcher (one ray spending the budget) is in the
 /// ranking; its bias is far below what a quick run detects on the smooth Eq. 21 medium.
 pub const CONTROL: &str = "ray_marching[step=5]";
-
-fn sweep(mode: Mode) -> Sweep {
-    let (mut estimators, _) = available(IDS);
-    estimators.push(EstimatorSpec { id: "ray_marching".into(), params: Params::new().with("jitter", 0.0) });
-    estimators.push(EstimatorSpec { id: "ray_marching".into(), params: Params::new().with("step", 5.0) });
-    let bed = |id: &str, p: Params| TestBedSpec { id: id.into(), variant: Some("single-scatter".into()), params: p };
-    let (res, amounts, reps): (f64, &[u64], usize) = match mode {
-        Mode::Quick => (16.0, &[50, 100, 300], 32),
-        Mode::Full => (32.0, &[50, 100, 300, 1000], 64),
-    };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds: vec![bed("eq21-medium", Params::new().with("resolution", res)), bed("perlin-medium", Params::new())],
-        estimators,
-        budgets: amounts.iter().map(|&a| Budget { kind: BudgetKind::Fetches, amount: a }).collect(),
-        reps,
-        seed: 1,
-        mode,
-        baseline: Some("delta_tracking".into()),
-    }
-}
 
 /// RMSE of an estimator at a budget on a test bed (single-scatter variant).
 pub fn rmse(r: &RunReport, tb: &str, est: &str, budget: u64) -> Option<f64> {

@@ -11,9 +11,9 @@
 use crate::stability_cases::{self as sc, Expect, Outcome};
 use crate::stability_list::{cases, PDF_ZERO};
 use crate::stability_numeric::{self as num, Sequence};
-use crate::{available, ExperimentDef};
+use crate::ExperimentDef;
 use estimators::params::Params;
-use mcbench::config::{powers_of_four, Mode, Sweep, TestBedSpec};
+use mcbench::config::Mode;
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::guarded::one_line;
@@ -26,34 +26,8 @@ use std::path::{Path, PathBuf};
 pub const IDS: &[&str] = &["is0_cv0", "is1_cv2"];
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "stability",
-    reproduces: "SPEC §10 (numerical stability cases), issue 9 item 3",
-    summary: "every SPEC §10 stability case: correct within error bars or refused with a one-line error",
-    ids: IDS,
-    sweep,
-    claims: |_| Vec::new(),
-    post: Some(post),
-};
-
-fn sweep(mode: Mode) -> Sweep {
-    let (estimators, _) = available(IDS);
-    let bed = |v: &str| TestBedSpec {
-        id: "gradient-box".into(),
-        variant: Some(v.into()),
-        params: Params::new().with("resolution", 4.0),
-    };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds: vec![bed("furnace"), bed("albedo-0")],
-        estimators,
-        budgets: powers_of_four(1..=2),
-        reps: if mode == Mode::Quick { 8 } else { 32 },
-        seed: 1,
-        mode,
-        baseline: None,
-    }
-}
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("stability.toml"), claims: |_| Vec::new(), post: Some(post) };
 
 /// The numeric cases (the same in quick and full mode: 1e8 is the SPEC's count): (id, spec item,
 /// expected, outcome).

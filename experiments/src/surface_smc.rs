@@ -1,10 +1,8 @@
 //! `surface-smc` (paper 001 Fig. 4, §5): the gradient-plane test bed, the surface cache ids and
 //! the independent-MC baselines, spp = 4^k.
 
-use crate::{available, ExperimentDef};
-use estimators::params::Params;
+use crate::ExperimentDef;
 use mcbench::claims;
-use mcbench::config::{powers_of_four, Mode, Sweep, TestBedSpec};
 use mcbench::output::{Claim, RunReport};
 
 /// Every id the experiment runs (those not registered yet are reported as unavailable).
@@ -21,34 +19,7 @@ pub const IDS: &[&str] = &[
 ];
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "surface-smc",
-    reproduces: "paper 001 Fig. 4 and §5 (slopes, 77x speed-up)",
-    summary: "gradient-plane: SMC surface caches vs independent MC and BRDF sampling, RMSE and efficiency vs spp",
-    ids: IDS,
-    sweep,
-    claims,
-    post: None,
-};
-
-fn sweep(mode: Mode) -> Sweep {
-    let (estimators, _) = available(IDS);
-    let bed = |v: &str| TestBedSpec { id: "gradient-plane".into(), variant: Some(v.into()), params: Params::new() };
-    let (testbeds, budgets, reps) = match mode {
-        Mode::Quick => (vec![bed("default")], powers_of_four(1..=6), 8),
-        Mode::Full => (vec![bed("default"), bed("stiff")], powers_of_four(1..=7), 16),
-    };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds,
-        estimators,
-        budgets,
-        reps,
-        seed: 1,
-        mode,
-        baseline: Some("is0_cv0".into()),
-    }
-}
+pub static DEF: ExperimentDef = ExperimentDef { toml: include_str!("surface_smc.toml"), claims, post: None };
 
 fn claims(r: &RunReport) -> Vec<Claim> {
     let tb = ("gradient-plane", "default");

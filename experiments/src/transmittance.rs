@@ -5,11 +5,8 @@
 //! with a coarse fixed step (`ray_marching[step=5]`). Claims: the paper's errors at
 //! 10 fetches, and Eq. 16 predicted vs measured variance on the central ray.
 
-use crate::{available, ExperimentDef};
-use estimators::budget::{Budget, BudgetKind};
-use estimators::params::Params;
+use crate::ExperimentDef;
 use mcbench::claims;
-use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::output::{Claim, RunReport};
 
 /// Every id the experiment runs.
@@ -17,46 +14,8 @@ pub const IDS: &[&str] =
     &["ray_marching", "delta_tracking", "ratio_tracking", "residual_ratio_tracking", "double_particle"];
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    name: "transmittance",
-    reproduces: "paper 002 Fig. 8-10 (equal-fetch transmittance, Eq. 16 variance)",
-    summary: "eq21/perlin: ray marching vs delta vs ratio vs residual ratio tracking at equal fetches; Eq. 16 vs measured variance",
-    ids: IDS,
-    sweep,
-    claims,
-    post: Some(crate::transmittance_post::post),
-};
-
-fn sweep(mode: Mode) -> Sweep {
-    let (mut estimators, _) = available(&IDS[..4]);
-    // The control: ray marching with a coarse fixed step (4 steps on the 20-unit central ray), whose
-    // Jensen bias is large enough to detect; the fine one-ray ray marching above is the paper's.
-    estimators.push(EstimatorSpec { id: "ray_marching".into(), params: Params::new().with("step", 5.0) });
-    estimators.push(EstimatorSpec {
-        id: "double_particle".into(),
-        params: Params::new().with("sigma_samp", 0.4).with("control", 1.0),
-    });
-    let bed = |id: &str, v: &str, p: Params| TestBedSpec { id: id.into(), variant: Some(v.into()), params: p };
-    let res = if mode == Mode::Quick { 16.0 } else { 32.0 };
-    let testbeds = vec![
-        bed("eq21-medium", "transmittance", Params::new().with("resolution", res)),
-        bed("perlin-medium", "transmittance", Params::new().with("resolution", 16.0)),
-        bed("eq21-medium", "central-ray", Params::new()),
-    ];
-    let amounts: &[u64] = if mode == Mode::Quick { &[10, 20, 40, 80] } else { &[10, 20, 40, 80, 160, 320] };
-    let budgets = amounts.iter().map(|&a| Budget { kind: BudgetKind::Fetches, amount: a }).collect();
-    let reps = if mode == Mode::Quick { 16 } else { 64 };
-    Sweep {
-        experiment: DEF.name.into(),
-        testbeds,
-        estimators,
-        budgets,
-        reps,
-        seed: 1,
-        mode,
-        baseline: Some("delta_tracking".into()),
-    }
-}
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("transmittance.toml"), claims, post: Some(crate::transmittance_post::post) };
 
 fn rmse(r: &RunReport, tb: &str, est: &str, budget: u64) -> Option<f64> {
     r.rows

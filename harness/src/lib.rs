@@ -64,6 +64,7 @@ pub mod config;
 pub mod conformance;
 pub mod console;
 pub mod cputime;
+pub mod declare;
 pub mod error;
 pub mod execute;
 pub mod folder;
