@@ -25,6 +25,7 @@ fn sweep(ids: &[&str], reps: usize) -> Sweep {
         seed: 42,
         mode: Mode::Quick,
         baseline: Some("is0_cv0".into()),
+        claims: Vec::new(),
     }
 }
 
@@ -248,4 +249,28 @@ fn registry() -> &'static mcbench::Registry {
 /// Plans a sweep against [`registry`].
 fn plan_of(sweep: mcbench::config::Sweep) -> mcbench::error::Result<mcbench::plan::Plan> {
     mcbench::plan::Plan::prepare(sweep, registry())
+}
+
+/// Claims declared in a config file are judged on the run and land in summary.json's `paper`.
+#[test]
+fn claims_declared_in_a_config_are_judged() {
+    let text = "name = 'claimed'\nreps = 8\nbudgets = [4, 16, 64, 256]\nbaseline = 'is0_cv0'\n\
+                [[testbeds]]\nid = 'gradient-plane'\nvariant = 'diffuse'\nparams = { resolution = 4 }\n\
+                [[estimators]]\nid = 'is0_cv0'\n[[estimators]]\nid = 'clamped_is0_cv0'\nparams = { clamp = 0.5 }\n\
+                [[claims]]\nkind = 'slope'\ntestbed = 'gradient-plane/diffuse'\nestimator = 'is0_cv0'\nvalue = -0.5\ntext = 'independent MC at -1/2'\n\
+                [[claims]]\nkind = 'control_flagged'\nestimator = 'clamped_is0_cv0[clamp=0.5]'\n";
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("claimed.toml");
+    std::fs::write(&path, text).expect("write");
+    let sweep = mcbench::config::SweepFile::read(&path).and_then(|f| f.apply(None, Mode::Quick)).expect("parses");
+    assert_eq!(sweep.claims.len(), 2);
+    let out = run_into(dir.path(), sweep, 2, false);
+    let slope = out.report.paper.iter().find(|c| c.claim == "independent MC at -1/2").expect("judged");
+    assert_eq!(slope.held, Some(true), "{slope:?}");
+    let control = out.report.paper.iter().find(|c| c.claim.contains("clamped_is0_cv0")).expect("judged");
+    assert_eq!(control.held, Some(true), "{control:?}");
+    let bad = text.replace("kind = 'slope'", "kind = 'slop'");
+    std::fs::write(&path, bad).expect("write");
+    let err = mcbench::config::SweepFile::read(&path).expect_err("unknown kind");
+    assert!(err.to_string().contains("slop") && err.exit_code() == 2, "{err}");
 }

@@ -138,6 +138,7 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
         seed: 3,
         mode: Mode::Quick,
         baseline: None,
+        claims: Vec::new(),
     };
     let registry = crate::test_registry();
     let opts = ExecOptions {

@@ -106,6 +106,14 @@ pub fn slope_steeper(report: &RunReport, tb: (&str, &str), estimator: &str, pape
     })
 }
 
+/// "Estimator X converges faster than slope `below`": held when our CI lies below `below`.
+pub fn slope_steeper_than(report: &RunReport, tb: (&str, &str), estimator: &str, below: f64, claim: &str) -> Claim {
+    slope_claim(report, tb, estimator, below, claim, |f| {
+        let note = format!("held if the 95% CI [{:.3}, {:.3}] lies below {below}", f.slope_ci_low, f.slope_ci_high);
+        (f.slope_ci_high < below, note)
+    })
+}
+
 /// "X beats the baseline by `paper` x at equal time": held when our speed-up is at least half the
 /// paper's (budgets and machines differ; the ratio is in the note).
 pub fn speedup_claim(report: &RunReport, tb: (&str, &str), estimator: &str, paper: f64, claim: &str) -> Claim {

@@ -17,6 +17,7 @@
 //! params = { clamp = 4.0 }
 //! ```
 
+use crate::claim_spec::ClaimSpec;
 use crate::error::{HarnessError, Result};
 use estimators::budget::{Budget, BudgetKind};
 use estimators::error::ConfigError;
@@ -122,6 +123,9 @@ pub struct Sweep {
     pub mode: Mode,
     /// Estimator name the speed-ups are computed against.
     pub baseline: Option<String>,
+    /// Claims judged on the finished run ([`ClaimSpec`]).
+    #[serde(default)]
+    pub claims: Vec<ClaimSpec>,
 }
 
 /// `4^k` for `k` in `ks`: the papers' spp sweep.
@@ -162,6 +166,8 @@ pub struct SweepFile {
     pub testbeds: Option<Vec<TestBedSpec>>,
     /// Estimators.
     pub estimators: Option<Vec<EstimatorSpec>>,
+    /// Claims judged on the finished run (`[[claims]]` tables, [`ClaimSpec`]).
+    pub claims: Option<Vec<ClaimSpec>>,
 }
 
 impl SweepFile {
@@ -192,6 +198,7 @@ impl SweepFile {
                 seed: 1,
                 mode,
                 baseline: None,
+                claims: Vec::new(),
             },
         };
         if let Some(name) = self.name {
@@ -218,6 +225,9 @@ impl SweepFile {
         }
         if let Some(e) = self.estimators {
             sweep.estimators = e;
+        }
+        if let Some(c) = self.claims {
+            sweep.claims = c;
         }
         Ok(sweep)
     }

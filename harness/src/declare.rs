@@ -25,6 +25,7 @@
 //! assert_eq!(file.sweep(Mode::Full).unwrap().budgets.len(), 5);
 //! ```
 
+use crate::claim_spec::ClaimSpec;
 use crate::config::{EstimatorSpec, Mode, Sweep, SweepFile, TestBedSpec};
 use crate::error::{HarnessError, Result};
 use crate::registry::{ClaimsFn, Experiment, PostFn, Sweeps};
@@ -54,6 +55,8 @@ pub struct ExperimentFile {
     pub testbeds: Option<Vec<TestBedSpec>>,
     /// Estimators.
     pub estimators: Option<Vec<EstimatorSpec>>,
+    /// Claims judged on every run of it (`[[claims]]`).
+    pub claims: Option<Vec<ClaimSpec>>,
     /// Overrides for `--quick`.
     #[serde(default)]
     pub quick: SweepFile,
@@ -79,6 +82,7 @@ impl ExperimentFile {
             baseline: self.baseline.clone(),
             testbeds: self.testbeds.clone(),
             estimators: self.estimators.clone(),
+            claims: self.claims.clone(),
         };
         let base = shared.apply(None, mode)?;
         let mut overrides = match mode {

@@ -193,11 +193,11 @@ pub fn finish(
         labels: plan.estimators.iter().map(|e| (e.name.clone(), e.entry.label.to_string())).collect(),
         diagnostics,
     };
-    if let Some(d) = def {
-        if let Some(claims) = d.claims {
-            report.paper = claims(&report);
-        }
+    if let Some(claims) = def.and_then(|d| d.claims) {
+        report.paper = claims(&report);
     }
+    let declared: Vec<_> = sweep.claims.iter().map(|c| c.judge(&report)).collect();
+    report.paper.extend(declared);
     let mut extra_plots = Vec::new();
     if let Some(post) = def.and_then(|d| d.post) {
         extra_plots = post(plan, run, &mut report, &results, opts.plots.then_some(plots_dir.as_path()), opts.registry)?;

@@ -201,6 +201,18 @@ impl OutputDir {
         Ok(path)
     }
 
+    /// Writes `rows` as `<dir>/<name>` with the csv crate (a header from the row type's field
+    /// names, one record per row), atomically, and records it.
+    pub fn write_csv<T: serde::Serialize>(&self, name: &str, rows: &[T]) -> Result<PathBuf> {
+        let path = self.dir.join(name);
+        let mut w = csv::Writer::from_writer(Vec::new());
+        for r in rows {
+            w.serialize(r).map_err(|e| HarnessError::write(&path, e))?;
+        }
+        let bytes = w.into_inner().map_err(|e| HarnessError::write(&path, e))?;
+        self.write(name, &bytes)
+    }
+
     /// Records a file that was written into the folder by other means (the PNG encoder writes its
     /// own files; they are renamed into place atomically, then read back here for the digest).
     pub fn record(&self, path: &Path) -> Result<()> {

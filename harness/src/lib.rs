@@ -58,6 +58,7 @@
 
 pub mod analysis;
 pub mod cell;
+pub mod claim_spec;
 pub mod claims;
 pub mod cli;
 pub mod config;

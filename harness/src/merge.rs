@@ -179,6 +179,7 @@ mod tests {
             seed,
             mode: Mode::Quick,
             baseline: None,
+            claims: Vec::new(),
         };
         let m = Manifest {
             format: shard::FORMAT,

@@ -95,6 +95,7 @@ pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
                     seed: 1,
                     mode,
                     baseline: None,
+                    claims: Vec::new(),
                 },
             }
         })
@@ -115,6 +116,7 @@ fn first_part(registry: &Registry, mode: Mode) -> Sweep {
             seed: 1,
             mode,
             baseline: None,
+            claims: Vec::new(),
         };
     }
     all.swap_remove(0).sweep

@@ -124,6 +124,7 @@ mod tests {
             seed: 5,
             mode: Mode::Quick,
             baseline: None,
+            claims: Vec::new(),
         };
         let plan = Plan::prepare(
             sweep,

@@ -144,6 +144,7 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
         seed: 3,
         mode: Mode::Quick,
         baseline: None,
+        claims: Vec::new(),
     };
     let plan = Plan::prepare(
         sweep,
