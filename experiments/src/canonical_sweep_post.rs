@@ -12,6 +12,7 @@ use mcbench::folder::OutputDir;
 use mcbench::output::RunReport;
 use mcbench::plan::Plan;
 use mcbench::runner::RunResults;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// The finished cells with the sweep's critical value for the variance checks.
@@ -47,45 +48,97 @@ pub fn short(r: &CellRow) -> String {
     }
 }
 
-fn csv_text(a: &Analysis) -> String {
-    let mut out = String::from(
-        "profile,target,family,ratio,estimator,claim,reps,rays,fetches,reference,mean,variance,var_cost,rel_var_cost,rel_mse_cost,predicted_mean,predicted_variance,variance_sd,z,agreement,test,p_value,verdict,detectable_rel_bias,skipped\n",
-    );
-    let opt = |x: Option<f64>| x.map(|v| format!("{v:e}")).unwrap_or_default();
-    for r in &a.rows {
-        let m = r.measured.as_ref();
-        let test = m.and_then(|m| m.test.as_ref());
-        let fields = [
-            r.profile.name().to_string(),
-            r.target.to_string(),
-            FAMILIES[r.family].key.to_string(),
-            r.ratio.map(|x| x.to_string()).unwrap_or_else(|| "own".into()),
-            format!("\"{}\"", r.estimator),
-            r.claim.name().to_string(),
-            m.map(|m| m.reps.to_string()).unwrap_or_default(),
-            opt(m.map(|m| m.rays)),
-            opt(m.map(|m| m.fetches)),
-            format!("{:e}", r.reference),
-            opt(m.map(|m| m.mean)),
-            opt(m.map(|m| m.variance)),
-            opt(r.var_cost()),
-            opt(r.rel_var_cost()),
-            opt(r.rel_mse_cost()),
-            opt(r.predicted.map(|p| p.mean)),
-            opt(r.predicted.map(|p| p.variance())),
-            opt(r.predicted.zip(m).map(|(p, m)| p.sample_variance_sd(m.reps as f64))),
-            opt(r.z()),
-            r.agreement(a.z_crit).name().to_string(),
-            test.map(|t| t.test.clone()).unwrap_or_default(),
-            opt(test.map(|t| t.p)),
-            test.map(|t| t.verdict.clone()).unwrap_or_default(),
-            opt(test.map(|t| t.detectable)),
-            r.skipped.as_ref().map(|s| format!("\"{}\"", s.replace('"', "'"))).unwrap_or_default(),
-        ];
-        out.push_str(&fields.join(","));
-        out.push('\n');
-    }
-    out
+/// One row of `cells.csv`: one cell of the sweep (run or skipped; the measured and predicted
+/// columns are empty where there is nothing to report).
+#[derive(Serialize)]
+struct CellsRow<'a> {
+    /// The extinction profile.
+    profile: &'static str,
+    /// The target transmittance T.
+    target: f64,
+    /// The estimator family's key.
+    family: &'static str,
+    /// sigma_samp / max sigma_t, or `own` for a family with its own sampling density.
+    ratio: String,
+    /// The estimator name in result files.
+    estimator: &'a str,
+    /// What the paper claims of its expectation.
+    claim: &'static str,
+    /// Repetitions.
+    reps: Option<usize>,
+    /// Rays (samples) per estimate.
+    rays: Option<f64>,
+    /// Fetches per estimate.
+    fetches: Option<f64>,
+    /// The exact reference of the analysed integral.
+    reference: f64,
+    /// Mean of the estimates.
+    mean: Option<f64>,
+    /// Sample variance of one estimate.
+    variance: Option<f64>,
+    /// Variance x fetches per estimate.
+    var_cost: Option<f64>,
+    /// Variance x fetches relative to T^2.
+    rel_var_cost: Option<f64>,
+    /// MSE x fetches relative to T^2 (includes bias).
+    rel_mse_cost: Option<f64>,
+    /// Predicted mean of one estimate.
+    predicted_mean: Option<f64>,
+    /// Predicted variance of one estimate.
+    predicted_variance: Option<f64>,
+    /// Predicted standard deviation of the measured (sample) variance.
+    variance_sd: Option<f64>,
+    /// (measured - predicted variance) / variance_sd.
+    z: Option<f64>,
+    /// How the measured variance compares with the prediction.
+    agreement: &'static str,
+    /// The deciding unbiasedness test (`holm_t` or `pooled_z`).
+    test: Option<&'a str>,
+    /// Its p-value.
+    p_value: Option<f64>,
+    /// Its verdict (`pass`, `biased` or `untested`).
+    verdict: Option<&'a str>,
+    /// The relative bias the test detects with 80% power.
+    detectable_rel_bias: Option<f64>,
+    /// Why the cell did not run.
+    skipped: Option<&'a str>,
+}
+
+fn cells_rows(a: &Analysis) -> Vec<CellsRow<'_>> {
+    a.rows
+        .iter()
+        .map(|r| {
+            let m = r.measured.as_ref();
+            let test = m.and_then(|m| m.test.as_ref());
+            CellsRow {
+                profile: r.profile.name(),
+                target: r.target,
+                family: FAMILIES[r.family].key,
+                ratio: r.ratio.map_or_else(|| "own".into(), |x| x.to_string()),
+                estimator: &r.estimator,
+                claim: r.claim.name(),
+                reps: m.map(|m| m.reps),
+                rays: m.map(|m| m.rays),
+                fetches: m.map(|m| m.fetches),
+                reference: r.reference,
+                mean: m.map(|m| m.mean),
+                variance: m.map(|m| m.variance),
+                var_cost: r.var_cost(),
+                rel_var_cost: r.rel_var_cost(),
+                rel_mse_cost: r.rel_mse_cost(),
+                predicted_mean: r.predicted.map(|p| p.mean),
+                predicted_variance: r.predicted.map(|p| p.variance()),
+                variance_sd: r.predicted.zip(m).map(|(p, m)| p.sample_variance_sd(m.reps as f64)),
+                z: r.z(),
+                agreement: r.agreement(a.z_crit).name(),
+                test: test.map(|t| t.test.as_str()),
+                p_value: test.map(|t| t.p),
+                verdict: test.map(|t| t.verdict.as_str()),
+                detectable_rel_bias: test.map(|t| t.detectable),
+                skipped: r.skipped.as_deref(),
+            }
+        })
+        .collect()
 }
 
 /// The experiment's post-run analysis (see the module doc).
@@ -100,9 +153,9 @@ pub fn post(
     report.skipped.extend(refused_terminating(plan));
     let equal_cost = plan.sweep.budgets.iter().any(|b| b.kind == BudgetKind::Fetches);
     let analysis = Analysis::new(cell_rows(plan, run, report), equal_cost);
-    results.write("cells.csv", csv_text(&analysis).as_bytes())?;
-    let (csv, md) = crate::canonical_winners::tables(&analysis);
-    results.write("winners.csv", csv.as_bytes())?;
+    results.write_csv("cells.csv", &cells_rows(&analysis))?;
+    let (winners, md) = crate::canonical_winners::tables(&analysis);
+    results.write_csv("winners.csv", &winners)?;
     results.write("winners.md", md.as_bytes())?;
     report.paper.extend(crate::canonical_sweep_claims::claims(&analysis));
     match plots {

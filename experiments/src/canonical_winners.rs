@@ -13,6 +13,7 @@ use estimators::estimator::Bias;
 use estimators::testbeds::canonical_1d::TARGETS;
 use estimators::testbeds::canonical_profiles::Profile;
 use mcbench::report::{markdown_table, sig};
+use serde::Serialize;
 
 /// Whether a family subtracts a control variate (explorer fetches; exact on some profiles).
 pub fn has_cv(family: usize) -> bool {
@@ -102,9 +103,33 @@ pub fn cell_text(w: &Win<'_>) -> String {
     s
 }
 
-/// `winners.csv` and `winners.md`.
-pub fn tables(a: &Analysis) -> (String, String) {
-    let mut csv = String::from("profile,target,ratio,with_cv,winner,estimator,rel_var_cost,resolved,tie_with\n");
+/// One row of `winners.csv`: the winner at one profile, target and ratio, with or without control
+/// variates (empty cells where no estimator qualifies).
+#[derive(Serialize)]
+pub struct WinnerRow {
+    /// The extinction profile.
+    pub profile: &'static str,
+    /// The target transmittance T.
+    pub target: f64,
+    /// sigma_samp / max sigma_t.
+    pub ratio: f64,
+    /// Whether estimators with control variates compete.
+    pub with_cv: bool,
+    /// The winner's label (`RT/DP`, `DT/ST` for the merged equivalents).
+    pub winner: Option<String>,
+    /// The winning estimator's name in result files.
+    pub estimator: Option<String>,
+    /// The winner's measured variance x fetches relative to T^2.
+    pub rel_var_cost: Option<f64>,
+    /// Whether the winner's variance is resolved by the run.
+    pub resolved: bool,
+    /// The runner-up's label when within two combined error bars (a statistical tie).
+    pub tie_with: Option<String>,
+}
+
+/// The rows of `winners.csv` and the text of `winners.md`.
+pub fn tables(a: &Analysis) -> (Vec<WinnerRow>, String) {
+    let mut rows = Vec::new();
     let mut md = String::from(
         "# canonical-sweep: which estimator wins where\n\nLowest measured variance x fetches per estimate (relative to T^2) among the unbiased \
          estimators run at each sigma_samp ratio (columns: sigma_samp / max sigma_t). `?`: the winner's variance is not resolved \
@@ -131,15 +156,17 @@ pub fn tables(a: &Analysis) -> (String, String) {
                 let mut line = vec![t.to_string()];
                 for ratio in RATIOS {
                     let w = cell_win(a, p, t, ratio, with_cv);
-                    csv.push_str(&format!(
-                        "{},{t},{ratio},{with_cv},{},\"{}\",{},{},{}\n",
-                        p.name(),
-                        w.as_ref().map(|w| w.label.clone()).unwrap_or_default(),
-                        w.as_ref().map(|w| w.best.estimator.clone()).unwrap_or_default(),
-                        w.as_ref().and_then(|w| w.best.rel_var_cost()).map(|v| format!("{v:e}")).unwrap_or_default(),
-                        w.as_ref().is_some_and(|w| w.resolved),
-                        w.as_ref().and_then(|w| w.tie.clone()).unwrap_or_default(),
-                    ));
+                    rows.push(WinnerRow {
+                        profile: p.name(),
+                        target: t,
+                        ratio,
+                        with_cv,
+                        winner: w.as_ref().map(|w| w.label.clone()),
+                        estimator: w.as_ref().map(|w| w.best.estimator.clone()),
+                        rel_var_cost: w.as_ref().and_then(|w| w.best.rel_var_cost()),
+                        resolved: w.as_ref().is_some_and(|w| w.resolved),
+                        tie_with: w.as_ref().and_then(|w| w.tie.clone()),
+                    });
                     line.push(w.as_ref().map(cell_text).unwrap_or_else(|| "-".into()));
                 }
                 let all = a.rows.iter().filter(|r| r.profile == p && r.target == t && (with_cv || !has_cv(r.family)));
@@ -152,5 +179,5 @@ pub fn tables(a: &Analysis) -> (String, String) {
             md.push_str(&format!("\n## {}\n\n{}", p.name(), markdown_table(&header, &table)));
         }
     }
-    (csv, md)
+    (rows, md)
 }

@@ -10,6 +10,7 @@ use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::plot::{write_figure, Figure, Series};
 use mcbench::runner::RunResults;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// RMSE per frame of one cell, with its time per estimate.
@@ -17,6 +18,23 @@ struct FrameErrors {
     variant: String,
     estimator: String,
     rmse: Vec<f64>,
+    seconds: f64,
+}
+
+/// One row of `frames.csv`: the error of one cell at one frame.
+#[derive(Serialize)]
+struct FrameRow<'a> {
+    /// The test bed.
+    testbed: &'a str,
+    /// Its variant.
+    variant: &'a str,
+    /// The estimator.
+    estimator: &'a str,
+    /// The frame, from 1.
+    frame: usize,
+    /// RMSE of the frame's integrals against the reference (over pixels and channels).
+    rmse: f64,
+    /// Mean seconds per estimate of the cell.
     seconds: f64,
 }
 
@@ -86,13 +104,20 @@ pub fn post(
 ) -> Result<Vec<PathBuf>> {
     let mode = plan.sweep.mode;
     let errors = frame_errors(plan, run);
-    let mut csv = String::from("testbed,variant,estimator,frame,rmse,seconds\n");
-    for e in &errors {
-        for (f, r) in e.rmse.iter().enumerate() {
-            csv.push_str(&format!("envmap-sequence,{},\"{}\",{},{},{}\n", e.variant, e.estimator, f + 1, r, e.seconds));
-        }
-    }
-    results_dir.write("frames.csv", csv.as_bytes())?;
+    let rows: Vec<FrameRow<'_>> = errors
+        .iter()
+        .flat_map(|e| {
+            e.rmse.iter().enumerate().map(|(f, &rmse)| FrameRow {
+                testbed: "envmap-sequence",
+                variant: &e.variant,
+                estimator: &e.estimator,
+                frame: f + 1,
+                rmse,
+                seconds: e.seconds,
+            })
+        })
+        .collect();
+    results_dir.write_csv("frames.csv", &rows)?;
     let mut figures: Vec<(String, Figure)> = Vec::new();
     let frames = plan.beds.first().map(|b| b.bed.sequence_length()).unwrap_or(1);
     if frames < 2 {

@@ -9,10 +9,35 @@ use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::runner::RunResults;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// The refinement criterion the ids run with (their default).
 const CRITERION: f64 = 32.0;
+
+/// One row of `structure.csv`: the octree of one variant and id at the largest budget (the
+/// diagnostics' means over repetitions; NaN where an id reports no such diagnostic).
+#[derive(Serialize)]
+struct StructureRow {
+    /// The test bed variant.
+    variant: String,
+    /// The estimator id.
+    estimator: String,
+    /// Samples per pixel (the largest budget).
+    spp: u64,
+    /// The refinement criterion the ids run with.
+    criterion: f64,
+    /// Depth of the octree.
+    depth: f64,
+    /// Nodes of the octree.
+    nodes: f64,
+    /// Leaves of the octree (= radiance caches).
+    leaves: f64,
+    /// Directional cells over all caches.
+    cells: f64,
+    /// Heap bytes: the caches (cells and partial-sum trees) plus the nodes.
+    bytes: f64,
+}
 
 fn diag(r: &RunReport, variant: &str, estimator: &str, budget: u64, name: &str) -> Option<f64> {
     r.diagnostics
@@ -31,21 +56,28 @@ pub fn post(
     _registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
     let last = plan.sweep.budgets.last().map_or(0, |b| b.amount);
-    let mut csv = String::from("variant,estimator,spp,criterion,depth,nodes,leaves,cells,bytes\n");
-    let names = ["depth", "nodes", "leaves", "cells", "bytes"];
-    let mut seen = Vec::new();
+    let mut rows = Vec::new();
     for d in &report.diagnostics {
-        if d.budget != last || d.name != "nodes" || seen.contains(&(d.variant.clone(), d.estimator.clone())) {
+        if d.budget != last
+            || d.name != "nodes"
+            || rows.iter().any(|r: &StructureRow| r.variant == d.variant && r.estimator == d.estimator)
+        {
             continue;
         }
-        seen.push((d.variant.clone(), d.estimator.clone()));
-        let v: Vec<String> = names
-            .iter()
-            .map(|n| format!("{:.1}", diag(report, &d.variant, &d.estimator, last, n).unwrap_or(f64::NAN)))
-            .collect();
-        csv.push_str(&format!("{},{},{last},{CRITERION},{}\n", d.variant, d.estimator, v.join(",")));
+        let get = |name: &str| diag(report, &d.variant, &d.estimator, last, name).unwrap_or(f64::NAN);
+        rows.push(StructureRow {
+            variant: d.variant.clone(),
+            estimator: d.estimator.clone(),
+            spp: last,
+            criterion: CRITERION,
+            depth: get("depth"),
+            nodes: get("nodes"),
+            leaves: get("leaves"),
+            cells: get("cells"),
+            bytes: get("bytes"),
+        });
     }
-    results.write("structure.csv", csv.as_bytes())?;
+    results.write_csv("structure.csv", &rows)?;
     // Paper 000 Table 1 (Fig. 5 column: criterion 256, depth 7, 2489 nodes, 2178 leaves, 3887712
     // cells, 163.5 MB at 512 x 512 pixels): ours is the same structure at 16 x 16 pixels.
     let table1 = [("depth", 7.0), ("nodes", 2489.0), ("leaves", 2178.0), ("cells", 3_887_712.0), ("bytes", 163.5e6)];

@@ -12,7 +12,29 @@ use mcbench::output::RunReport;
 use mcbench::plan::Plan;
 use mcbench::plot::{write_figure, Figure, Series};
 use mcbench::runner::RunResults;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
+
+/// One row of `fom.csv`: one cell of the summary.
+#[derive(Serialize)]
+struct FomRow<'a> {
+    /// The test bed (medium).
+    testbed: &'a str,
+    /// The estimator id without its parameters.
+    model: &'a str,
+    /// The estimator's sigma_samp (empty for delta tracking, which has none).
+    sigma_samp: Option<f64>,
+    /// The budget (fetches per estimate).
+    budget: u64,
+    /// Mean fetches per estimate.
+    fetches: f64,
+    /// Mean samples (particles) per estimate.
+    samples: f64,
+    /// Root mean squared error against the reference.
+    rmse: f64,
+    /// Figure of merit 1 / (MSE x fetches) (empty where undefined).
+    fom: Option<f64>,
+}
 
 /// The sigma_samp an estimator name carries (`spm_adaptive[sigma_samp=0.8]` -> 0.8).
 fn sigma_of(name: &str) -> Option<f64> {
@@ -32,21 +54,21 @@ pub fn post(
     plots: Option<&Path>,
     _registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
-    let mut csv = String::from("testbed,model,sigma_samp,budget,fetches,samples,rmse,fom\n");
-    for r in &report.rows {
-        let sigma = sigma_of(&r.estimator).map_or(String::new(), |s| s.to_string());
-        let fom = r.fom.map_or(String::new(), |f| format!("{f:e}"));
-        csv.push_str(&format!(
-            "{},{},{sigma},{},{},{},{:e},{fom}\n",
-            r.testbed,
-            model_of(&r.estimator),
-            r.budget,
-            r.fetches,
-            r.samples,
-            r.rmse
-        ));
-    }
-    results.write("fom.csv", csv.as_bytes())?;
+    let rows: Vec<FomRow<'_>> = report
+        .rows
+        .iter()
+        .map(|r| FomRow {
+            testbed: &r.testbed,
+            model: model_of(&r.estimator),
+            sigma_samp: sigma_of(&r.estimator),
+            budget: r.budget,
+            fetches: r.fetches,
+            samples: r.samples,
+            rmse: r.rmse,
+            fom: r.fom,
+        })
+        .collect();
+    results.write_csv("fom.csv", &rows)?;
     let Some(dir) = plots else { return Ok(Vec::new()) };
     let budget = report.rows.iter().map(|r| r.budget).max().unwrap_or(0);
     let mut files = Vec::new();

@@ -14,6 +14,7 @@ use mcbench::output::RunReport;
 use mcbench::plan::Plan;
 use mcbench::plot::maps::{write_maps, Map, Scale};
 use mcbench::runner::RunResults;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// Samples per estimate of the Fig. 7 maps.
@@ -36,27 +37,84 @@ const WEIGHTS: [(&str, &str); 4] = [
     ("alpha_cone", "alpha, cone"),
 ];
 
-fn table2(report: &RunReport) -> String {
-    let mut csv = String::from("source,image,variant,method,spp,image_seconds,err,p_eff,efficiency_mse,rmse\n");
-    for p in PAPER {
-        let variant = if p.0 == "Checks" { "default" } else { "occluded" };
-        csv.push_str(&format!("paper,{},{variant},{},{},{},{},{},,\n", p.0, p.1, p.2, p.3, p.4, p.5));
+/// One row of `table2.csv`: a row of the paper's Table 2 or one of ours.
+#[derive(Serialize)]
+struct Table2Row<'a> {
+    /// `paper` (the paper's numbers) or `ours`.
+    source: &'a str,
+    /// The paper's image (Checks, Plant), or our test bed.
+    image: &'a str,
+    /// Our variant (the paper's rows: the one standing in for their image).
+    variant: &'a str,
+    /// The paper's method (MIS, PMC-HI), or our estimator.
+    method: &'a str,
+    /// Samples per pixel.
+    spp: u64,
+    /// Seconds for the whole image (the paper's T; ours: seconds per estimate x pixels).
+    image_seconds: f64,
+    /// Perceptual error Err (ours: mean over pixels of MSE / tvi(reference luminance)).
+    err: f64,
+    /// P-Eff = 1 / (image seconds x Err) (empty when ours has no timing).
+    p_eff: Option<f64>,
+    /// Our plain efficiency 1 / (MSE x seconds per estimate) (empty for the paper's rows and
+    /// without timing).
+    efficiency_mse: Option<f64>,
+    /// Our RMSE (empty for the paper's rows).
+    rmse: Option<f64>,
+}
+
+/// One row of `alpha_maps.csv`: the PMC-HI mixture weights of one pixel after one estimate of
+/// [`FIG7_SPP`] samples (NaN where the estimate reports no such weight).
+#[derive(Serialize)]
+struct AlphaRow<'a> {
+    /// The test bed variant.
+    variant: &'a str,
+    /// Pixel column.
+    px: usize,
+    /// Pixel row.
+    py: usize,
+    /// Weight of the large light's sampler.
+    alpha_light0: f64,
+    /// Weight of the small light's sampler.
+    alpha_light1: f64,
+    /// Weight of BRDF sampling.
+    alpha_brdf: f64,
+    /// Weight of the adapted cone sampler.
+    alpha_cone: f64,
+}
+
+fn table2(report: &RunReport) -> Vec<Table2Row<'_>> {
+    let mut rows = Vec::new();
+    for (image, method, spp, image_seconds, err, p_eff) in PAPER {
+        let variant = if image == "Checks" { "default" } else { "occluded" };
+        rows.push(Table2Row {
+            source: "paper",
+            image,
+            variant,
+            method,
+            spp,
+            image_seconds,
+            err,
+            p_eff: Some(p_eff),
+            efficiency_mse: None,
+            rmse: None,
+        });
     }
     for r in report.rows.iter().filter(|r| r.testbed == "checker-direct") {
-        let opt = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:.6e}"));
-        csv.push_str(&format!(
-            "ours,checker-direct,{},\"{}\",{},{:.6},{:.6},{},{},{:.6}\n",
-            r.variant,
-            r.estimator,
-            r.budget,
-            r.seconds * r.integrals as f64,
-            r.p_err,
-            opt(r.p_eff),
-            opt(r.efficiency_mse),
-            r.rmse
-        ));
+        rows.push(Table2Row {
+            source: "ours",
+            image: "checker-direct",
+            variant: &r.variant,
+            method: &r.estimator,
+            spp: r.budget,
+            image_seconds: r.seconds * r.integrals as f64,
+            err: r.p_err,
+            p_eff: r.p_eff,
+            efficiency_mse: r.efficiency_mse,
+            rmse: Some(r.rmse),
+        });
     }
-    csv
+    rows
 }
 
 /// Writes `table2.csv`, `alpha_maps.csv` and the Fig. 7 maps.
@@ -68,10 +126,10 @@ pub fn post(
     plots: Option<&Path>,
     _registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
-    results.write("table2.csv", table2(report).as_bytes())?;
+    results.write_csv("table2.csv", &table2(report))?;
     let Some(est) = plan.estimators.iter().find(|e| e.name == "pmc_hi") else { return Ok(Vec::new()) };
     let budget = Budget::samples(FIG7_SPP).map_err(|e| HarnessError::write("fig7", e))?;
-    let mut csv = String::from("variant,px,py,alpha_light0,alpha_light1,alpha_brdf,alpha_cone\n");
+    let mut alphas = Vec::new();
     let mut files = Vec::new();
     for bed in plan.beds.iter().filter(|b| b.bed.hemisphere().is_some_and(|h| h.lights().len() == 2)) {
         let (w, h) = bed.bed.resolution();
@@ -92,8 +150,15 @@ pub fn post(
             for (k, (name, _)) in WEIGHTS.iter().enumerate() {
                 maps[k].push(d.iter().find(|(n, _)| n == name).map_or(f64::NAN, |x| x.1));
             }
-            let v: Vec<String> = maps.iter().map(|m| m[i].to_string()).collect();
-            csv.push_str(&format!("{},{},{},{}\n", bed.variant, i % w, i / w, v.join(",")));
+            alphas.push(AlphaRow {
+                variant: &bed.variant,
+                px: i % w,
+                py: i / w,
+                alpha_light0: maps[0][i],
+                alpha_light1: maps[1][i],
+                alpha_brdf: maps[2][i],
+                alpha_cone: maps[3][i],
+            });
         }
         if let Some(dir) = plots {
             let panels: Vec<Map> = maps
@@ -114,6 +179,6 @@ pub fn post(
             files.extend(write_maps(dir, &format!("fig7_{}", bed.variant), &title, &panels)?);
         }
     }
-    results.write("alpha_maps.csv", csv.as_bytes())?;
+    results.write_csv("alpha_maps.csv", &alphas)?;
     Ok(files)
 }

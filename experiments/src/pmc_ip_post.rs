@@ -18,6 +18,7 @@ use mcbench::output::RunReport;
 use mcbench::plan::{Plan, PreparedBed};
 use mcbench::plot::maps::{write_maps, Map, Scale};
 use mcbench::runner::RunResults;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// The paper's Table 1: (image, method, spp schedule, T seconds, Err, P-Eff).
@@ -51,35 +52,94 @@ fn pmc_ip_of(plan: &Plan, name: &str) -> Option<PmcIp> {
     PmcIp::from_params(&e.spec.params).ok()
 }
 
-fn table1(plan: &Plan, report: &RunReport) -> String {
-    let mut csv = String::from(
-        "variant,method,estimator,spp,schedule,image_seconds,err,p_eff,efficiency_mse,rmse,paper_image,paper_schedule,paper_seconds,paper_err,paper_p_eff\n",
-    );
+/// One row of `table1.csv`: one of our rows matching the paper's Table 1, with the paper's
+/// numbers beside.
+#[derive(Serialize)]
+struct Table1Row<'a> {
+    /// The test bed variant.
+    variant: &'a str,
+    /// `Uniform` or `PMC-IP`.
+    method: &'a str,
+    /// Our estimator.
+    estimator: &'a str,
+    /// Samples per pixel.
+    spp: u64,
+    /// The spp schedule: `initial+per iteration...` for PMC-IP, the spp for uniform.
+    schedule: String,
+    /// Seconds for the whole image (seconds per estimate x pixels).
+    image_seconds: f64,
+    /// Perceptual error Err (mean over pixels of MSE / tvi(reference luminance)).
+    err: f64,
+    /// P-Eff = 1 / (image seconds x Err) (empty without timing).
+    p_eff: Option<f64>,
+    /// Our plain efficiency 1 / (MSE x seconds per estimate) (empty without timing).
+    efficiency_mse: Option<f64>,
+    /// RMSE against the reference.
+    rmse: f64,
+    /// The paper's image of the matching row.
+    paper_image: &'a str,
+    /// The paper's spp schedule.
+    paper_schedule: &'a str,
+    /// The paper's image time T in seconds.
+    paper_seconds: f64,
+    /// The paper's Err.
+    paper_err: f64,
+    /// The paper's P-Eff.
+    paper_p_eff: f64,
+}
+
+/// One row of `pixels.csv`: one pixel of the Fig. 4 maps (channel 0).
+#[derive(Serialize)]
+struct PixelRow<'a> {
+    /// The test bed variant.
+    variant: &'a str,
+    /// Pixel column.
+    px: usize,
+    /// Pixel row.
+    py: usize,
+    /// The stored reference.
+    reference: f64,
+    /// The reference's standard error.
+    reference_se: f64,
+    /// The PMC-IP weight alpha^(1) after the initial image, x pixels (1 = the uniform share).
+    alpha_1: f64,
+    /// Samples the PMC-IP run spent on the pixel.
+    samples: f64,
+    /// Variance of the uniform 10-spp estimate over the run's repetitions (NaN without the cell).
+    var_uniform_10: f64,
+    /// Variance of the PMC-IP 10-spp estimate over the run's repetitions (NaN without the cell).
+    var_pmc_ip_10: f64,
+}
+
+fn table1<'a>(plan: &'a Plan, report: &RunReport) -> Vec<Table1Row<'a>> {
+    let mut rows = Vec::new();
     for b in &plan.beds {
         for ((est, budget), paper) in OURS.iter().zip(PAPER) {
             let Some(r) = row(report, &b.variant, est, *budget) else { continue };
-            let (method, sched) = match pmc_ip_of(plan, est) {
+            let (method, schedule) = match pmc_ip_of(plan, est) {
                 Some(ip) => ("PMC-IP", schedule(&ip, *budget)),
                 None => ("Uniform", budget.to_string()),
             };
-            let opt = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:.6e}"));
-            csv.push_str(&format!(
-                "{},{method},\"{est}\",{budget},{sched},{:.6},{:.6},{},{},{:.6},{},{},{},{},{}\n",
-                b.variant,
-                r.seconds * r.integrals as f64,
-                r.p_err,
-                opt(r.p_eff),
-                opt(r.efficiency_mse),
-                r.rmse,
-                paper.0,
-                paper.2,
-                paper.3,
-                paper.4,
-                paper.5
-            ));
+            rows.push(Table1Row {
+                variant: &b.variant,
+                method,
+                estimator: est,
+                spp: *budget,
+                schedule,
+                image_seconds: r.seconds * r.integrals as f64,
+                err: r.p_err,
+                p_eff: r.p_eff,
+                efficiency_mse: r.efficiency_mse,
+                rmse: r.rmse,
+                paper_image: paper.0,
+                paper_schedule: paper.2,
+                paper_seconds: paper.3,
+                paper_err: paper.4,
+                paper_p_eff: paper.5,
+            });
         }
     }
-    csv
+    rows
 }
 
 /// Per-pixel variance (channel 0) of an estimator's cell at a budget.
@@ -122,11 +182,11 @@ pub fn post(
     plots: Option<&Path>,
     _registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
-    results.write("table1.csv", table1(plan, report).as_bytes())?;
+    results.write_csv("table1.csv", &table1(plan, report))?;
     report.paper.extend(mcbench::claims::reference_precision(plan, report));
     let budget = 10;
     let Some(ip) = pmc_ip_of(plan, "pmc_ip") else { return Ok(Vec::new()) };
-    let mut csv = String::from("variant,px,py,reference,reference_se,alpha_1,samples,var_uniform_10,var_pmc_ip_10\n");
+    let mut rows = Vec::new();
     let mut files = Vec::new();
     for (bi, bed) in plan.beds.iter().enumerate() {
         let (w, h) = bed.bed.resolution();
@@ -139,20 +199,17 @@ pub fn post(
         let nan = vec![f64::NAN; pixels];
         let var_u = variance_image(plan, run, bi, "uniform_image", budget).unwrap_or_else(|| nan.clone());
         let var_p = variance_image(plan, run, bi, "pmc_ip", budget).unwrap_or(nan);
-        for p in 0..pixels {
-            csv.push_str(&format!(
-                "{},{},{},{},{},{},{},{},{}\n",
-                bed.variant,
-                p % w,
-                p / w,
-                reference[p],
-                bed.bed.reference().std_err[p][0],
-                alpha[p],
-                samples[p],
-                var_u[p],
-                var_p[p]
-            ));
-        }
+        rows.extend((0..pixels).map(|p| PixelRow {
+            variant: &bed.variant,
+            px: p % w,
+            py: p / w,
+            reference: reference[p],
+            reference_se: bed.bed.reference().std_err[p][0],
+            alpha_1: alpha[p],
+            samples: samples[p],
+            var_uniform_10: var_u[p],
+            var_pmc_ip_10: var_p[p],
+        }));
         let Some(dir) = plots else { continue };
         let channel = |img: &[Rgb]| img.iter().map(|v| v[0]).collect::<Vec<f64>>();
         let images = [reference.clone(), channel(&trace.initial_image), channel(&trace.estimate), channel(&uniform)];
@@ -183,6 +240,6 @@ pub fn post(
         );
         files.extend(write_maps(dir, &format!("fig4_{}", bed.variant), &title, &maps)?);
     }
-    results.write("pixels.csv", csv.as_bytes())?;
+    results.write_csv("pixels.csv", &rows)?;
     Ok(files)
 }

@@ -10,6 +10,7 @@ use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::runner::RunResults;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// Primary rays per pixel at ~300 fetches in paper 002 Fig. 12 (upper row; MIS's label is lost in
@@ -23,6 +24,33 @@ const PAPER_RAYS_300: [(&str, f64); 6] = [
     ("scattering_driven", 6.0),
 ];
 
+/// One row of `equal_fetch.csv`: one method at one test bed and budget.
+#[derive(Serialize)]
+struct EqualFetchRow<'a> {
+    /// The test bed.
+    testbed: &'a str,
+    /// Its variant.
+    variant: &'a str,
+    /// The budget (fetches per pixel).
+    budget: u64,
+    /// The estimator id.
+    estimator: &'a str,
+    /// Primary rays per pixel the budget buys (samples per estimate).
+    primary_rays: f64,
+    /// Shadow rays per pixel (rays - samples).
+    shadow_rays: f64,
+    /// Medium fetches per pixel.
+    fetches: f64,
+    /// Cheap (explorer) fetches per pixel.
+    cheap_fetches: f64,
+    /// RMSE against the reference.
+    rmse: f64,
+    /// RMSE relative to the reference.
+    rel_rmse: f64,
+    /// Rank by RMSE among the methods at this test bed and budget (1 = best; 0 = unranked).
+    rank: usize,
+}
+
 /// Writes `equal_fetch.csv` and adds the ray counts and unbiasedness summaries to the `paper` block.
 pub fn post(
     plan: &Plan,
@@ -32,9 +60,7 @@ pub fn post(
     _plots: Option<&Path>,
     _registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
-    let mut csv = String::from(
-        "testbed,variant,budget,estimator,primary_rays,shadow_rays,fetches,cheap_fetches,rmse,rel_rmse,rank\n",
-    );
+    let mut rows = Vec::new();
     let mut claims = Vec::new();
     for bed in &plan.beds {
         let tb = bed.spec.id.as_str();
@@ -47,16 +73,19 @@ pub fn post(
                     continue;
                 };
                 let rank = order.iter().position(|(i, _)| i == id).map_or(0, |p| p + 1);
-                csv.push_str(&format!(
-                    "{tb},{},{budget},{id},{:.3},{:.3},{:.1},{:.1},{:.6e},{:.6e},{rank}\n",
-                    row.variant,
-                    row.samples,
-                    row.rays - row.samples,
-                    row.fetches,
-                    row.cheap_fetches,
-                    row.rmse,
-                    row.rel_rmse
-                ));
+                rows.push(EqualFetchRow {
+                    testbed: tb,
+                    variant: &row.variant,
+                    budget,
+                    estimator: id,
+                    primary_rays: row.samples,
+                    shadow_rays: row.rays - row.samples,
+                    fetches: row.fetches,
+                    cheap_fetches: row.cheap_fetches,
+                    rmse: row.rmse,
+                    rel_rmse: row.rel_rmse,
+                    rank,
+                });
                 if budget == PAPER_BUDGETS[1] {
                     let paper = PAPER_RAYS_300.iter().find(|(i, _)| i == id).map(|p| p.1);
                     claims.push(Claim {
@@ -120,7 +149,7 @@ pub fn post(
             });
         }
     }
+    results.write_csv("equal_fetch.csv", &rows)?;
     report.paper.extend(claims);
-    results.write("equal_fetch.csv", csv.as_bytes())?;
     Ok(Vec::new())
 }

@@ -20,6 +20,7 @@ use mcbench::guarded::one_line;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::runner::RunResults;
+use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 /// Ids of the harness sweep (the post hook names its own).
@@ -66,20 +67,51 @@ fn params_text(p: &Params) -> String {
         .join(";")
 }
 
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
+/// One row of `stability.csv`: one case and its outcome.
+#[derive(Serialize)]
+struct StabilityRow {
+    /// The case's short id.
+    case: String,
+    /// The SPEC §10 item it checks.
+    spec_item: String,
+    /// The test bed (`numeric` for the numeric cases).
+    testbed: String,
+    /// Its variant.
+    variant: String,
+    /// The estimator (`-` for the numeric cases).
+    estimator: String,
+    /// The estimator's parameters, then the test bed's as `bed[...]` (`k=v;k=v`).
+    params: String,
+    /// `correct`, `refused` or `FAILED`.
+    outcome: &'static str,
+    /// The outcome theory expects: `correct` or `refused`.
+    expected: &'static str,
+    /// Our value: the mean over integrals and repetitions of channel 0, or the measured quantity
+    /// of a numeric case (empty when there is none).
+    value: Option<f64>,
+    /// The reference of `value` (empty when there is none).
+    reference: Option<f64>,
+    /// The deciding statistic as text, `name=value` (the value to 10 significant digits, nothing
+    /// after `=` when there is none).
+    statistic: String,
+    /// The refusal or failure text (one line), or a note.
+    error_text: String,
 }
 
-fn num_field(x: f64) -> String {
-    if x.is_nan() {
-        String::new()
-    } else {
-        format!("{x:.9e}")
-    }
+/// One row of `pdf_zero.csv`: a place where a sampling pdf can be 0, and how it is guarded.
+#[derive(Serialize)]
+struct PdfZeroRow {
+    /// The source file (and function) of the guard.
+    site: &'static str,
+    /// What the guard does.
+    guard: &'static str,
+    /// The stability cases that exercise it.
+    cases: &'static str,
+}
+
+/// None (an empty cell) for NaN, else the number.
+fn nan_to_none(x: f64) -> Option<f64> {
+    (!x.is_nan()).then_some(x)
 }
 
 /// Runs every case, writes `stability.csv` and `pdf_zero.csv`, adds one claim per case.
@@ -94,7 +126,7 @@ pub fn post(
     let mode = plan.sweep.mode;
     let seed = plan.sweep.seed;
     let k = if mode == Mode::Quick { 1 } else { 4 };
-    let mut rows: Vec<[String; 11]> = Vec::new();
+    let mut rows = Vec::new();
     let mut push = |id: &str, item: &str, bed: String, est: String, params: String, expect: Expect, o: Outcome| {
         let expected = if expect == Expect::Correct { "correct" } else { "refused" };
         report.paper.push(Claim {
@@ -106,19 +138,21 @@ pub fn post(
             note: format!("{}: {}", o.outcome, one_line(&o.text)),
         });
         let (tb, variant) = bed.split_once('/').unwrap_or((&bed, ""));
-        rows.push([
-            id.into(),
-            item.into(),
-            tb.into(),
-            variant.into(),
-            est,
+        let statistic = if o.statistic.is_nan() { String::new() } else { format!("{:.9e}", o.statistic) };
+        rows.push(StabilityRow {
+            case: id.into(),
+            spec_item: item.into(),
+            testbed: tb.into(),
+            variant: variant.into(),
+            estimator: est,
             params,
-            o.outcome.into(),
-            expected.into(),
-            num_field(o.value),
-            num_field(o.reference),
-            format!("{}={}|{}", o.statistic_name, num_field(o.statistic), one_line(&o.text)),
-        ]);
+            outcome: o.outcome,
+            expected,
+            value: nan_to_none(o.value),
+            reference: nan_to_none(o.reference),
+            statistic: format!("{}={statistic}", o.statistic_name),
+            error_text: one_line(&o.text),
+        });
     };
     for c in cases(k) {
         let o = sc::run(&c, seed, registry);
@@ -134,21 +168,9 @@ pub fn post(
     for (id, item, expect, o) in numeric_cases() {
         push(id, item, "numeric/".into(), "-".into(), String::new(), expect, o);
     }
-    let mut csv = String::from(
-        "case,spec_item,testbed,variant,estimator,params,outcome,expected,value,reference,statistic,error_text\n",
-    );
-    for r in &rows {
-        let (stat, text) = r[10].split_once('|').unwrap_or((&r[10], ""));
-        let fields: Vec<String> =
-            r[..10].iter().map(|s| csv_field(s)).chain([csv_field(stat), csv_field(text)]).collect();
-        csv.push_str(&fields.join(","));
-        csv.push('\n');
-    }
-    results.write("stability.csv", csv.as_bytes())?;
-    let mut pz = String::from("site,guard,cases\n");
-    for (site, guard, cases) in PDF_ZERO {
-        pz.push_str(&format!("{},{},{}\n", csv_field(site), csv_field(guard), csv_field(cases)));
-    }
-    results.write("pdf_zero.csv", pz.as_bytes())?;
+    results.write_csv("stability.csv", &rows)?;
+    let pdf_zero: Vec<PdfZeroRow> =
+        PDF_ZERO.iter().map(|&(site, guard, cases)| PdfZeroRow { site, guard, cases }).collect();
+    results.write_csv("pdf_zero.csv", &pdf_zero)?;
     Ok(Vec::new())
 }
