@@ -99,8 +99,9 @@ impl Params {
 pub trait ParamSet:
     Serialize + DeserializeOwned + schemars::JsonSchema + Default + Clone + Send + Sync + 'static
 {
-    /// Checks ranges and combinations, once, after parsing.
-    fn validate(&self) -> Result<(), ConfigError> {
+    /// Checks ranges and combinations, once, after parsing; `owner` is the estimator or test-bed
+    /// id the parameters were given to (for messages naming `owner.field`).
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         Ok(())
     }
 }
@@ -172,7 +173,7 @@ pub fn parse<P: ParamSet>(owner: &str, raw: &Params) -> Result<P, ConfigError> {
         });
         ConfigError::invalid(field, given.unwrap_or_default(), inner)
     })?;
-    p.validate()?;
+    p.validate(owner)?;
     Ok(p)
 }
 
