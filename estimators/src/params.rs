@@ -182,7 +182,8 @@ pub fn parse<P: ParamSet>(owner: &str, raw: &Params) -> Result<P, ConfigError> {
 pub struct ParamDoc {
     /// Its name.
     pub name: String,
-    /// Its type (`number`, `integer`, `string`, ...; `or none` when it may be left unset).
+    /// Its type (`number`, `integer`, `string`, `one of` its names, ...; `or none` when it may be left
+    /// unset).
     pub kind: String,
     /// Its default, as JSON text (`null`: chosen by the variant or computed).
     pub default: String,
@@ -204,6 +205,7 @@ pub fn describe<P: ParamSet>() -> Vec<ParamDoc> {
                     let named: Vec<&str> = ts.iter().filter_map(|t| t.as_str()).filter(|t| *t != "null").collect();
                     format!("{} or none", named.join(" or "))
                 }
+                _ if !value_names(p).is_empty() => format!("one of {}", value_names(p).join(", ")),
                 _ if p.get("enum").is_some() || p.get("oneOf").is_some() => "one of the listed names".into(),
                 _ => "value".into(),
             };
@@ -215,6 +217,18 @@ pub fn describe<P: ParamSet>() -> Vec<ParamDoc> {
             }
         })
         .collect()
+}
+
+/// The values a text parameter may take (a unit enum's names), from its JSON schema.
+fn value_names(schema: &serde_json::Value) -> Vec<String> {
+    let name = |v: &serde_json::Value| v.as_str().map(str::to_string);
+    match (schema.get("enum"), schema.get("oneOf")) {
+        (Some(serde_json::Value::Array(values)), _) => values.iter().filter_map(name).collect(),
+        (_, Some(serde_json::Value::Array(options))) => {
+            options.iter().filter_map(|o| o.get("const").and_then(name)).collect()
+        }
+        _ => Vec::new(),
+    }
 }
 
 /// The parameters of `owner` with every default filled in, as JSON (result files' `params`
@@ -254,5 +268,21 @@ mod tests {
         assert!(p.count("n", 1, 10).is_err());
         assert!(p.f64_in("n", 0.0, 0.0, 1.0).unwrap_err().to_string().contains("[0, 1]"));
         assert!(p.reject_unknown("x", &["n"]).unwrap_err().to_string().contains("x.clamp"));
+    }
+
+    /// A parameter whose value is one of a few names.
+    #[derive(Clone, Debug, Default, Serialize, Deserialize, schemars::JsonSchema)]
+    #[serde(deny_unknown_fields, default)]
+    struct Named {
+        /// The precision.
+        storage: crate::cache::Storage,
+    }
+    impl ParamSet for Named {}
+
+    #[test]
+    fn names_of_an_enum_parameter_are_listed() {
+        let docs = describe::<Named>();
+        assert_eq!((docs[0].kind.as_str(), docs[0].default.as_str()), ("one of f32, f64", "\"f64\""));
+        assert_eq!(docs[0].doc, "The precision.");
     }
 }

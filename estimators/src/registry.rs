@@ -35,6 +35,8 @@ pub struct EstimatorEntry {
     pub summary: &'static str,
     /// Builds a configured instance (validates the parameters).
     pub build: BuildEstimator,
+    /// Its parameters (`mcbench list estimators --params`).
+    pub params: ParamSpec,
     /// How the harness's unbiasedness checks run it.
     pub checks: Checks,
 }
