@@ -12,6 +12,7 @@ use estimators::cache::{CacheConfig, ControlVariate, Domain};
 use estimators::estimator::Estimator;
 use estimators::math::{Rgb, Vec3};
 use estimators::media_smc::octree::Octree;
+use estimators::media_smc::params::MediaSmcParams;
 use estimators::media_smc::walk::Vertex;
 use estimators::media_smc::{walk, MediaSmc, Sampling};
 use estimators::params::Params;
@@ -67,8 +68,7 @@ fn media(c: &mut Criterion) {
         });
     }
 
-    let est =
-        MediaSmc::from_params("is1_cv2", Sampling::Cache, ControlVariate::Bilinear, &Params::new()).expect("params");
+    let est = MediaSmc::from_params(Sampling::Cache, ControlVariate::Bilinear, &MediaSmcParams::default());
     group.throughput(Throughput::Elements(256 * 4));
     group.sample_size(20);
     let mut rng = stream(3, "bench is1_cv2");

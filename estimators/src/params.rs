@@ -40,7 +40,8 @@ pub enum ParamValue {
     Text(String),
 }
 
-/// A set of named parameters. Getters check types and finiteness and name the field on error.
+/// A set of named parameters, as config files and the command line give them; estimators and test
+/// beds read them only through [`parse`] into their typed [`ParamSet`].
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(transparent)]
 pub struct Params(pub BTreeMap<String, ParamValue>);
@@ -55,42 +56,6 @@ impl Params {
         self.0.insert(name.to_string(), ParamValue::Number(v));
         self
     }
-    /// A finite number, or `default` when absent.
-    pub fn f64(&self, name: &str, default: f64) -> Result<f64, ConfigError> {
-        match self.0.get(name) {
-            None => Ok(default),
-            Some(ParamValue::Number(v)) if v.is_finite() => Ok(*v),
-            Some(ParamValue::Number(v)) => Err(ConfigError::invalid(name, v, "must be a finite number")),
-            Some(ParamValue::Text(t)) => Err(ConfigError::invalid(name, t, "must be a number")),
-        }
-    }
-    /// A number in `[lo, hi]`, or `default` when absent.
-    pub fn f64_in(&self, name: &str, default: f64, lo: f64, hi: f64) -> Result<f64, ConfigError> {
-        let v = self.f64(name, default)?;
-        if !(lo..=hi).contains(&v) {
-            return Err(ConfigError::invalid(name, v, format!("must lie in [{lo}, {hi}]")));
-        }
-        Ok(v)
-    }
-    /// A positive whole number, or `default` when absent.
-    pub fn count(&self, name: &str, default: usize, max: usize) -> Result<usize, ConfigError> {
-        let v = self.f64(name, default as f64)?;
-        if v < 1.0 || v.fract() != 0.0 || v > max as f64 {
-            return Err(ConfigError::invalid(name, v, format!("must be a whole number in [1, {max}]")));
-        }
-        Ok(v as usize)
-    }
-    /// Refuses names outside `known` (catches typos in config files).
-    pub fn reject_unknown(&self, owner: &str, known: &[&str]) -> Result<(), ConfigError> {
-        match self.0.keys().find(|k| !known.contains(&k.as_str())) {
-            None => Ok(()),
-            Some(k) => Err(ConfigError::UnknownName {
-                kind: "parameter",
-                name: format!("{owner}.{k}"),
-                valid: if known.is_empty() { "none".into() } else { known.join(", ") },
-            }),
-        }
-    }
 }
 
 /// The typed parameters of one estimator or test bed: a serde struct with `deny_unknown_fields`
@@ -99,13 +64,14 @@ impl Params {
 pub trait ParamSet:
     Serialize + DeserializeOwned + schemars::JsonSchema + Default + Clone + Send + Sync + 'static
 {
-    /// Checks ranges and combinations, once, after parsing.
-    fn validate(&self) -> Result<(), ConfigError> {
+    /// Checks ranges and combinations, once, after parsing; `owner` is the estimator or test-bed
+    /// id the parameters were given to (for messages naming `owner.field`).
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         Ok(())
     }
 }
 
-/// `v` as a count: a whole number in `[1, max]` (the message of [`Params::count`]).
+/// `v` as a count: a whole number in `[1, max]`.
 pub fn check_count(name: &str, v: usize, max: usize) -> Result<usize, ConfigError> {
     if v < 1 || v > max {
         return Err(ConfigError::invalid(name, v, format!("must be a whole number in [1, {max}]")));
@@ -113,7 +79,7 @@ pub fn check_count(name: &str, v: usize, max: usize) -> Result<usize, ConfigErro
     Ok(v)
 }
 
-/// `v` in `[lo, hi]` (the message of [`Params::f64_in`]).
+/// `v` in `[lo, hi]`.
 pub fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, ConfigError> {
     if !(lo..=hi).contains(&v) {
         return Err(ConfigError::invalid(name, v, format!("must lie in [{lo}, {hi}]")));
@@ -172,7 +138,7 @@ pub fn parse<P: ParamSet>(owner: &str, raw: &Params) -> Result<P, ConfigError> {
         });
         ConfigError::invalid(field, given.unwrap_or_default(), inner)
     })?;
-    p.validate()?;
+    p.validate(owner)?;
     Ok(p)
 }
 
@@ -181,7 +147,8 @@ pub fn parse<P: ParamSet>(owner: &str, raw: &Params) -> Result<P, ConfigError> {
 pub struct ParamDoc {
     /// Its name.
     pub name: String,
-    /// Its type (`number`, `integer`, `string`, ...; `or none` when it may be left unset).
+    /// Its type (`number`, `integer`, `string`, `one of` its names, ...; `or none` when it may be left
+    /// unset).
     pub kind: String,
     /// Its default, as JSON text (`null`: chosen by the variant or computed).
     pub default: String,
@@ -203,6 +170,7 @@ pub fn describe<P: ParamSet>() -> Vec<ParamDoc> {
                     let named: Vec<&str> = ts.iter().filter_map(|t| t.as_str()).filter(|t| *t != "null").collect();
                     format!("{} or none", named.join(" or "))
                 }
+                _ if !value_names(p).is_empty() => format!("one of {}", value_names(p).join(", ")),
                 _ if p.get("enum").is_some() || p.get("oneOf").is_some() => "one of the listed names".into(),
                 _ => "value".into(),
             };
@@ -214,6 +182,18 @@ pub fn describe<P: ParamSet>() -> Vec<ParamDoc> {
             }
         })
         .collect()
+}
+
+/// The values a text parameter may take (a unit enum's names), from its JSON schema.
+fn value_names(schema: &serde_json::Value) -> Vec<String> {
+    let name = |v: &serde_json::Value| v.as_str().map(str::to_string);
+    match (schema.get("enum"), schema.get("oneOf")) {
+        (Some(serde_json::Value::Array(values)), _) => values.iter().filter_map(name).collect(),
+        (_, Some(serde_json::Value::Array(options))) => {
+            options.iter().filter_map(|o| o.get("const").and_then(name)).collect()
+        }
+        _ => Vec::new(),
+    }
 }
 
 /// The parameters of `owner` with every default filled in, as JSON (result files' `params`
@@ -246,12 +226,29 @@ mod tests {
     use super::*;
 
     #[test]
-    fn getters_validate_and_name_the_field() {
-        let p = Params::new().with("clamp", f64::NAN).with("n", 2.5);
-        assert!(p.f64("clamp", 1.0).unwrap_err().to_string().contains("clamp"));
-        assert_eq!(p.f64("absent", 3.0), Ok(3.0));
-        assert!(p.count("n", 1, 10).is_err());
-        assert!(p.f64_in("n", 0.0, 0.0, 1.0).unwrap_err().to_string().contains("[0, 1]"));
-        assert!(p.reject_unknown("x", &["n"]).unwrap_err().to_string().contains("x.clamp"));
+    fn checks_name_the_field() {
+        assert!(check_count("n", 0, 10).unwrap_err().to_string().contains("whole number in [1, 10]"));
+        assert_eq!(check_count("n", 10, 10), Ok(10));
+        assert!(check_range("x", 1.5, 0.0, 1.0).unwrap_err().to_string().contains("x = 1.5: must lie in [0, 1]"));
+        let typo = parse::<NoParams>("owner", &Params::new().with("clamp", 1.0)).unwrap_err().to_string();
+        assert!(typo.contains("owner.clamp") && typo.contains("valid: none"), "{typo}");
+        let nan = parse::<NoParams>("owner", &Params::new().with("x", f64::NAN)).unwrap_err().to_string();
+        assert!(nan.contains("owner.x") && nan.contains("finite"), "{nan}");
+    }
+
+    /// A parameter whose value is one of a few names.
+    #[derive(Clone, Debug, Default, Serialize, Deserialize, schemars::JsonSchema)]
+    #[serde(deny_unknown_fields, default)]
+    struct Named {
+        /// The precision.
+        storage: crate::cache::Storage,
+    }
+    impl ParamSet for Named {}
+
+    #[test]
+    fn names_of_an_enum_parameter_are_listed() {
+        let docs = describe::<Named>();
+        assert_eq!((docs[0].kind.as_str(), docs[0].default.as_str()), ("one of f32, f64", "\"f64\""));
+        assert_eq!(docs[0].doc, "The precision.");
     }
 }

@@ -35,6 +35,8 @@ pub struct EstimatorEntry {
     pub summary: &'static str,
     /// Builds a configured instance (validates the parameters).
     pub build: BuildEstimator,
+    /// Its parameters (`mcbench list estimators --params`).
+    pub params: ParamSpec,
     /// How the harness's unbiasedness checks run it.
     pub checks: Checks,
 }
@@ -241,6 +243,7 @@ impl EstimatorEntry {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::ParamValue;
 
     #[test]
     fn ids_are_unique_and_lookups_list_valid_names() {
@@ -251,5 +254,38 @@ mod tests {
         let err = estimator("nope").err().map(|e| e.to_string()).unwrap_or_default();
         assert!(err.contains("is0_cv0"), "{err}");
         assert!(testbed("gradient-plane").is_ok());
+    }
+
+    /// Every parameter of every estimator and test bed is documented, the defaults are valid, and
+    /// an estimator builds from its resolved defaults given explicitly (its `params` spec is the
+    /// one its `build` parses).
+    #[test]
+    fn parameters_are_documented_and_their_defaults_valid() {
+        let specs = ESTIMATORS.iter().map(|e| (e.id, e.params)).chain(TESTBEDS.iter().map(|t| (t.id, t.params)));
+        for (id, spec) in specs {
+            for doc in (spec.describe)() {
+                assert!(!doc.doc.trim().is_empty(), "{id}.{} has no doc", doc.name);
+            }
+            let resolved = (spec.resolve)(id, &Params::new());
+            assert!(resolved.is_ok(), "{id}: {resolved:?}");
+        }
+        for e in ESTIMATORS {
+            let resolved = (e.params.resolve)(e.id, &Params::new()).unwrap_or_default();
+            let mut explicit = Params::new();
+            for (name, v) in resolved.as_object().into_iter().flatten() {
+                let value = match v {
+                    serde_json::Value::Number(x) => ParamValue::Number(x.as_f64().unwrap_or(f64::NAN)),
+                    serde_json::Value::String(t) => ParamValue::Text(t.clone()),
+                    _ => continue,
+                };
+                explicit.0.insert(name.clone(), value);
+            }
+            let described: Vec<String> = (e.params.describe)().into_iter().map(|d| d.name).collect();
+            assert!(explicit.0.keys().all(|k| described.contains(k)), "{}: {explicit:?} vs {described:?}", e.id);
+            let built = (e.build)(&explicit).err();
+            assert!(built.is_none(), "{} refuses its defaults {explicit:?}: {built:?}", e.id);
+            let typo = (e.build)(&Params::new().with("no_such_parameter", 1.0)).err().map(|x| x.to_string());
+            assert!(typo.is_some_and(|t| t.contains(&format!("{}.no_such_parameter", e.id))), "{}", e.id);
+        }
     }
 }

@@ -15,7 +15,7 @@
 //! ## Quick start: your own estimator, from your own crate
 //!
 //! ```no_run
-//! use mcbench::{Checks, EstimateError, Estimator, EstimatorEntry, Registry, Rgb, StreamRng, Task};
+//! use mcbench::{Checks, EstimateError, Estimator, EstimatorEntry, ParamSpec, Registry, Rgb, StreamRng, Task};
 //! use mcbench::estimators::{estimator::Bias, testbed::Needs};
 //!
 //! /// Independent uniform-hemisphere sampling of a surface integral.
@@ -44,7 +44,11 @@
 //!     needs: Needs::SURFACE,
 //!     samplers: &["uniform_hemisphere"],
 //!     summary: "independent uniform sampling of the hemisphere",
-//!     build: |_params| Ok(Box::new(Uniform)),
+//!     build: |params| {
+//!         mcbench::estimators::params::parse::<mcbench::estimators::params::NoParams>("my_uniform", params)?;
+//!         Ok(Box::new(Uniform))
+//!     },
+//!     params: ParamSpec::NONE,
 //!     checks: Checks::DEFAULT,
 //! };
 //!
@@ -88,6 +92,7 @@ pub use estimators;
 pub use estimators::error::{ConfigError, EstimateError};
 pub use estimators::estimator::{Bias, Estimator};
 pub use estimators::math::Rgb;
+pub use estimators::params::ParamSpec;
 pub use estimators::registry::{BedCase, CaseRole, Checks, EstimatorEntry, Exemption, TestBedEntry};
 pub use estimators::rng::StreamRng;
 pub use estimators::task::Task;

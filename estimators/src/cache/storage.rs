@@ -6,8 +6,8 @@
 //! stored coefficients are rounded, so the integral `G` is always the exact integral of the `g`
 //! reconstructed from the stored values.
 
-use crate::error::ConfigError;
-use crate::params::{ParamValue, Params};
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// A floating-point type the cache cells are stored in.
 pub trait Scalar: Copy + Default + PartialEq + Send + Sync + std::fmt::Debug + 'static {
@@ -54,8 +54,11 @@ impl Scalar for f32 {
     }
 }
 
-/// The storage choice of an estimator (parameter `storage = "f32" | "f64"`, default `f64`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// The storage choice of an estimator (parameter `storage`, the text `"f32"` or `"f64"`, default
+/// `f64`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "lowercase")]
+#[schemars(inline)]
 pub enum Storage {
     /// Single precision: 20 bytes per cell.
     F32,
@@ -65,16 +68,6 @@ pub enum Storage {
 }
 
 impl Storage {
-    /// Reads parameter `name` (a text value `f32` or `f64`; absent means `f64`).
-    pub fn from_params(params: &Params, name: &str) -> Result<Self, ConfigError> {
-        match params.0.get(name) {
-            None => Ok(Storage::F64),
-            Some(ParamValue::Text(t)) if t == "f64" => Ok(Storage::F64),
-            Some(ParamValue::Text(t)) if t == "f32" => Ok(Storage::F32),
-            Some(ParamValue::Text(t)) => Err(ConfigError::invalid(name, t, "must be \"f32\" or \"f64\"")),
-            Some(ParamValue::Number(v)) => Err(ConfigError::invalid(name, v, "must be the text \"f32\" or \"f64\"")),
-        }
-    }
     /// The name (`f32` or `f64`).
     pub fn name(self) -> &'static str {
         match self {
@@ -89,16 +82,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn positive_values_never_round_to_zero_and_the_parameter_is_validated() {
+    fn positive_values_never_round_to_zero_and_the_parameter_is_a_name() {
         assert_eq!(<f32 as Scalar>::put_positive(1e-300), f32::from_bits(1));
         assert_eq!(<f32 as Scalar>::put_positive(0.0), 0.0);
         assert_eq!(<f32 as Scalar>::put(0.5).get(), 0.5);
-        let mut p = Params::new();
-        assert_eq!(Storage::from_params(&p, "storage"), Ok(Storage::F64));
-        p.0.insert("storage".into(), ParamValue::Text("f32".into()));
-        assert_eq!(Storage::from_params(&p, "storage"), Ok(Storage::F32));
-        p.0.insert("storage".into(), ParamValue::Text("f16".into()));
-        assert!(Storage::from_params(&p, "storage").unwrap_err().to_string().contains("storage"));
-        assert!(Storage::from_params(&Params::new().with("storage", 32.0), "storage").is_err());
+        let parse = |v: serde_json::Value| serde_json::from_value::<Storage>(v).map_err(|e| e.to_string());
+        assert_eq!(parse(serde_json::json!("f32")), Ok(Storage::F32));
+        assert_eq!(parse(serde_json::json!("f64")), Ok(Storage::F64));
+        assert!(parse(serde_json::json!("f16")).is_err());
+        assert!(parse(serde_json::json!(32)).is_err());
+        assert_eq!(serde_json::to_value(Storage::default()).ok(), Some(serde_json::json!("f64")));
+        for s in [Storage::F32, Storage::F64] {
+            assert_eq!(serde_json::to_value(s).ok(), Some(serde_json::json!(s.name())));
+        }
     }
 }

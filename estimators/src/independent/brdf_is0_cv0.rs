@@ -4,6 +4,7 @@
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, NoParams, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::task::Task;
@@ -19,9 +20,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["brdf"],
     summary: "BRDF importance sampling (cosine + Phong lobe mixture), no control variate",
     build: |p| {
-        p.reject_unknown("brdf_is0_cv0", &[])?;
+        parse::<NoParams>("brdf_is0_cv0", p)?;
         Ok(Box::new(BrdfIs0Cv0))
     },
+    params: ParamSpec::NONE,
     checks: Checks::DEFAULT,
 };
 

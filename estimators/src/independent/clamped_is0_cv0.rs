@@ -2,14 +2,17 @@
 //! sample's contribution `f / p` clamped per channel at `clamp` (a "firefly clamp"). Its only
 //! purpose is to prove that the unbiasedness test can fail (SPEC §6 "Teeth").
 
-use crate::error::EstimateError;
+use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, ParamSet, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::uniform_hemisphere;
 use crate::task::Task;
 use crate::testbed::Needs;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {
@@ -20,16 +23,33 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::SURFACE,
     samplers: &["uniform_hemisphere"],
     summary: "biased control: is0_cv0 with each sample clamped at `clamp` (default 2)",
-    build: |p| {
-        p.reject_unknown("clamped_is0_cv0", &["clamp"])?;
-        let clamp = p.f64("clamp", 2.0)?;
-        if clamp <= 0.0 {
-            return Err(crate::error::ConfigError::invalid("clamped_is0_cv0.clamp", clamp, "must be > 0"));
-        }
-        Ok(Box::new(ClampedIs0Cv0 { clamp }))
-    },
+    build: |p| Ok(Box::new(ClampedIs0Cv0 { clamp: parse::<ClampedParams>("clamped_is0_cv0", p)?.clamp })),
+    params: ParamSpec::of::<ClampedParams>(),
     checks: Checks::DEFAULT,
 };
+
+/// Parameters of `clamped_is0_cv0`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct ClampedParams {
+    /// Per-channel ceiling of one sample's contribution `f / p` (> 0).
+    pub clamp: f64,
+}
+
+impl Default for ClampedParams {
+    fn default() -> Self {
+        ClampedParams { clamp: 2.0 }
+    }
+}
+
+impl ParamSet for ClampedParams {
+    fn validate(&self, owner: &str) -> Result<(), ConfigError> {
+        if self.clamp <= 0.0 {
+            return Err(ConfigError::invalid(format!("{owner}.clamp"), self.clamp, "must be > 0"));
+        }
+        Ok(())
+    }
+}
 
 /// The estimator.
 pub struct ClampedIs0Cv0 {

@@ -4,6 +4,7 @@
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, NoParams, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::uniform_hemisphere;
@@ -20,12 +21,13 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "independent MC baseline: uniform hemisphere sampling; on a medium, the path tracer (free flights, phase sampling)",
     build: |p| {
-        p.reject_unknown("is0_cv0", &[])?;
+        parse::<NoParams>("is0_cv0", p)?;
         Ok(Box::new(crate::media_smc::SurfaceOrMedium {
             surface: Box::new(Is0Cv0),
             medium: Box::new(crate::media_smc::PathTracer),
         }))
     },
+    params: ParamSpec::NONE,
     checks: Checks::DEFAULT,
 };
 

@@ -47,7 +47,7 @@ impl Default for MediumParams {
 }
 
 impl ParamSet for MediumParams {
-    fn validate(&self) -> Result<(), ConfigError> {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         if let Some(r) = self.resolution {
             check_count("resolution", r, 512)?;
         }

@@ -19,24 +19,22 @@
 //! snapshot fixed before its direction is drawn.
 
 pub mod octree;
+pub mod params;
 pub mod walk;
 
 use crate::accumulate::RgbMean;
-use crate::cache::{CacheConfig, ControlVariate, Domain, Scalar, Storage, MAX_DEPTH_LIMIT};
-use crate::error::{ConfigError, EstimateError};
+use crate::cache::{CacheConfig, ControlVariate, Domain, Scalar, Storage};
+use crate::error::EstimateError;
 use crate::estimator::Estimator;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::task::{MediumProbe, Task};
 use crate::testbed::TestBed;
 use octree::Octree;
+use params::MediaSmcParams;
 pub use walk::{Sampling, Transport};
 
 pub mod rm_is1_cv2;
-
-/// The parameters every medium SMC id accepts (the surface ones plus `shared`).
-pub const PARAMS: &[&str] = &["criterion", "max_depth", "storage", "shared"];
 
 /// The generic medium SMC estimator.
 #[derive(Clone, Debug)]
@@ -50,23 +48,19 @@ pub struct MediaSmc {
 }
 
 impl MediaSmc {
-    /// Builds from parameters: `criterion` (mean records per cell before a split, default 32),
-    /// `max_depth` (octree depth, default 5), `storage` (`f64` / `f32`), `shared` (1: one structure
-    /// per image, the default; 0: one per pixel).
-    pub fn from_params(id: &str, sampling: Sampling, cv: ControlVariate, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown(id, PARAMS)?;
-        let criterion = params.f64_in("criterion", 32.0, 1.0, 1e9)?;
-        let max_depth = params.count("max_depth", 5, MAX_DEPTH_LIMIT as usize)? as u32;
-        let storage = Storage::from_params(params, "storage")?;
-        let shared = params.f64_in("shared", 1.0, 0.0, 1.0)? >= 0.5;
+    /// Builds from its parameters: `criterion` (mean records per cell before a split), `max_depth`
+    /// (octree depth), `storage` (`f64` / `f32`), `shared` (>= 0.5: one structure per image; below:
+    /// one per pixel).
+    pub fn from_params(sampling: Sampling, cv: ControlVariate, params: &MediaSmcParams) -> Self {
         let config = CacheConfig {
             domain: Domain::Sphere,
-            criterion,
-            max_depth,
+            criterion: params.criterion,
+            max_depth: params.max_depth as u32,
             counter_divisor: octree::SPLIT_DIVISOR,
             importance: sampling == Sampling::Cache,
         };
-        Ok(MediaSmc { transport: Transport::FreeFlight, sampling, cv, config, storage, shared })
+        let (storage, shared) = (params.storage, params.shared >= 0.5);
+        MediaSmc { transport: Transport::FreeFlight, sampling, cv, config, storage, shared }
     }
 
     /// The same estimator over ray-marching steps of length `step` (paper 000 Eq. 8-9: biased).
@@ -189,18 +183,6 @@ impl SurfaceOrMedium {
             Some(t) if t.hemisphere().is_none() && t.medium().is_some() => self.medium.as_ref(),
             _ => self.surface.as_ref(),
         }
-    }
-    /// Builds an id from its surface estimator and its medium estimator, splitting the parameters:
-    /// `shared` belongs to the medium only.
-    pub fn build(
-        surface: impl Fn(&Params) -> Result<Box<dyn Estimator>, ConfigError>,
-        medium: impl Fn(&Params) -> Result<Box<dyn Estimator>, ConfigError>,
-        params: &Params,
-    ) -> Result<Box<dyn Estimator>, ConfigError> {
-        let medium = medium(params)?;
-        let mut surface_params = params.clone();
-        surface_params.0.remove("shared");
-        Ok(Box::new(SurfaceOrMedium { surface: surface(&surface_params)?, medium }))
     }
 }
 

@@ -9,9 +9,11 @@
 //! the id exists as the biased control the unbiasedness tests must flag. The id is not
 //! `ray_marching`, which feat/media uses for the transmittance tracker.
 
-use super::{MediaSmc, Sampling, PARAMS};
+use super::params::RmIs1Cv2Params;
+use super::{MediaSmc, Sampling};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry, Exemption};
 use crate::testbed::Needs;
 
@@ -25,14 +27,11 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["uniform_hemisphere", "phase"],
     summary: "ray marching over the 4 pi + 1 domain (paper 000 Eq. 8-9) with the SMC octree; biased control",
     build: |p| {
-        let known: Vec<&str> = PARAMS.iter().copied().chain(["step"]).collect();
-        p.reject_unknown("rm_is1_cv2", &known)?;
-        let step = p.f64_in("step", 0.5, 1e-6, 10.0)?;
-        let mut rest = p.clone();
-        rest.0.remove("step");
-        let est = MediaSmc::from_params("rm_is1_cv2", Sampling::Cache, ControlVariate::Bilinear, &rest)?;
-        Ok(Box::new(est.ray_marching(step)))
+        let p = parse::<RmIs1Cv2Params>("rm_is1_cv2", p)?;
+        let est = MediaSmc::from_params(Sampling::Cache, ControlVariate::Bilinear, &p.octree());
+        Ok(Box::new(est.ray_marching(p.step)))
     },
+    params: ParamSpec::of::<RmIs1Cv2Params>(),
     checks: Checks {
         params: &[],
         exempt: &[

@@ -4,6 +4,7 @@
 
 use super::*;
 use crate::budget::Budget;
+use crate::params::Params;
 use crate::registry;
 use crate::rng::StreamKey;
 use crate::stats::{holm_bonferroni, one_sample_t, Moments};
@@ -87,13 +88,8 @@ fn smc_ids_are_unbiased_on_exact_references() {
 #[test]
 fn octree_invariants_hold_after_adaptation() {
     let b = GradientBox::without_reference("albedo-0.8", &Params::new()).unwrap();
-    let est = MediaSmc::from_params(
-        "is1_cv2",
-        Sampling::Cache,
-        ControlVariate::Bilinear,
-        &Params::new().with("criterion", 4.0),
-    )
-    .unwrap();
+    let params = MediaSmcParams { criterion: 4.0, ..MediaSmcParams::default() };
+    let est = MediaSmc::from_params(Sampling::Cache, ControlVariate::Bilinear, &params);
     let mut tree = Octree::<f64>::new(Vec3::default(), 0.5, est.config);
     let mut rng = crate::rng::stream(3, "octree");
     let mut vertices = Vec::new();

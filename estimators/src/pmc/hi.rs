@@ -20,12 +20,14 @@ use super::kernel::{Cone, Kernel};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
+use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::mixture::dms_counts;
 use crate::task::{HemisphereProbe, Task};
 use crate::testbed::Needs;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// Registry entry of `pmc_hi`.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {
@@ -36,7 +38,8 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::SURFACE.and(Needs::AREA_LIGHTS),
     samplers: &["brdf", "rect_light", "cone", "mixture"],
     summary: "PMC for hemispheric integrals: BRDF + per-light + cone mixture adapted per population (Eq. 7-9)",
-    build: |p| Ok(Box::new(PmcHi::from_params("pmc_hi", p, 1)?)),
+    build: |p| Ok(Box::new(PmcHi::from_params(&parse::<PmcHiParams>("pmc_hi", p)?))),
+    params: ParamSpec::of::<PmcHiParams>(),
     checks: Checks::DEFAULT,
 };
 
@@ -49,7 +52,8 @@ pub static FEEDBACK: EstimatorEntry = EstimatorEntry {
     needs: Needs::SURFACE.and(Needs::AREA_LIGHTS),
     samplers: &["brdf", "rect_light", "cone", "mixture"],
     summary: "PMC-HI whose weights start from the previous image-plane pass (paper 003 §6.1)",
-    build: |p| Ok(Box::new(PmcHi::from_params("pmc_hi_feedback", p, 2)?)),
+    build: |p| Ok(Box::new(PmcHi::from_params(&parse::<PmcHiFeedbackParams>("pmc_hi_feedback", p)?.into()))),
+    params: ParamSpec::of::<PmcHiFeedbackParams>(),
     checks: Checks::DEFAULT,
 };
 
@@ -66,13 +70,79 @@ pub struct PmcHi {
     pub min_beta: f64,
 }
 
+/// Parameters of `pmc_hi`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct PmcHiParams {
+    /// Directions per population (1 to 2^20; unset: `2m`, m the mixture's components: the BRDF,
+    /// one per light and the cone).
+    pub population: Option<usize>,
+    /// Defensive share of the BRDF and light components (1e-6 to 1).
+    pub delta: f64,
+    /// Image-plane passes at the same pixel, each after the first starting from the weights the
+    /// previous one adapted (1 to 64).
+    pub passes: usize,
+}
+
+impl Default for PmcHiParams {
+    fn default() -> Self {
+        PmcHiParams { population: None, delta: 0.1, passes: 1 }
+    }
+}
+
+impl ParamSet for PmcHiParams {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
+        if let Some(n) = self.population {
+            check_count("population", n, 1 << 20)?;
+        }
+        check_range("delta", self.delta, 1e-6, 1.0)?;
+        check_count("passes", self.passes, 64)?;
+        Ok(())
+    }
+}
+
+/// Parameters of `pmc_hi_feedback`: those of `pmc_hi`, two passes by default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct PmcHiFeedbackParams {
+    /// Directions per population (1 to 2^20; unset: `2m`, m the mixture's components: the BRDF,
+    /// one per light and the cone).
+    pub population: Option<usize>,
+    /// Defensive share of the BRDF and light components (1e-6 to 1).
+    pub delta: f64,
+    /// Image-plane passes at the same pixel, each after the first starting from the weights the
+    /// previous one adapted (1 to 64).
+    pub passes: usize,
+}
+
+impl Default for PmcHiFeedbackParams {
+    fn default() -> Self {
+        PmcHiFeedbackParams { passes: 2, ..PmcHiParams::default().into() }
+    }
+}
+
+impl From<PmcHiParams> for PmcHiFeedbackParams {
+    fn from(p: PmcHiParams) -> Self {
+        PmcHiFeedbackParams { population: p.population, delta: p.delta, passes: p.passes }
+    }
+}
+
+impl From<PmcHiFeedbackParams> for PmcHiParams {
+    fn from(p: PmcHiFeedbackParams) -> Self {
+        PmcHiParams { population: p.population, delta: p.delta, passes: p.passes }
+    }
+}
+
+impl ParamSet for PmcHiFeedbackParams {
+    fn validate(&self, owner: &str) -> Result<(), ConfigError> {
+        PmcHiParams::from(self.clone()).validate(owner)
+    }
+}
+
 impl PmcHi {
-    fn from_params(id: &str, p: &Params, passes: usize) -> Result<Self, ConfigError> {
-        p.reject_unknown(id, &["population", "delta", "passes"])?;
-        let population = if p.0.contains_key("population") { p.count("population", 8, 1 << 20)? } else { 0 };
-        let delta = p.f64_in("delta", 0.1, 1e-6, 1.0)?;
-        let passes = p.count("passes", passes, 64)?;
-        Ok(PmcHi { population, delta, passes, min_beta: 0.02 })
+    /// Builds from its parameters.
+    pub fn from_params(p: &PmcHiParams) -> Self {
+        PmcHi { population: p.population.unwrap_or(0), delta: p.delta, passes: p.passes, min_beta: 0.02 }
     }
 }
 

@@ -35,7 +35,7 @@ use crate::budget::BudgetKind;
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::params::Params;
+use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
 use crate::perception::{luminance, tvi};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
@@ -44,6 +44,8 @@ use crate::stats::Moments;
 use crate::task::{ImageProbe, Task};
 use crate::testbed::Needs;
 use rand::Rng;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {
@@ -55,8 +57,39 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "PMC image-plane sampler: per-pixel mixture, alpha ∝ eps + sigma^2/tvi(L), DMS allocation (§4)",
     build: |p| Ok(Box::new(PmcIp::from_params(p)?)),
+    params: ParamSpec::of::<PmcIpParams>(),
     checks: Checks::DEFAULT,
 };
+
+/// Parameters of `pmc_ip`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct PmcIpParams {
+    /// Samples per pixel of the initial (uniform) image (1 to 2^20).
+    pub initial: usize,
+    /// Adaptive iterations after the initial image (1 to 4096).
+    pub iterations: usize,
+    /// The defensive constant of §4.2 added to every pixel's weight (1e-12 to 1e12).
+    pub eps: f64,
+    /// Samples reserved for every pixel in every iteration (0 to 1024).
+    pub min_samples: usize,
+}
+
+impl Default for PmcIpParams {
+    fn default() -> Self {
+        PmcIpParams { initial: 2, iterations: 2, eps: 0.01, min_samples: 1 }
+    }
+}
+
+impl ParamSet for PmcIpParams {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
+        check_count("initial", self.initial, 1 << 20)?;
+        check_count("iterations", self.iterations, 4096)?;
+        check_range("eps", self.eps, 1e-12, 1e12)?;
+        check_range("min_samples", self.min_samples as f64, 0.0, 1024.0)?;
+        Ok(())
+    }
+}
 
 /// The configured sampler.
 #[derive(Clone, Debug, PartialEq)]
@@ -98,17 +131,15 @@ pub struct Trace {
 }
 
 impl PmcIp {
-    /// Reads `initial` (default 2), `iterations` (2), `eps` (0.01), `min_samples` (1).
+    /// Builds from its parameters.
+    pub fn new(p: &PmcIpParams) -> Self {
+        PmcIp { initial: p.initial as u64, iterations: p.iterations, eps: p.eps, min_samples: p.min_samples }
+    }
+
+    /// Parses `initial` (default 2), `iterations` (2), `eps` (0.01), `min_samples` (1) as
+    /// [`PmcIpParams`] and builds.
     pub fn from_params(p: &Params) -> Result<Self, ConfigError> {
-        p.reject_unknown("pmc_ip", &["initial", "iterations", "eps", "min_samples"])?;
-        let initial = p.count("initial", 2, 1 << 20)? as u64;
-        let iterations = p.count("iterations", 2, 4096)?;
-        let eps = p.f64_in("eps", 0.01, 1e-12, 1e12)?;
-        let min_samples = p.f64_in("min_samples", 1.0, 0.0, 1024.0)?;
-        if min_samples.fract() != 0.0 {
-            return Err(ConfigError::invalid("pmc_ip.min_samples", min_samples, "must be a whole number"));
-        }
-        Ok(PmcIp { initial, iterations, eps, min_samples: min_samples as usize })
+        Ok(PmcIp::new(&parse::<PmcIpParams>("pmc_ip", p)?))
     }
 
     /// The kernel weights of §4.2 from each pixel's luminance statistics:

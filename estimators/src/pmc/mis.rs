@@ -6,11 +6,15 @@
 //! point-light single scattering in a medium the same id is paper 002's MIS
 //! ([`crate::single_scatter::mis`]).
 
-use crate::error::{ConfigError, EstimateError};
+use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
+use crate::single_scatter::mis::MisScatter;
+use crate::single_scatter::params::MisParams;
+use crate::single_scatter::SingleScatterOr;
 use crate::task::{HemisphereProbe, Task};
 use crate::testbed::Needs;
 
@@ -24,19 +28,13 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["brdf", "rect_light"],
     summary: "one BRDF + one light sample per round, balance heuristic (power = 2: power heuristic); on point-light single scattering (paper 002), source- + scattering-driven points, balance heuristic",
     build: |p| {
-        crate::single_scatter::SingleScatterOr::build(
-            "mis",
-            p,
-            (&["power"], |p| {
-                let power = p.f64("power", 1.0)?;
-                if power != 1.0 && power != 2.0 {
-                    return Err(ConfigError::invalid("mis.power", power, "must be 1 (balance) or 2 (power heuristic)"));
-                }
-                Ok(Box::new(Mis { power }))
-            }),
-            (crate::single_scatter::mis::PARAMS, |p| Ok(Box::new(crate::single_scatter::mis::MisScatter::from_params(p)?))),
-        )
+        let p = parse::<MisParams>("mis", p)?;
+        Ok(Box::new(SingleScatterOr {
+            single_scatter: Box::new(MisScatter::from_params(&p)?),
+            other: Box::new(Mis { power: p.power }),
+        }))
     },
+    params: ParamSpec::of::<MisParams>(),
     checks: Checks::DEFAULT,
 };
 

@@ -7,9 +7,10 @@
 //! at most the image budget (less when every pixel has stopped).
 
 use super::ip::image_probes;
-use crate::error::EstimateError;
+use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec};
 use crate::perception::luminance;
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
@@ -17,6 +18,8 @@ use crate::stats::Moments;
 use crate::task::{ImageProbe, Task};
 use crate::testbed::Needs;
 use rand::Rng;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {
@@ -28,13 +31,36 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "biased control: per-pixel sampling stopped once the relative standard error <= threshold (paper 003 §2)",
     build: |p| {
-        p.reject_unknown("threshold_image", &["initial", "threshold"])?;
-        let initial = p.count("initial", 2, 1 << 20)?;
-        let threshold = p.f64_in("threshold", 0.1, 0.0, 1e6)?;
-        Ok(Box::new(ThresholdImage { initial, threshold }))
+        let p = parse::<ThresholdImageParams>("threshold_image", p)?;
+        Ok(Box::new(ThresholdImage { initial: p.initial, threshold: p.threshold }))
     },
+    params: ParamSpec::of::<ThresholdImageParams>(),
     checks: Checks::DEFAULT,
 };
+
+/// Parameters of `threshold_image`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields, default)]
+pub struct ThresholdImageParams {
+    /// Samples per pixel before any pixel may stop (1 to 2^20; at least 2 are always taken).
+    pub initial: usize,
+    /// Relative standard error at which a pixel stops (0 to 1e6).
+    pub threshold: f64,
+}
+
+impl Default for ThresholdImageParams {
+    fn default() -> Self {
+        ThresholdImageParams { initial: 2, threshold: 0.1 }
+    }
+}
+
+impl ParamSet for ThresholdImageParams {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
+        check_count("initial", self.initial, 1 << 20)?;
+        check_range("threshold", self.threshold, 0.0, 1e6)?;
+        Ok(())
+    }
+}
 
 /// The estimator.
 #[derive(Clone, Copy, Debug)]

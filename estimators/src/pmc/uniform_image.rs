@@ -6,6 +6,7 @@
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, NoParams, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::task::Task;
@@ -22,9 +23,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "uniform image-plane sampling: spp samples at uniform positions in every pixel (Table 1 baseline)",
     build: |p| {
-        p.reject_unknown("uniform_image", &[])?;
+        parse::<NoParams>("uniform_image", p)?;
         Ok(Box::new(UniformImage))
     },
+    params: ParamSpec::NONE,
     checks: Checks::DEFAULT,
 };
 

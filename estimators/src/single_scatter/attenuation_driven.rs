@@ -8,14 +8,16 @@
 //! only gain is that the transmittance samples are reused (paper: poor importance sampling).
 
 use super::transmittance::PrimaryTracker;
-use super::{residual_params, run, supports_single_scatter, ShadowRays};
+use super::{run, supports_single_scatter, ShadowRays};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::task::Task;
 use crate::testbed::{Needs, TestBed};
+use crate::tracking::params::ResidualParams;
 use crate::tracking::residual_ratio_tracking::ResidualRatioTracking;
 
 /// Registry entry.
@@ -27,7 +29,11 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::MEDIUM.and(Needs::POINT_LIGHT),
     samplers: &["free_flight"],
     summary: "point-light single scattering at the primary ray's residual-ratio-tracking interaction points (density sigma_samp), a shadow ray from each",
-    build: |p| Ok(Box::new(AttenuationDriven { cfg: residual_params(p, "attenuation_driven", &[])? })),
+    build: |p| {
+        let p = parse::<ResidualParams>("attenuation_driven", p)?;
+        Ok(Box::new(AttenuationDriven { cfg: ResidualRatioTracking::from_params(&p, "attenuation_driven")? }))
+    },
+    params: ParamSpec::of::<ResidualParams>(),
     checks: Checks::DEFAULT,
 };
 

@@ -7,11 +7,13 @@
 //! negative with residual tracking, hence the sign). More variance per primary ray, far fewer
 //! shadow rays (paper Fig. 12: 30 rays against 10 at equal fetches).
 
+use super::params::AttenuationSirParams;
 use super::transmittance::PrimaryTracker;
-use super::{residual_params, run, supports_single_scatter, ShadowRays};
+use super::{run, supports_single_scatter, ShadowRays};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::mixture::pick;
@@ -30,9 +32,11 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     summary:
         "attenuation-driven candidates, shadow rays only for `shadow_rays` (1) of them resampled by importance (SIR)",
     build: |p| {
-        let cfg = residual_params(p, "attenuation_driven_sir", &["shadow_rays"])?;
-        Ok(Box::new(AttenuationDrivenSir { cfg, shadow_rays: p.count("shadow_rays", 1, 1000)? }))
+        let p = parse::<AttenuationSirParams>("attenuation_driven_sir", p)?;
+        let cfg = ResidualRatioTracking::from_params(&p.residual(), "attenuation_driven_sir")?;
+        Ok(Box::new(AttenuationDrivenSir { cfg, shadow_rays: p.shadow_rays }))
     },
+    params: ParamSpec::of::<AttenuationSirParams>(),
     checks: Checks::DEFAULT,
 };
 

@@ -3,23 +3,20 @@
 //! evaluated with one tracking run of the primary ray ([`super::points`]) and combined with the
 //! balance heuristic (Veach): `sum_i f(t_i) / (n (p_src(t_i) + p_scat(t_i)))` over the `2n` points.
 
+use super::params::MisParams;
 use super::points::PointEstimator;
-use super::scattering_driven::{scatter_floor, ScatterDensity};
+use super::scattering_driven::ScatterDensity;
 use super::source_driven::equiangular;
-use super::{residual_params, run, supports_single_scatter};
+use super::{run, supports_single_scatter};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::Estimator;
 use crate::math::Rgb;
-use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::samplers::equiangular::Equiangular;
 use crate::task::Task;
 use crate::testbed::TestBed;
 use crate::tracking::residual_ratio_tracking::ResidualRatioTracking;
 use rand::Rng;
-
-/// The parameter names of the single-scatter half of `mis`.
-pub const PARAMS: &[&str] = &["explorer_spacing", "recent", "sigma_floor", "sigma_samp0", "points", "scatter_floor"];
 
 /// The estimator.
 pub struct MisScatter {
@@ -32,12 +29,12 @@ pub struct MisScatter {
 }
 
 impl MisScatter {
-    /// Builds from parameters.
-    pub fn from_params(p: &Params) -> Result<Self, ConfigError> {
+    /// Builds from the single-scattering parameters of `mis`.
+    pub fn from_params(p: &MisParams) -> Result<Self, ConfigError> {
         Ok(MisScatter {
-            cfg: residual_params(p, "mis", &["points", "scatter_floor"])?,
-            points: p.count("points", 1, 1000)?,
-            floor: scatter_floor(p, "mis")?,
+            cfg: ResidualRatioTracking::from_params(&p.residual(), "mis")?,
+            points: p.points,
+            floor: p.scatter_floor,
         })
     }
 }

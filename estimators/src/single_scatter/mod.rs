@@ -26,6 +26,7 @@ pub mod attenuation_driven;
 pub mod attenuation_driven_sir;
 pub mod delta_tracking;
 pub mod mis;
+pub mod params;
 pub mod points;
 pub mod ray_marching;
 pub mod scattering_driven;
@@ -37,9 +38,7 @@ use crate::error::{ConfigError, EstimateError};
 use crate::estimator::Estimator;
 use crate::lighting::PointLight;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
 use crate::phase::Phase;
-use crate::registry::BuildEstimator;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::task::{MediumProbe, Task};
@@ -180,13 +179,6 @@ impl ShadowRays {
     }
 }
 
-/// The residual tracking parameters of a single-scatter estimator, plus its own `extra` names.
-pub fn residual_params(p: &Params, owner: &str, extra: &[&str]) -> Result<ResidualRatioTracking, ConfigError> {
-    let known: Vec<&str> = ResidualRatioTracking::PARAMS.iter().chain(extra).copied().collect();
-    p.reject_unknown(owner, &known)?;
-    ResidualRatioTracking::from_params(p, owner)
-}
-
 /// One id serving point-light single-scatter integrals with `single_scatter` and every other test
 /// bed with `other` (SPEC §4.2 names `ray_marching`, `delta_tracking` and `mis` for single
 /// scattering too, and one id is one registry entry).
@@ -198,31 +190,6 @@ pub struct SingleScatterOr {
 }
 
 impl SingleScatterOr {
-    /// Builds both halves of an id: `other_keys` and `scatter_keys` are the parameter names each
-    /// half takes (a name in both goes to both); any other name is refused.
-    pub fn build(
-        id: &str,
-        params: &Params,
-        (other_keys, other): (&[&str], BuildEstimator),
-        (scatter_keys, single_scatter): (&[&str], BuildEstimator),
-    ) -> Result<Box<dyn Estimator>, ConfigError> {
-        let known: Vec<&str> = other_keys.iter().chain(scatter_keys).copied().collect();
-        params.reject_unknown(id, &known)?;
-        let part = |keys: &[&str]| {
-            Params(
-                params
-                    .0
-                    .iter()
-                    .filter(|(k, _)| keys.contains(&k.as_str()))
-                    .map(|(k, v)| (k.clone(), v.clone()))
-                    .collect(),
-            )
-        };
-        Ok(Box::new(SingleScatterOr {
-            single_scatter: single_scatter(&part(scatter_keys))?,
-            other: other(&part(other_keys))?,
-        }))
-    }
     fn pick(&self, task: &Task<'_>) -> &dyn Estimator {
         match task.medium().map(|m| m.ray().quantity) {
             Some(MediumQuantity::SingleScatter { .. }) => self.single_scatter.as_ref(),

@@ -7,12 +7,13 @@
 //! estimator stays unbiased where the approximation is zero). Drawn before the primary ray is
 //! tracked; the integrand by [`super::points`]; estimate `(1/n) sum f(t_i) / p(t_i)`.
 
+use super::params::ScatteringDrivenParams;
 use super::points::PointEstimator;
-use super::{residual_params, run, supports_single_scatter, Geometry};
-use crate::error::{ConfigError, EstimateError};
+use super::{run, supports_single_scatter, Geometry};
+use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
-use crate::params::Params;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -31,24 +32,13 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "scattering points mimicking T sigma_t through the piecewise-linear main part, continuous transmittance, residual-ratio-tracking shadow rays",
     build: |p| {
-        let cfg = residual_params(p, "scattering_driven", &["points", "scatter_floor"])?;
-        Ok(Box::new(ScatteringDriven { cfg, points: p.count("points", 1, 1000)?, floor: scatter_floor(p, "scattering_driven")? }))
+        let p = parse::<ScatteringDrivenParams>("scattering_driven", p)?;
+        let cfg = ResidualRatioTracking::from_params(&p.residual(), "scattering_driven")?;
+        Ok(Box::new(ScatteringDriven { cfg, points: p.points, floor: p.scatter_floor }))
     },
+    params: ParamSpec::of::<ScatteringDrivenParams>(),
     checks: Checks::DEFAULT,
 };
-
-/// The `scatter_floor` parameter (> 0).
-pub fn scatter_floor(p: &Params, owner: &str) -> Result<f64, ConfigError> {
-    let v = p.f64("scatter_floor", 0.01)?;
-    if v <= 0.0 {
-        return Err(ConfigError::invalid(
-            format!("{owner}.scatter_floor"),
-            v,
-            "must be > 0 (the density must cover every sigma_t > 0)",
-        ));
-    }
-    Ok(v)
-}
 
 /// The estimator.
 pub struct ScatteringDriven {

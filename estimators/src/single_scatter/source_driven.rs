@@ -4,11 +4,13 @@
 //! each by the continuous transmittance and a residual-ratio-tracking shadow ray
 //! ([`super::points`]); estimate `(1/n) sum f(t_i) / p(t_i)`.
 
+use super::params::SourceDrivenParams;
 use super::points::PointEstimator;
-use super::{residual_params, run, supports_single_scatter, Geometry};
+use super::{run, supports_single_scatter, Geometry};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::equiangular::Equiangular;
@@ -27,9 +29,11 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["equiangular"],
     summary: "equiangular (Cauchy) scattering points, continuous transmittance of the primary ray, residual-ratio-tracking shadow rays",
     build: |p| {
-        let cfg = residual_params(p, "source_driven", &["points"])?;
-        Ok(Box::new(SourceDriven { cfg, points: p.count("points", 1, 1000)? }))
+        let p = parse::<SourceDrivenParams>("source_driven", p)?;
+        let cfg = ResidualRatioTracking::from_params(&p.residual(), "source_driven")?;
+        Ok(Box::new(SourceDriven { cfg, points: p.points }))
     },
+    params: ParamSpec::of::<SourceDrivenParams>(),
     checks: Checks::DEFAULT,
 };
 

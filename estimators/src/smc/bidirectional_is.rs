@@ -3,7 +3,9 @@
 //! resampled; `L_r = L^_ns * (1/N) sum (p~_c / p~) V` with `L^_ns = mean(p~ / q)`, and `L_ns` by
 //! the Rao-Blackwellised `mean(p~_c / q)`. Both unbiased (the resampled set is properly weighted).
 
+use super::params::BidirectionalParams;
 use crate::estimator::Bias;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -17,6 +19,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary:
         "SIR: M environment-map candidates (`candidates`, default 128), N = budget resampled by BRDF cos, every frame",
-    build: |p| Ok(Box::new(super::SmcEstimator(super::config(p, "bidirectional_is", &[], 128, None)?))),
+    build: |p| {
+        let p = parse::<BidirectionalParams>("bidirectional_is", p)?;
+        Ok(Box::new(super::SmcEstimator(p.common().config("bidirectional_is", None)?)))
+    },
+    params: ParamSpec::of::<BidirectionalParams>(),
     checks: Checks::DEFAULT,
 };

@@ -4,10 +4,12 @@
 //! the product only as M grows (self-normalised importance resampling), so at the default M = 4
 //! the expectation is off by O(1/M). Consistent, not unbiased; the harness must flag it.
 
+use super::params::BidirectionalSnParams;
 use super::resampling::{normalise_log_weights, resample, Scheme};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry, Exemption};
 use crate::rng::StreamRng;
 use crate::task::Task;
@@ -22,7 +24,11 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::ENV_SEQUENCE,
     samplers: &[],
     summary: "biased control: independent L_ns times the self-normalised SIR mean of V at tiny M (default 4)",
-    build: |p| Ok(Box::new(BidirectionalSn(super::config(p, "bidirectional_is_sn", &[], 4, None)?))),
+    build: |p| {
+        let p = parse::<BidirectionalSnParams>("bidirectional_is_sn", p)?;
+        Ok(Box::new(BidirectionalSn(p.common().config("bidirectional_is_sn", None)?)))
+    },
+    params: ParamSpec::of::<BidirectionalSnParams>(),
     // Two candidates: the self-normalisation bias shrinks like 1/M, so more would hide it.
     checks: Checks {
         params: &[("candidates", 2.0)],

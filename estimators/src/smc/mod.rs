@@ -5,7 +5,7 @@
 //! - [`mh`]: the Metropolis-Hastings mixture kernel of Eq. 6-8;
 //! - [`engine`]: bidirectional importance sampling, Algorithm 1 and Algorithm 2 in log space;
 //! - the estimators: [`bidirectional_is`], [`bidirectional_is_sn`] (biased control), [`smc`],
-//!   [`smc_bridge`], [`smc_path`], [`smc_adaptive`].
+//!   [`smc_bridge`], [`smc_path`], [`smc_adaptive`], and their parameters ([`params`]).
 //!
 //! Every estimator takes a sample budget N (particles per pixel and frame) and runs whole pixel
 //! sequences through [`crate::estimator::Estimator::estimate_sequence`].
@@ -14,6 +14,7 @@ pub mod bidirectional_is;
 pub mod bidirectional_is_sn;
 pub mod engine;
 pub mod mh;
+pub mod params;
 pub mod resampling;
 #[allow(clippy::module_inception)] // the estimator id of paper 004 Algorithm 1 is `smc`
 pub mod smc;
@@ -23,46 +24,12 @@ pub mod smc_path;
 #[cfg(test)]
 mod tests;
 
-use crate::error::ConfigError;
 use crate::error::EstimateError;
 use crate::estimator::Estimator;
 use crate::math::Rgb;
-use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::task::Task;
-use engine::{Config, Transition};
-use mh::MhKernel;
-use resampling::Scheme;
-
-/// Parameters every paper 004 estimator accepts.
-pub const COMMON: &[&str] = &["candidates", "cone", "p_independent", "resampling", "threshold"];
-
-/// Reads the common parameters: `candidates` (M, default `m`), `cone` (local-move half-angle in
-/// degrees, 3), `p_independent` (share of environment-map proposals, 0.5), `resampling` (0
-/// multinomial, 1 residual, 2 stratified, 3 systematic: default), `threshold` (ESS share, 0.5).
-pub fn config(
-    params: &Params,
-    owner: &str,
-    extra: &[&str],
-    m: usize,
-    transition: Option<Transition>,
-) -> Result<Config, ConfigError> {
-    let known: Vec<&str> = COMMON.iter().chain(extra).copied().collect();
-    params.reject_unknown(owner, &known)?;
-    let candidates = params.count("candidates", m, 1 << 20)?;
-    let cone = params.f64_in("cone", 3.0, 1e-3, 90.0)?;
-    let p_independent = params.f64_in("p_independent", 0.5, 0.0, 1.0)?;
-    let code = params.f64_in("resampling", 3.0, 0.0, 3.0)?;
-    let scheme = Scheme::from_code(code as usize).filter(|_| code.fract() == 0.0).ok_or_else(|| {
-        ConfigError::invalid(
-            format!("{owner}.resampling"),
-            code,
-            "0 multinomial, 1 residual, 2 stratified, 3 systematic",
-        )
-    })?;
-    let threshold = params.f64_in("threshold", 0.5, 0.0, 1.0)?;
-    Ok(Config { candidates, kernel: MhKernel::new(cone, p_independent), scheme, threshold, transition })
-}
+use engine::Config;
 
 /// A configured paper 004 estimator.
 pub struct SmcEstimator(pub Config);

@@ -3,10 +3,12 @@
 //! `L_ns,n = L_ns,n-1 sum_j W_{n-1,j} w~_j` (Eq. 10), resampling when ESS < N/2, K MH moves of the
 //! Eq. 6-8 mixture kernel, and `L_r` by Eq. 9. The product of Eq. 10 increments times the weighted
 //! mean is the unbiased SMC estimate (Del Moral, Doucet and Jasra 2006), so the claim is unbiased.
-//! Parameters: `moves` (K, default 5) and the common ones of [`super::config`].
+//! Parameters: `moves` (K, default 5) and the common ones ([`super::params::SmcParams`]).
 
 use super::engine::Transition;
+use super::params::SmcParams;
 use crate::estimator::Bias;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -20,8 +22,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "Algorithm 1: propagate, reweight p~_n/p~_{n-1}, resample at ESS < N/2, K MH moves (`moves`, default 5)",
     build: |p| {
-        let moves = p.count("moves", 5, 10_000)?;
-        Ok(Box::new(super::SmcEstimator(super::config(p, "smc", &["moves"], 128, Some(Transition::Single { moves }))?)))
+        let p = parse::<SmcParams>("smc", p)?;
+        let transition = Transition::Single { moves: p.moves };
+        Ok(Box::new(super::SmcEstimator(p.common().config("smc", Some(transition))?)))
     },
+    params: ParamSpec::of::<SmcParams>(),
     checks: Checks::DEFAULT,
 };

@@ -6,7 +6,9 @@
 //! `max_bridges` (32) and the common ones.
 
 use super::engine::Transition;
+use super::params::SmcAdaptiveParams;
 use crate::estimator::Bias;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -20,15 +22,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "bridges chosen by bisection on the conditional ESS (`cess`, default 0.9; `max_bridges`, 32), ratio L_ns",
     build: |p| {
-        let cess = p.f64_in("cess", 0.9, 0.01, 0.9999)?;
-        let max = p.count("max_bridges", 32, 10_000)?;
-        Ok(Box::new(super::SmcEstimator(super::config(
-            p,
-            "smc_adaptive",
-            &["cess", "max_bridges"],
-            128,
-            Some(Transition::Adaptive { cess, max }),
-        )?)))
+        let p = parse::<SmcAdaptiveParams>("smc_adaptive", p)?;
+        let transition = Transition::Adaptive { cess: p.cess, max: p.max_bridges };
+        Ok(Box::new(super::SmcEstimator(p.common().config("smc_adaptive", Some(transition))?)))
     },
+    params: ParamSpec::of::<SmcAdaptiveParams>(),
     checks: Checks::DEFAULT,
 };

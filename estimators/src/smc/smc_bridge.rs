@@ -4,7 +4,9 @@
 //! unbiased. Parameters: `bridges` (P, default 5) and the common ones.
 
 use super::engine::Transition;
+use super::params::SmcBridgeParams;
 use crate::estimator::Bias;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -18,14 +20,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "Algorithm 2: P bridges (`bridges`, default 5) with one MH move each, L_ns by the standard ratio (Eq. 10)",
     build: |p| {
-        let bridges = p.count("bridges", 5, 10_000)?;
-        Ok(Box::new(super::SmcEstimator(super::config(
-            p,
-            "smc_bridge",
-            &["bridges"],
-            128,
-            Some(Transition::Bridged { bridges, path: false }),
-        )?)))
+        let p = parse::<SmcBridgeParams>("smc_bridge", p)?;
+        let transition = Transition::Bridged { bridges: p.bridges, path: false };
+        Ok(Box::new(super::SmcEstimator(p.common().config("smc_bridge", Some(transition))?)))
     },
+    params: ParamSpec::of::<SmcBridgeParams>(),
     checks: Checks::DEFAULT,
 };

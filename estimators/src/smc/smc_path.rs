@@ -5,7 +5,9 @@
 //! decides. Parameters: `bridges` (P, default 5) and the common ones.
 
 use super::engine::Transition;
+use super::params::SmcBridgeParams;
 use crate::estimator::Bias;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -19,8 +21,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "Algorithm 2 with L_ns by path sampling (Eq. 15-16): P bridges (`bridges`, default 5), exponentiated log estimate",
     build: |p| {
-        let bridges = p.count("bridges", 5, 10_000)?;
-        Ok(Box::new(super::SmcEstimator(super::config(p, "smc_path", &["bridges"], 128, Some(Transition::Bridged { bridges, path: true }))?)))
+        let p = parse::<SmcBridgeParams>("smc_path", p)?;
+        let transition = Transition::Bridged { bridges: p.bridges, path: true };
+        Ok(Box::new(super::SmcEstimator(p.common().config("smc_path", Some(transition))?)))
     },
+    params: ParamSpec::of::<SmcBridgeParams>(),
     checks: Checks::DEFAULT,
 };

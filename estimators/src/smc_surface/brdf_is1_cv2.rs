@@ -3,9 +3,11 @@
 //! computing both estimates from the one sample drawn; the tracker's weights clamp the count at
 //! the refinement criterion (see [`super::variance_tracker`]).
 
+use super::params::SurfaceSmcParams;
 use super::{Sampling, SmcSurface};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -18,6 +20,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::SURFACE,
     samplers: &["brdf"],
     summary: "variance tracker choosing BRDF importance sampling or is1_cv2 per sample",
-    build: |p| SmcSurface::build("brdf_is1_cv2", Sampling::BrdfTracked, ControlVariate::Bilinear, p),
+    build: |p| {
+        let p = parse::<SurfaceSmcParams>("brdf_is1_cv2", p)?;
+        Ok(Box::new(SmcSurface::from_params(Sampling::BrdfTracked, ControlVariate::Bilinear, &p)))
+    },
+    params: ParamSpec::of::<SurfaceSmcParams>(),
     checks: Checks::DEFAULT,
 };

@@ -1,10 +1,12 @@
 //! `is0_cv1` (paper 001 Fig. 4): uniform hemisphere sampling, piecewise constant (order 0) cache
 //! control variate; one adaptive cache per estimate (see [`super`]).
 
-use super::{Sampling, SmcSurface};
+use super::params::CacheSmcParams;
+use super::{build_surface_or_medium, Sampling};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
-use crate::media_smc::{MediaSmc, Sampling as MediaSampling};
+use crate::media_smc::Sampling as MediaSampling;
+use crate::params::ParamSpec;
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -17,12 +19,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::NONE,
     samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: uniform sampling, piecewise-constant control variate (cv1); on a medium, the octree of spherical caches (paper 000)",
-    build: |p| {
-        crate::media_smc::SurfaceOrMedium::build(
-            |p| SmcSurface::build("is0_cv1", Sampling::Uniform, ControlVariate::Constant, p),
-            |p| Ok(Box::new(MediaSmc::from_params("is0_cv1", MediaSampling::Uniform, ControlVariate::Constant, p)?)),
-            p,
-        )
-    },
+    build: |p| build_surface_or_medium("is0_cv1", (Sampling::Uniform, MediaSampling::Uniform), ControlVariate::Constant, p),
+    params: ParamSpec::of::<CacheSmcParams>(),
     checks: Checks::DEFAULT,
 };

@@ -1,10 +1,12 @@
 //! `is0_cv2` (paper 001 Fig. 4): uniform hemisphere sampling, bilinear (order 1) cache control
 //! variate; one adaptive cache per estimate (see [`super`]).
 
-use super::{Sampling, SmcSurface};
+use super::params::CacheSmcParams;
+use super::{build_surface_or_medium, Sampling};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
-use crate::media_smc::{MediaSmc, Sampling as MediaSampling};
+use crate::media_smc::Sampling as MediaSampling;
+use crate::params::ParamSpec;
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -17,12 +19,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::NONE,
     samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: uniform sampling, bilinear control variate (cv2); on a medium, the octree of spherical caches (paper 000)",
-    build: |p| {
-        crate::media_smc::SurfaceOrMedium::build(
-            |p| SmcSurface::build("is0_cv2", Sampling::Uniform, ControlVariate::Bilinear, p),
-            |p| Ok(Box::new(MediaSmc::from_params("is0_cv2", MediaSampling::Uniform, ControlVariate::Bilinear, p)?)),
-            p,
-        )
-    },
+    build: |p| build_surface_or_medium("is0_cv2", (Sampling::Uniform, MediaSampling::Uniform), ControlVariate::Bilinear, p),
+    params: ParamSpec::of::<CacheSmcParams>(),
     checks: Checks::DEFAULT,
 };

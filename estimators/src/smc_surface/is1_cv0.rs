@@ -1,10 +1,12 @@
 //! `is1_cv0` (paper 001 Fig. 4): cache PDF importance sampling, no control variate; one adaptive
 //! cache per estimate (see [`super`]).
 
-use super::{Sampling, SmcSurface};
+use super::params::CacheSmcParams;
+use super::{build_surface_or_medium, Sampling};
 use crate::cache::ControlVariate;
 use crate::estimator::Bias;
-use crate::media_smc::{MediaSmc, Sampling as MediaSampling};
+use crate::media_smc::Sampling as MediaSampling;
+use crate::params::ParamSpec;
 use crate::registry::{Checks, EstimatorEntry};
 use crate::testbed::Needs;
 
@@ -17,12 +19,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     needs: Needs::NONE,
     samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: cache-PDF importance sampling, no control variate; on a medium, the octree of spherical caches (paper 000)",
-    build: |p| {
-        crate::media_smc::SurfaceOrMedium::build(
-            |p| SmcSurface::build("is1_cv0", Sampling::Cache, ControlVariate::None, p),
-            |p| Ok(Box::new(MediaSmc::from_params("is1_cv0", MediaSampling::Cache, ControlVariate::None, p)?)),
-            p,
-        )
-    },
+    build: |p| build_surface_or_medium("is1_cv0", (Sampling::Cache, MediaSampling::Cache), ControlVariate::None, p),
+    params: ParamSpec::of::<CacheSmcParams>(),
     checks: Checks::DEFAULT,
 };

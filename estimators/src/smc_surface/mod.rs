@@ -11,8 +11,9 @@
 //!
 //! The ids are thin entries over one generic core, [`SmcSurface`]: `is0_cv1`, `is0_cv2`,
 //! `is1_cv0`, `is1_cv1`, `is1_cv2` and `brdf_is1_cv2` (the §4.5 variance tracker choosing between
-//! BRDF importance sampling and `is1_cv2` from the same sample). Parameters: `criterion`
-//! (default 8, paper 001 Table 1), `max_depth` (default 8) and `storage` (`"f64"` or `"f32"`).
+//! BRDF importance sampling and `is1_cv2` from the same sample). Parameters ([`params`]):
+//! `criterion` (default 8, paper 001 Table 1), `max_depth` (default 8) and `storage` (`"f64"` or
+//! `"f32"`).
 
 pub mod brdf_is1_cv2;
 pub mod is0_cv1;
@@ -20,20 +21,20 @@ pub mod is0_cv2;
 pub mod is1_cv0;
 pub mod is1_cv1;
 pub mod is1_cv2;
+pub mod params;
 pub mod variance_tracker;
 
 use crate::accumulate::RgbMean;
-use crate::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, Storage, MAX_DEPTH_LIMIT};
+use crate::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, Storage};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::Estimator;
 use crate::math::{Frame, Rgb};
-use crate::params::Params;
+use crate::media_smc::{MediaSmc, SurfaceOrMedium};
+use crate::params::{parse, Params};
 use crate::rng::StreamRng;
 use crate::task::{HemisphereProbe, Task};
+use params::{CacheSmcParams, SurfaceSmcParams};
 use variance_tracker::VarianceTracker;
-
-/// The parameters every surface SMC id accepts.
-pub const PARAMS: &[&str] = &["criterion", "max_depth", "storage"];
 
 /// How directions are drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -67,25 +68,14 @@ pub struct SmcSurface {
 }
 
 impl SmcSurface {
-    /// Builds the estimator `id` from its parameters (`criterion` in `[1, 1e9]`, `max_depth` in
-    /// `[1, 12]`, `storage` `"f64"` or `"f32"`), refusing unknown ones.
-    pub fn from_params(id: &str, sampling: Sampling, cv: ControlVariate, params: &Params) -> Result<Self, ConfigError> {
-        params.reject_unknown(id, PARAMS)?;
-        let criterion = params.f64_in("criterion", 8.0, 1.0, 1e9)?;
-        let max_depth = params.count("max_depth", 8, MAX_DEPTH_LIMIT as usize)? as u32;
-        let storage = Storage::from_params(params, "storage")?;
-        let config = CacheConfig { criterion, max_depth, ..CacheConfig::surface(sampling != Sampling::Uniform) };
-        Ok(SmcSurface { sampling, cv, config, storage, snapshot: Snapshot::BeforeRecord })
-    }
-
-    /// [`SmcSurface::from_params`], boxed for a registry entry.
-    pub fn build(
-        id: &str,
-        sampling: Sampling,
-        cv: ControlVariate,
-        params: &Params,
-    ) -> Result<Box<dyn Estimator>, ConfigError> {
-        Ok(Box::new(Self::from_params(id, sampling, cv, params)?))
+    /// Builds from its parameters (`criterion`, `max_depth`, `storage`).
+    pub fn from_params(sampling: Sampling, cv: ControlVariate, params: &SurfaceSmcParams) -> Self {
+        let config = CacheConfig {
+            criterion: params.criterion,
+            max_depth: params.max_depth as u32,
+            ..CacheConfig::surface(sampling != Sampling::Uniform)
+        };
+        SmcSurface { sampling, cv, config, storage: params.storage, snapshot: Snapshot::BeforeRecord }
     }
 
     /// The biased control of the tests: estimates read the cache after their own record.
@@ -214,6 +204,21 @@ impl Estimator for SmcSurface {
             Storage::F32 => self.run::<f32>(task, rng),
         }
     }
+}
+
+/// Builds one of the ids serving both scene views (`is0_cv1` ... `is1_cv2`): this module's cache
+/// on surfaces, the octree of [`crate::media_smc`] in media, each with its own defaults.
+pub fn build_surface_or_medium(
+    id: &str,
+    (sampling, medium_sampling): (Sampling, crate::media_smc::Sampling),
+    cv: ControlVariate,
+    params: &Params,
+) -> Result<Box<dyn Estimator>, ConfigError> {
+    let p = parse::<CacheSmcParams>(id, params)?;
+    Ok(Box::new(SurfaceOrMedium {
+        surface: Box::new(SmcSurface::from_params(sampling, cv, &p.surface())),
+        medium: Box::new(MediaSmc::from_params(medium_sampling, cv, &p.medium())),
+    }))
 }
 
 #[cfg(test)]

@@ -85,8 +85,7 @@ fn unbiased_on_the_default_variant_and_the_control_is_flagged() {
 /// biased, and the test flags it at the size that passes the correct one.
 #[test]
 fn reading_the_cache_after_the_record_is_flagged() {
-    let est = SmcSurface::from_params("is1_cv2", Sampling::Cache, ControlVariate::Bilinear, &Params::new())
-        .unwrap()
+    let est = SmcSurface::from_params(Sampling::Cache, ControlVariate::Bilinear, &SurfaceSmcParams::default())
         .reading_after_record();
     let v = unbiasedness(&est, "is1_cv2_after", "default", &ALL_PIXELS, 4000, 16);
     assert!(v.rejects(), "post-record snapshot not flagged: p = {:e}", v.min_adjusted_p);
@@ -144,12 +143,8 @@ fn parameters_are_validated_and_named() {
         assert!(err(Params::new().with("max_depth", 13.0)).contains("max_depth"));
         assert!(err(Params::new().with("bogus", 1.0)).contains("bogus"));
     }
-    let est = SmcSurface::from_params(
-        "is1_cv2",
-        Sampling::Cache,
-        ControlVariate::Bilinear,
-        &Params::new().with("criterion", 16.0),
-    )
-    .unwrap();
-    assert_eq!(est.config().criterion, 16.0);
+    let p = parse::<CacheSmcParams>("is1_cv2", &Params::new().with("criterion", 16.0)).unwrap();
+    let est = SmcSurface::from_params(Sampling::Cache, ControlVariate::Bilinear, &p.surface());
+    assert_eq!((est.config().criterion, est.config().max_depth), (16.0, 8));
+    assert_eq!((p.medium().criterion, p.medium().max_depth), (16.0, 5));
 }

@@ -98,7 +98,7 @@ impl Default for Canonical1dParams {
 }
 
 impl ParamSet for Canonical1dParams {
-    fn validate(&self) -> Result<(), ConfigError> {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         check_count("points", self.points, 10_000)?;
         check_range("albedo", self.albedo, 0.0, 1.0)?;
         if let Some(t) = self.tau {

@@ -63,7 +63,7 @@ impl Default for CheckerDirectParams {
 }
 
 impl ParamSet for CheckerDirectParams {
-    fn validate(&self) -> Result<(), ConfigError> {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         check_count("resolution", self.resolution, 512).map(|_| ())
     }
 }

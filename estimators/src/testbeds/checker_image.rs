@@ -67,7 +67,7 @@ impl Default for CheckerImageParams {
 }
 
 impl ParamSet for CheckerImageParams {
-    fn validate(&self) -> Result<(), ConfigError> {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         check_count("resolution", self.resolution, 512)?;
         check_count("light_samples", self.light_samples, 1024).map(|_| ())
     }

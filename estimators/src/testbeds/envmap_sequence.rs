@@ -91,7 +91,7 @@ impl Default for EnvmapSequenceParams {
 }
 
 impl ParamSet for EnvmapSequenceParams {
-    fn validate(&self) -> Result<(), ConfigError> {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         check_count("resolution", self.resolution, 512)?;
         check_count("frames", self.frames, 1000)?;
         check_range("rotation", self.rotation, -360.0, 360.0)?;

@@ -68,7 +68,7 @@ pub struct GradientBoxParams {
 }
 
 impl ParamSet for GradientBoxParams {
-    fn validate(&self) -> Result<(), ConfigError> {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         if let Some(r) = self.resolution {
             check_count("resolution", r, 256)?;
         }

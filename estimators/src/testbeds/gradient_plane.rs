@@ -56,7 +56,7 @@ impl Default for GradientPlaneParams {
 }
 
 impl ParamSet for GradientPlaneParams {
-    fn validate(&self) -> Result<(), ConfigError> {
+    fn validate(&self, _owner: &str) -> Result<(), ConfigError> {
         check_count("resolution", self.resolution, 512).map(|_| ())
     }
 }

@@ -7,13 +7,15 @@
 //! scattering: Woodcock tracking to the first real collision and a Woodcock shadow ray
 //! ([`crate::single_scatter::delta_tracking`]).
 
+use super::params::SigmaSampParams;
 use super::spm::{trace, SpmMode};
-use super::{ray_moments, sigma_samp_param, track, transmittance, Rule, SigmaSamp};
+use super::{ray_moments, track, transmittance, Rule, SigmaSamp};
 use crate::accumulate::RgbMean;
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::EstimateMoments;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -31,20 +33,17 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     summary:
         "Woodcock tracking with the majorant: transmittance, analog particle tracing, or point-light single scattering",
     build: |p| {
-        crate::single_scatter::SingleScatterOr::build(
-            "delta_tracking",
-            p,
-            (&["sigma_samp", "sigma_samp_ratio"], |p| {
-                Ok(Box::new(DeltaTracking {
-                    sigma_samp: SigmaSamp::from_params(p, "delta_tracking", SigmaSamp::Majorant)?,
-                }))
+        let p = parse::<SigmaSampParams>("delta_tracking", p)?;
+        Ok(Box::new(crate::single_scatter::SingleScatterOr {
+            single_scatter: Box::new(crate::single_scatter::delta_tracking::DeltaTrackingScatter {
+                sigma_samp: p.sigma_samp,
             }),
-            (&["sigma_samp"], |p| {
-                let sigma_samp = sigma_samp_param(p, "delta_tracking")?;
-                Ok(Box::new(crate::single_scatter::delta_tracking::DeltaTrackingScatter { sigma_samp }))
+            other: Box::new(DeltaTracking {
+                sigma_samp: SigmaSamp::from_params(&p, "delta_tracking", SigmaSamp::Majorant)?,
             }),
-        )
+        }))
     },
+    params: ParamSpec::of::<SigmaSampParams>(),
     checks: Checks::DEFAULT,
 };
 

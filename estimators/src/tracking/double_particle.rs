@@ -6,12 +6,14 @@
 //! piecewise-linear main part through explorer points spaced `explorer_spacing`, `control = 2`
 //! the constant at its mean (the L2-optimal constant of §3.4).
 
+use super::params::DoubleParticleParams;
 use super::residual_ratio_tracking::{main_part, MainPart};
 use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::EstimateMoments;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -29,15 +31,12 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     summary:
         "double particle model (Eq. 8) with any sigma_samp (default 1), optional control variate (1 linear, 2 mean)",
     build: |p| {
-        p.reject_unknown("double_particle", &["sigma_samp", "sigma_samp_ratio", "control", "explorer_spacing"])?;
-        let sigma_samp = SigmaSamp::from_params(p, "double_particle", SigmaSamp::Absolute(1.0))?;
-        let control = MainPart::from_control(p, "double_particle", 0.0)?;
-        let spacing = p.f64("explorer_spacing", 0.5)?;
-        if spacing <= 0.0 {
-            return Err(ConfigError::invalid("double_particle.explorer_spacing", spacing, "must be > 0"));
-        }
-        Ok(Box::new(DoubleParticle { sigma_samp, control, spacing }))
+        let p = parse::<DoubleParticleParams>("double_particle", p)?;
+        let sigma_samp = SigmaSamp::from_params(&p.sigma(), "double_particle", SigmaSamp::Absolute(1.0))?;
+        let control = MainPart::from_control(p.control, "double_particle")?;
+        Ok(Box::new(DoubleParticle { sigma_samp, control, spacing: p.explorer_spacing }))
     },
+    params: ParamSpec::of::<DoubleParticleParams>(),
     checks: Checks::DEFAULT,
 };
 

@@ -7,6 +7,7 @@
 
 pub mod delta_tracking;
 pub mod double_particle;
+pub mod params;
 pub mod ratio_tracking;
 pub mod ray_marching;
 pub mod residual_ratio_tracking;
@@ -16,7 +17,6 @@ pub mod spm;
 use crate::error::{ConfigError, EstimateError};
 use crate::math::{Rgb, Vec3};
 use crate::media::moments::{tracker_moments, EstimateMoments};
-use crate::params::Params;
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
 use crate::stats::NeumaierSum;
@@ -290,16 +290,12 @@ pub fn check_finite_variance(
     Ok(())
 }
 
-/// A positive finite `sigma_samp` parameter (`None` when absent).
-pub fn sigma_samp_param(p: &Params, owner: &str) -> Result<Option<f64>, ConfigError> {
-    if !p.0.contains_key("sigma_samp") {
-        return Ok(None);
+/// A `sigma_samp` parameter, refused unless positive (`None` when absent).
+pub fn sigma_samp_param(sigma_samp: Option<f64>, owner: &str) -> Result<Option<f64>, ConfigError> {
+    match sigma_samp {
+        Some(v) if v <= 0.0 => Err(ConfigError::invalid(format!("{owner}.sigma_samp"), v, "must be > 0")),
+        v => Ok(v),
     }
-    let v = p.f64("sigma_samp", 1.0)?;
-    if v <= 0.0 {
-        return Err(ConfigError::invalid(format!("{owner}.sigma_samp"), v, "must be > 0"));
-    }
-    Ok(Some(v))
 }
 
 /// A tracker's constant sampling density `sigma_samp` (paper 002 Eq. 4 with a constant density):
@@ -317,13 +313,12 @@ pub enum SigmaSamp {
 }
 
 impl SigmaSamp {
-    /// Reads `sigma_samp` or `sigma_samp_ratio` (not both; each finite and > 0), else `default`.
-    pub fn from_params(p: &Params, owner: &str, default: SigmaSamp) -> Result<SigmaSamp, ConfigError> {
-        let ratio = if p.0.contains_key("sigma_samp_ratio") { Some(p.f64("sigma_samp_ratio", 1.0)?) } else { None };
-        match (sigma_samp_param(p, owner)?, ratio) {
-            (Some(_), Some(_)) => Err(ConfigError::invalid(
+    /// From `sigma_samp` or `sigma_samp_ratio` (not both; each > 0), else `default`.
+    pub fn from_params(p: &params::SigmaSampParams, owner: &str, default: SigmaSamp) -> Result<SigmaSamp, ConfigError> {
+        match (sigma_samp_param(p.sigma_samp, owner)?, p.sigma_samp_ratio) {
+            (Some(_), Some(r)) => Err(ConfigError::invalid(
                 format!("{owner}.sigma_samp_ratio"),
-                ratio.unwrap_or(f64::NAN),
+                r,
                 "give sigma_samp or sigma_samp_ratio, not both",
             )),
             (Some(v), None) => Ok(SigmaSamp::Absolute(v)),

@@ -3,11 +3,13 @@
 //! must give a majorant: a smaller density is the double particle model, and is refused here as a
 //! skipped pair with the reason), weight `*= 1 - r`.
 
+use super::params::SigmaSampParams;
 use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::EstimateMoments;
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -24,9 +26,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "ratio tracking with the constant majorant (paper 002 Eq. 8, [NSJ14])",
     build: |p| {
-        p.reject_unknown("ratio_tracking", &["sigma_samp", "sigma_samp_ratio"])?;
-        Ok(Box::new(RatioTracking { sigma_samp: SigmaSamp::from_params(p, "ratio_tracking", SigmaSamp::Majorant)? }))
+        let p = parse::<SigmaSampParams>("ratio_tracking", p)?;
+        Ok(Box::new(RatioTracking { sigma_samp: SigmaSamp::from_params(&p, "ratio_tracking", SigmaSamp::Majorant)? }))
     },
+    params: ParamSpec::of::<SigmaSampParams>(),
     checks: Checks::DEFAULT,
 };
 

@@ -8,12 +8,14 @@
 //! On point-light single-scatter integrals the same id marches the primary and shadow rays
 //! ([`crate::single_scatter::ray_marching`]).
 
+use super::params::RayMarchingParams;
 use super::{segment, supports_transmittance, transmittance};
 use crate::budget::{Budget, BudgetKind};
-use crate::error::{ConfigError, EstimateError};
+use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::{ray_marching_moments, EstimateMoments};
+use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry, Exemption};
 use crate::rng::StreamRng;
 use crate::task::Task;
@@ -31,20 +33,18 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "biased control: fixed-step ray marching of the optical depth (step 0.9; one ray = the fetch budget); on single scattering, of the primary and shadow rays",
     build: |p| {
-        crate::single_scatter::SingleScatterOr::build(
-            "ray_marching",
-            p,
-            (&["step"], |p| Ok(Box::new(RayMarching { step: step(p)?, fixed_step: p.0.contains_key("step") }))),
-            (&["step", "jitter"], |p| {
-                let fixed_step = p.0.contains_key("step");
-                let jitter = match p.f64("jitter", 1.0)? {
-                    j if j == 0.0 || j == 1.0 => j == 1.0,
-                    j => return Err(ConfigError::invalid("ray_marching.jitter", j, "must be 0 or 1")),
-                };
-                Ok(Box::new(crate::single_scatter::ray_marching::RayMarchingScatter { step: step(p)?, fixed_step, jitter }))
+        let p = parse::<RayMarchingParams>("ray_marching", p)?;
+        let (step, fixed_step) = (p.step(), p.step.is_some());
+        Ok(Box::new(crate::single_scatter::SingleScatterOr {
+            single_scatter: Box::new(crate::single_scatter::ray_marching::RayMarchingScatter {
+                step,
+                fixed_step,
+                jitter: p.jitter == 1,
             }),
-        )
+            other: Box::new(RayMarching { step, fixed_step }),
+        }))
     },
+    params: ParamSpec::of::<RayMarchingParams>(),
     // A coarse step (4 steps on the 20-unit central ray) whose Jensen bias the checks can resolve;
     // the default step 0.9 is the paper's baseline, biased far below what they can see.
     checks: Checks {
@@ -68,15 +68,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         ],
     },
 };
-
-/// The `step` parameter (> 0, default 0.9).
-fn step(p: &crate::params::Params) -> Result<f64, ConfigError> {
-    let step = p.f64("step", 0.9)?;
-    if step <= 0.0 {
-        return Err(ConfigError::invalid("ray_marching.step", step, "must be > 0"));
-    }
-    Ok(step)
-}
 
 /// The estimator.
 pub struct RayMarching {

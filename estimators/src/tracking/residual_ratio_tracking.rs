@@ -9,11 +9,12 @@
 //! needed (negative difference extinction, §3.3). The harness estimates pixels independently, so
 //! explorer data is not shared across pixels here.
 
+use super::params::ResidualParams;
 use super::{supports_transmittance, track_scaled, transmittance, Rule};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
+use crate::params::{check_count, parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::{Interp, SamplingDensity};
@@ -31,9 +32,10 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "control variate through explorer points + constant sigma_samp ~ max |sigma_diff| of the last rays",
     build: |p| {
-        p.reject_unknown("residual_ratio_tracking", ResidualRatioTracking::PARAMS)?;
-        Ok(Box::new(ResidualRatioTracking::from_params(p, "residual_ratio_tracking")?))
+        let p = parse::<ResidualParams>("residual_ratio_tracking", p)?;
+        Ok(Box::new(ResidualRatioTracking::from_params(&p, "residual_ratio_tracking")?))
     },
+    params: ParamSpec::of::<ResidualParams>(),
     checks: Checks::DEFAULT,
 };
 
@@ -52,30 +54,24 @@ pub struct ResidualRatioTracking {
 }
 
 impl ResidualRatioTracking {
-    /// The parameter names (shared by the single-scatter estimators, whose rays are tracked the
-    /// same way).
-    pub const PARAMS: &'static [&'static str] =
-        &["explorer_spacing", "recent", "sigma_floor", "sigma_samp0", "control"];
-
-    /// Reads the parameters (unknown names are the caller's to refuse), naming `owner` on error.
-    pub fn from_params(p: &Params, owner: &str) -> Result<Self, ConfigError> {
-        let spacing = p.f64("explorer_spacing", 0.5)?;
-        let floor = p.f64("sigma_floor", 0.05)?;
-        let first = p.f64("sigma_samp0", 0.0)?;
+    /// Builds from its parameters (shared by the single-scatter estimators, whose rays are tracked
+    /// the same way), refusing out-of-range values naming `owner`.
+    pub fn from_params(p: &ResidualParams, owner: &str) -> Result<Self, ConfigError> {
+        let (spacing, floor) = (p.explorer_spacing, p.sigma_floor);
         for (name, v) in [("explorer_spacing", spacing), ("sigma_floor", floor)] {
             if v <= 0.0 {
                 return Err(ConfigError::invalid(format!("{owner}.{name}"), v, "must be > 0"));
             }
         }
-        let recent = p.count("recent", 4, 1000)?;
-        let Some(kind) = MainPart::from_control(p, owner, 1.0)? else {
+        let recent = check_count("recent", p.recent, 1000)?;
+        let Some(kind) = MainPart::from_control(p.control, owner)? else {
             return Err(ConfigError::invalid(
                 format!("{owner}.control"),
                 0,
                 "the residual estimator needs a main part: 1 (piecewise linear) or 2 (mean)",
             ));
         };
-        Ok(ResidualRatioTracking { spacing, recent, floor, first: (first > 0.0).then_some(first), kind })
+        Ok(ResidualRatioTracking { spacing, recent, floor, first: p.sigma_samp0.filter(|first| *first > 0.0), kind })
     }
 
     /// A fresh sigma_samp memory for a scene with this majorant.
@@ -96,11 +92,11 @@ pub enum MainPart {
 
 impl MainPart {
     /// The `control` parameter: 0 (none), 1 ([`MainPart::Linear`]) or 2 ([`MainPart::Mean`]).
-    pub fn from_control(p: &Params, owner: &str, default: f64) -> Result<Option<MainPart>, ConfigError> {
-        match p.f64("control", default)? {
-            0.0 => Ok(None),
-            1.0 => Ok(Some(MainPart::Linear)),
-            2.0 => Ok(Some(MainPart::Mean)),
+    pub fn from_control(control: u32, owner: &str) -> Result<Option<MainPart>, ConfigError> {
+        match control {
+            0 => Ok(None),
+            1 => Ok(Some(MainPart::Linear)),
+            2 => Ok(Some(MainPart::Mean)),
             v => Err(ConfigError::invalid(
                 format!("{owner}.control"),
                 v,

@@ -7,11 +7,13 @@
 //!   before the run (`ConfigError`, exit 2), and an `r` out of range met at run time is refused.
 //! - `single_particle_nonterminating`: Eq. 12 probabilities, any `r`.
 
+use super::params::SigmaSampParams;
 use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
 use crate::media::moments::EstimateMoments;
+use crate::params::{parse, ParamSpec, Params};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
 use crate::samplers::free_flight::SamplingDensity;
@@ -28,6 +30,7 @@ pub static TERMINATING: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "single particle model, terminating (Eq. 9, 19): refuses r > 2/(a+1) or r < 0",
     build: |p| build(p, "single_particle_terminating", true),
+    params: ParamSpec::of::<SigmaSampParams>(),
     checks: Checks::DEFAULT,
 };
 
@@ -41,12 +44,13 @@ pub static NONTERMINATING: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "single particle model, non-terminating (Eq. 12, 20), any r",
     build: |p| build(p, "single_particle_nonterminating", false),
+    params: ParamSpec::of::<SigmaSampParams>(),
     checks: Checks::DEFAULT,
 };
 
-fn build(p: &crate::params::Params, id: &str, terminating: bool) -> Result<Box<dyn Estimator>, ConfigError> {
-    p.reject_unknown(id, &["sigma_samp", "sigma_samp_ratio"])?;
-    Ok(Box::new(SingleParticle { sigma_samp: SigmaSamp::from_params(p, id, SigmaSamp::Absolute(1.0))?, terminating }))
+fn build(p: &Params, id: &str, terminating: bool) -> Result<Box<dyn Estimator>, ConfigError> {
+    let p = parse::<SigmaSampParams>(id, p)?;
+    Ok(Box::new(SingleParticle { sigma_samp: SigmaSamp::from_params(&p, id, SigmaSamp::Absolute(1.0))?, terminating }))
 }
 
 /// The estimator.

@@ -6,12 +6,13 @@
 //! `spm_nonterminating` (Eq. 12), `spm_adaptive` (non-terminating when `r < 1` or
 //! `q_scat + q_tran > 1`, terminating otherwise).
 
-use super::sigma_samp_param;
+use super::params::SpmParams;
 use super::single_particle::check_terminating;
 use crate::accumulate::RgbMean;
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
+use crate::params::{parse, ParamSpec};
 use crate::phase::Phase;
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
@@ -99,10 +100,8 @@ macro_rules! spm_entry {
             needs: Needs::MEDIUM,
             samplers: &["free_flight", "phase"],
             summary: $summary,
-            build: |p| {
-                p.reject_unknown($id, &["sigma_samp"])?;
-                Ok(Box::new(Spm { sigma_samp: sigma_samp_param(p, $id)?.unwrap_or(1.0), mode: $mode }))
-            },
+            build: |p| Ok(Box::new(Spm { sigma_samp: parse::<SpmParams>($id, p)?.sigma_samp, mode: $mode })),
+            params: ParamSpec::of::<SpmParams>(),
             checks: Checks::DEFAULT,
         };
     };
