@@ -507,6 +507,9 @@ mod tests {
             efficiency_mse: None,
             p_err: 0.0,
             p_eff: None,
+            estimator_id: String::new(),
+            params: String::new(),
+            testbed_params: String::new(),
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {

@@ -8,7 +8,6 @@ use crate::error::{HarnessError, Result};
 use crate::execute::{self, ExecOptions};
 use crate::progress::Progress;
 use crate::registry::Registry;
-use crate::report::markdown_table;
 use crate::shard::ShardSpec;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use estimators::params::Params;
@@ -33,6 +32,9 @@ enum Command {
     List {
         /// What to list (all when omitted).
         what: Option<ListWhat>,
+        /// Also each estimator's and test bed's parameters (name, type, default, meaning).
+        #[arg(long)]
+        params: bool,
     },
     /// Run experiments by name, or a custom sweep from --config.
     Run {
@@ -245,8 +247,13 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             let registry = with_references(registry, &args.results, &args.references);
             run(&experiments, &args, &registry)
         }
-        Some(Command::List { what }) => {
-            list(what, registry);
+        Some(Command::List { what, params }) => {
+            let what = what.map(|w| match w {
+                ListWhat::Testbeds => crate::listing::What::TestBeds,
+                ListWhat::Estimators => crate::listing::What::Estimators,
+                ListWhat::Experiments => crate::listing::What::Experiments,
+            });
+            print!("{}", crate::listing::list(what, params, registry));
             Ok(())
         }
         Some(Command::Reference(args)) => reference(args, registry),
@@ -416,45 +423,6 @@ fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, _reg
 
 fn valid_experiments(registry: &Registry) -> String {
     registry.experiments().iter().map(|e| e.name.as_str()).collect::<Vec<_>>().join(", ")
-}
-
-fn list(what: Option<ListWhat>, registry: &Registry) {
-    let all = what.is_none();
-    if all || matches!(what, Some(ListWhat::Testbeds)) {
-        let rows: Vec<Vec<String>> = registry
-            .test_beds()
-            .iter()
-            .map(|t| vec![t.id.into(), t.variants.join(", "), t.provides.to_string(), t.summary.into()])
-            .collect();
-        println!("{}", markdown_table(&["test bed", "variants", "provides", "summary"], &rows));
-    }
-    if all || matches!(what, Some(ListWhat::Estimators)) {
-        let rows: Vec<Vec<String>> = registry
-            .estimators()
-            .iter()
-            .map(|e| {
-                let on: Vec<&str> =
-                    registry.test_beds().iter().filter(|t| e.skip_reason(t.provides).is_none()).map(|t| t.id).collect();
-                vec![
-                    e.id.into(),
-                    e.paper.into(),
-                    e.bias.name().into(),
-                    e.needs.to_string(),
-                    on.join(", "),
-                    e.summary.into(),
-                ]
-            })
-            .collect();
-        println!("{}", markdown_table(&["estimator", "paper", "claim", "needs", "runs on", "summary"], &rows));
-    }
-    if all || matches!(what, Some(ListWhat::Experiments)) {
-        let rows: Vec<Vec<String>> = registry
-            .experiments()
-            .iter()
-            .map(|e| vec![e.name.clone(), e.reproduces.clone(), e.summary.clone()])
-            .collect();
-        println!("{}", markdown_table(&["experiment", "reproduces", "summary"], &rows));
-    }
 }
 
 fn reference(args: ReferenceArgs, registry: &Registry) -> Result<()> {

@@ -6,9 +6,9 @@ use crate::cell::CellResult;
 use crate::config::Sweep;
 use crate::error::Result;
 use crate::folder::{check_output_dir, FolderLock, OutputDir};
-use crate::metrics::{summarize, SummaryRow};
+use crate::metrics::SummaryRow;
 use crate::output::{self, Diagnostic, IntegralRow, Meta, RunReport};
-use crate::plan::Plan;
+use crate::plan::{Plan, PreparedBed, PreparedEstimator};
 use crate::registry::{Experiment, Registry};
 use crate::runner::{self, Observer, RunOptions, RunResults};
 use estimators::budget::BudgetKind;
@@ -127,7 +127,7 @@ pub fn finish(
     for (bi, ei, cell) in &run.cells {
         let (bed, est) = (&plan.beds[*bi], &plan.estimators[*ei]);
         let reference = bed.bed.reference();
-        rows.push(summarize(cell, reference));
+        rows.push(plan.summary_row(*bi, *ei, cell));
         for (name, sum) in &cell.diagnostics {
             diagnostics.push(Diagnostic {
                 testbed: cell.key.testbed.clone(),
@@ -140,7 +140,7 @@ pub fn finish(
         }
         if Some(cell.key.budget.amount) == last_budget {
             tests.extend(analysis::unbiasedness(cell, reference, est.entry.bias));
-            integrals.extend(integral_rows(cell, bed.bed.as_ref()));
+            integrals.extend(integral_rows(cell, bed, est));
         }
     }
     let fits = analysis::fits(&rows);
@@ -230,7 +230,8 @@ fn draw_with(report: &RunReport, plots_dir: &Path, results_dir: &Path, extra: Ve
     plots.commit(&crate::folder::run_id(&report.meta.experiment), Some(&report.meta.run_id))
 }
 
-fn integral_rows(cell: &CellResult, bed: &dyn estimators::testbed::TestBed) -> Vec<IntegralRow> {
+fn integral_rows(cell: &CellResult, prepared: &PreparedBed, est: &PreparedEstimator) -> Vec<IntegralRow> {
+    let bed = prepared.bed.as_ref();
     let (w, h) = bed.resolution();
     // Integrals per pixel (frames of paper 004); 1 when a sequence spans pixels (gradient-box).
     let frames = (bed.integrals() / (w * h).max(1)).max(1);
@@ -252,6 +253,9 @@ fn integral_rows(cell: &CellResult, bed: &dyn estimators::testbed::TestBed) -> V
                 mean: mc.mean(),
                 std_err: mc.std_err(),
                 geometry: geometry.clone(),
+                estimator_id: est.spec.id.clone(),
+                params: est.params_json.clone(),
+                testbed_params: prepared.params_json.clone(),
             });
         }
     }

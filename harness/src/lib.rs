@@ -75,6 +75,7 @@ pub mod execute;
 pub mod folder;
 pub mod guarded;
 pub mod limits;
+pub mod listing;
 pub mod merge;
 pub mod metrics;
 pub mod output;

@@ -64,6 +64,15 @@ pub struct SummaryRow {
     /// (seconds per estimate x integrals) (timing).
     #[serde(default)]
     pub p_eff: Option<f64>,
+    /// Registered id of the estimator (`estimator` is the id with the parameters given).
+    #[serde(default)]
+    pub estimator_id: String,
+    /// The estimator's parameters with every default filled in, as JSON.
+    #[serde(default)]
+    pub params: String,
+    /// The test bed's parameters with every default filled in, as JSON.
+    #[serde(default)]
+    pub testbed_params: String,
 }
 
 /// Column names whose values depend on the wall clock (excluded from determinism checks).
@@ -140,5 +149,8 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         efficiency_mse: inverse(mse_v * seconds),
         p_err: p_err.value() / cell.moments.len().max(1) as f64,
         p_eff: inverse(seconds * cell.moments.len() as f64 * p_err.value() / cell.moments.len().max(1) as f64),
+        estimator_id: String::new(),
+        params: String::new(),
+        testbed_params: String::new(),
     }
 }

@@ -154,6 +154,12 @@ pub struct IntegralRow {
     pub std_err: f64,
     /// Geometry (name, value).
     pub geometry: Vec<(&'static str, f64)>,
+    /// Registered id of the estimator.
+    pub estimator_id: String,
+    /// The estimator's parameters with every default filled in, as JSON.
+    pub params: String,
+    /// The test bed's parameters with every default filled in, as JSON.
+    pub testbed_params: String,
 }
 
 fn csv_bytes<F: FnOnce(&mut csv::Writer<Vec<u8>>) -> csv::Result<()>>(f: F) -> Result<Vec<u8>> {
@@ -200,6 +206,9 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "efficiency_mse",
     "p_err",
     "p_eff",
+    "estimator_id",
+    "params",
+    "testbed_params",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).
@@ -227,6 +236,7 @@ pub fn write_integrals_csv(dir: &OutputDir, rows: &[IntegralRow]) -> Result<()> 
             "std_err",
         ];
         header.extend(&geo);
+        header.extend(["estimator_id", "params", "testbed_params"]);
         w.write_record(&header)?;
         for r in rows {
             let mut rec = vec![
@@ -245,6 +255,7 @@ pub fn write_integrals_csv(dir: &OutputDir, rows: &[IntegralRow]) -> Result<()> 
             for g in &geo {
                 rec.push(r.geometry.iter().find(|(n, _)| n == g).map(|(_, v)| v.to_string()).unwrap_or_default());
             }
+            rec.extend([r.estimator_id.clone(), r.params.clone(), r.testbed_params.clone()]);
             w.write_record(&rec)?;
         }
         Ok(())

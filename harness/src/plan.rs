@@ -20,6 +20,8 @@ pub struct PreparedBed {
     pub variant: String,
     /// The scene with its reference.
     pub bed: Box<dyn TestBed>,
+    /// Its parameters with every default filled in, as JSON (result files' `testbed_params`).
+    pub params_json: String,
 }
 
 impl PreparedBed {
@@ -39,6 +41,8 @@ pub struct PreparedEstimator {
     pub entry: &'static EstimatorEntry,
     /// The configured estimator.
     pub estimator: Box<dyn Estimator>,
+    /// Its parameters with every default filled in, as JSON (result files' `params`).
+    pub params_json: String,
 }
 
 /// A pair that does not run, and why.
@@ -69,6 +73,17 @@ pub struct Plan {
 }
 
 impl Plan {
+    /// The summary row of a cell of this plan (SPEC §8), with the estimator's id and both
+    /// parameter sets.
+    pub fn summary_row(&self, bi: usize, ei: usize, cell: &crate::cell::CellResult) -> crate::metrics::SummaryRow {
+        let (b, e) = (&self.beds[bi], &self.estimators[ei]);
+        let mut row = crate::metrics::summarize(cell, b.bed.reference());
+        row.estimator_id = e.spec.id.clone();
+        row.params = e.params_json.clone();
+        row.testbed_params = b.params_json.clone();
+        row
+    }
+
     /// Validates and builds everything (computing exact references), looking names up in
     /// `registry`.
     pub fn prepare(sweep: Sweep, registry: &Registry) -> Result<Plan> {
@@ -85,13 +100,15 @@ impl Plan {
                 return Err(ConfigError::invalid("testbeds", format!("{}/{variant}", spec.id), "listed twice").into());
             }
             let bed = (entry.build)(&variant, &spec.params, registry.references())?;
-            beds.push(PreparedBed { spec: spec.clone(), variant, bed });
+            let params_json = (entry.params.resolve)(entry.id, &spec.params)?.to_string();
+            beds.push(PreparedBed { spec: spec.clone(), variant, bed, params_json });
         }
         let mut estimators = Vec::new();
         for spec in &sweep.estimators {
             let entry = registry.estimator(&spec.id)?;
             let estimator = (entry.build)(&spec.params)?;
-            estimators.push(PreparedEstimator { name: spec.name(), spec: spec.clone(), entry, estimator });
+            let params_json = (entry.params.resolve)(entry.id, &spec.params)?.to_string();
+            estimators.push(PreparedEstimator { name: spec.name(), spec: spec.clone(), entry, estimator, params_json });
         }
         let kind = sweep.budgets[0].kind;
         let (mut pairs, mut skipped) = (Vec::new(), Vec::new());

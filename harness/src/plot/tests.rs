@@ -31,6 +31,9 @@ fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
         efficiency_mse: Some(1.0 / (rmse * rmse * seconds)),
         p_err: 0.0,
         p_eff: None,
+        estimator_id: String::new(),
+        params: String::new(),
+        testbed_params: String::new(),
     }
 }
 

@@ -13,7 +13,6 @@ use super::{parts, Row};
 use crate::config::Sweep;
 use crate::error::Result;
 use crate::folder::OutputDir;
-use crate::metrics::summarize;
 use crate::output::RunReport;
 use crate::plan::Plan;
 use crate::progress::Progress;
@@ -48,7 +47,7 @@ fn rows_of(
         let exempt = exemption(registry, &plan.estimators[*ei].spec.id, &cell.key.testbed, &cell.key.variant);
         rows.push(table::row_from_tests(cell, reference, bias, &tests, exempt));
         if with_tests {
-            report.rows.push(summarize(cell, reference));
+            report.rows.push(plan.summary_row(*bi, *ei, cell));
             report.tests.extend(tests);
         }
     }
