@@ -86,6 +86,32 @@ impl StoredReference {
 }
 
 /// Where test beds find stored references.
+///
+/// ```
+/// use estimators::math::Rgb;
+/// use estimators::references::{load, InMemory, ReferenceKey, ReferenceSource, StoredReference};
+/// use estimators::testbed::{Reference, ReferenceKind};
+///
+/// let key = ReferenceKey::new("my-bed", "default", &[("resolution", 1.into())], true);
+/// let reference = Reference {
+///     kind: ReferenceKind::Stored { command: "my long run".into(), samples: 64 },
+///     value: vec![Rgb([0.5; 3])],
+///     std_err: vec![Rgb([0.001; 3])],
+/// };
+/// let stored = StoredReference {
+///     testbed: key.testbed.clone(),
+///     variant: key.variant.clone(),
+///     params: key.params.clone(),
+///     command: "my long run".into(),
+///     resolution: (1, 1),
+///     reference,
+/// };
+/// let source = InMemory(vec![stored]);
+/// assert_eq!(load(&source, &key, 1).unwrap().value[0][0], 0.5);
+/// let other = ReferenceKey::new("my-bed", "default", &[("resolution", 2.into())], false);
+/// assert!(load(&source, &other, 4).unwrap_err().to_string().contains("--param resolution=2"));
+/// assert!(source.stored(&other).unwrap().is_none());
+/// ```
 pub trait ReferenceSource: Send + Sync {
     /// The stored reference of `key`, or `None` when there is none. A reference that is there but
     /// cannot be read, does not parse, or is of another key is an error naming it.

@@ -156,6 +156,29 @@ pub struct ShadingPoint {
 
 /// A scene whose integrals are hemispherical: `integral of L_in(w) f(w, w_o) cos(theta) dw` at
 /// one shading point per integral (papers 001, 003, 004).
+///
+/// ```
+/// use estimators::brdf::Phong;
+/// use estimators::math::{Rgb, Vec3};
+/// use estimators::testbed::{HemisphereScene, ShadingPoint};
+///
+/// /// A white sky over one diffuse point facing up.
+/// struct Sky;
+/// impl HemisphereScene for Sky {
+///     fn shading(&self, _i: usize) -> ShadingPoint {
+///         let brdf = Phong { kd: Rgb([0.5; 3]), ks: Rgb::ZERO, n: 1.0 };
+///         ShadingPoint { position: Vec3::default(), normal: Vec3::Z, wo: Vec3::Z, brdf }
+///     }
+///     fn incident(&self, _i: usize, _wi: Vec3) -> Rgb {
+///         Rgb([1.0; 3])
+///     }
+/// }
+///
+/// // One direction's integrand L f cos = 1 x 0.5 / pi x cos(theta).
+/// let (p, wi) = (Sky.shading(0), Vec3::new(0.0, 0.6, 0.8));
+/// let f = Sky.incident(0, wi) * p.brdf.eval(wi, p.wo, p.normal) * wi.dot(p.normal);
+/// assert!((f[0] - 0.5 / std::f64::consts::PI * 0.8).abs() < 1e-12);
+/// ```
 pub trait HemisphereScene: Send + Sync {
     /// The shading point of integral `i`.
     fn shading(&self, i: usize) -> ShadingPoint;
@@ -175,6 +198,24 @@ pub trait HemisphereScene: Send + Sync {
 /// `S(p, u, v)` is a random, unbiased estimate of the radiance seen through position `(u, v)` of
 /// the pixel's footprint. Image-plane samplers (PMC-IP, §4) choose how many samples each pixel
 /// gets and where; the scene decides what one sample costs.
+///
+/// ```
+/// use estimators::math::Rgb;
+/// use estimators::rng::{stream, StreamRng};
+/// use estimators::testbed::ImagePlaneScene;
+///
+/// /// A horizontal ramp: radiance u across every pixel's footprint (its pixel integral is 1/2).
+/// struct Ramp;
+/// impl ImagePlaneScene for Ramp {
+///     fn pixel_sample(&self, _pixel: usize, u: f64, _v: f64, _rng: &mut StreamRng) -> (Rgb, u64) {
+///         (Rgb([u; 3]), 1)
+///     }
+/// }
+///
+/// let mut rng = stream(1, "ramp");
+/// let (value, rays) = Ramp.pixel_sample(0, 0.25, 0.5, &mut rng);
+/// assert_eq!((value[0], rays), (0.25, 1));
+/// ```
 pub trait ImagePlaneScene: Send + Sync {
     /// One pixel sample of pixel `pixel` at footprint position `(u, v)` in `[0, 1)^2`, and the
     /// number of rays it traced.
@@ -218,6 +259,40 @@ pub struct MediumRay {
 /// A participating-medium scene (paper 002): extinction, the bound it declares, albedo,
 /// environment radiance, and the ray of each integral. Estimators reach it only through the
 /// counted [`crate::task::MediumProbe`]: every `sigma_t` counts one fetch.
+///
+/// ```
+/// use estimators::math::{Rgb, Vec3};
+/// use estimators::testbed::{MediumQuantity, MediumRay, MediumScene};
+///
+/// /// A slab 0 <= x <= 2 of constant extinction 0.5, seen along +x: T = exp(-1).
+/// struct Slab;
+/// impl MediumScene for Slab {
+///     fn sigma_t(&self, p: Vec3) -> f64 {
+///         if (0.0..=2.0).contains(&p.x) { 0.5 } else { 0.0 }
+///     }
+///     fn majorant(&self) -> f64 {
+///         0.5
+///     }
+///     fn albedo(&self) -> f64 {
+///         0.0
+///     }
+///     fn clip(&self, origin: Vec3, dir: Vec3) -> Option<(f64, f64)> {
+///         let (t0, t1) = ((0.0 - origin.x) / dir.x, (2.0 - origin.x) / dir.x);
+///         let (a, b) = (t0.min(t1).max(0.0), t0.max(t1));
+///         (b > a).then_some((a, b))
+///     }
+///     fn environment(&self, _w: Vec3) -> Rgb {
+///         Rgb([1.0; 3])
+///     }
+///     fn ray(&self, _i: usize) -> MediumRay {
+///         let weight = Rgb([1.0; 3]);
+///         MediumRay { origin: Vec3::new(-1.0, 0.0, 0.0), dir: Vec3::new(1.0, 0.0, 0.0), length: 4.0, quantity: MediumQuantity::Transmittance { weight } }
+///     }
+/// }
+///
+/// let r = Slab.ray(0);
+/// assert_eq!(Slab.clip(r.origin, r.dir), Some((1.0, 3.0)));
+/// ```
 pub trait MediumScene: Send + Sync {
     /// Real extinction at `p` (the whole parameter stack: one fetch).
     fn sigma_t(&self, p: Vec3) -> f64;
@@ -314,6 +389,19 @@ pub enum EnvQuantity {
 
 /// A scene whose integrals are per-pixel, per-frame reflections of a dynamic environment map
 /// (paper 004): integral `pixel * frames + frame`.
+///
+/// The built-in `envmap-sequence` test bed is one:
+/// ```
+/// use estimators::params::Params;
+/// use estimators::registry::testbed;
+///
+/// let params = Params::new().with("resolution", 2.0).with("frames", 3.0).with("env_width", 16.0).with("env_height", 8.0);
+/// let bed = testbed("envmap-sequence").unwrap().build_exact("mixed", &params).unwrap();
+/// let env = bed.env_sequence().unwrap();
+/// assert_eq!((env.frames(), bed.integrals()), (3, 2 * 2 * 3));
+/// let sun_side = env.environment(0).radiance(estimators::math::Vec3::new(0.0, 0.0, 1.0));
+/// assert!(sun_side.is_finite());
+/// ```
 pub trait EnvSequenceScene: Send + Sync {
     /// Frames per sequence.
     fn frames(&self) -> usize;

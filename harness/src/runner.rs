@@ -20,6 +20,27 @@ use std::time::Instant;
 const BATCH: usize = 16;
 
 /// Receives progress (no-op by default): the CLI draws bars from it.
+///
+/// ```
+/// use mcbench::runner::Observer;
+/// use std::sync::atomic::{AtomicUsize, Ordering};
+///
+/// /// Counts the cells a run computed (not the ones it read back).
+/// #[derive(Default)]
+/// struct Computed(AtomicUsize);
+/// impl Observer for Computed {
+///     fn cell_done(&self, _done: usize, _total: usize, _label: &str, resumed: bool) {
+///         if !resumed {
+///             self.0.fetch_add(1, Ordering::Relaxed);
+///         }
+///     }
+/// }
+///
+/// let seen = Computed::default();
+/// seen.cell_done(1, 2, "gradient-plane/default is0_cv0 samples=4", false);
+/// seen.cell_done(2, 2, "gradient-plane/default is0_cv0 samples=16", true);
+/// assert_eq!(seen.0.load(Ordering::Relaxed), 1);
+/// ```
 pub trait Observer: Sync {
     /// A cell finished (`resumed` when it was read back from disk).
     fn cell_done(&self, _done: usize, _total: usize, _label: &str, _resumed: bool) {}

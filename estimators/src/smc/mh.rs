@@ -14,6 +14,30 @@ use rand::Rng;
 use std::f64::consts::TAU;
 
 /// An independent proposal over directions with its density.
+///
+/// ```
+/// use estimators::brdf::DirectionSample;
+/// use estimators::math::Vec3;
+/// use estimators::smc::mh::Proposal;
+///
+/// /// Directions uniform on the sphere.
+/// struct Sphere;
+/// impl Proposal for Sphere {
+///     fn draw(&self, rng: &mut dyn rand::RngCore) -> DirectionSample {
+///         use rand::Rng;
+///         let (z, phi): (f64, f64) = (rng.gen_range(-1.0..1.0), rng.gen_range(0.0..std::f64::consts::TAU));
+///         let r = (1.0 - z * z).sqrt();
+///         DirectionSample { w: Vec3::new(r * phi.cos(), r * phi.sin(), z), pdf: self.density(Vec3::Z) }
+///     }
+///     fn density(&self, _w: Vec3) -> f64 {
+///         1.0 / (4.0 * std::f64::consts::PI)
+///     }
+/// }
+///
+/// let mut rng = estimators::rng::stream(3, "sphere");
+/// let s = Sphere.draw(&mut rng);
+/// assert!((s.w.dot(s.w) - 1.0).abs() < 1e-12 && s.pdf > 0.0);
+/// ```
 pub trait Proposal {
     /// Draws a direction.
     fn draw(&self, rng: &mut dyn rand::RngCore) -> DirectionSample;
