@@ -291,7 +291,7 @@ fn calibrated_samples(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Resu
 /// [`estimators::testbed::TestBed::sequence_length`]), batched to about `BATCH` integrals; each
 /// sequence draws from the stream of its first integral, so a static test bed (sequence length 1)
 /// keeps exactly the per-integral streams and batches it always had. A fetch budget first becomes a
-/// fixed sample count ([`samples_for_fetch_budget`]; its pilot is deterministic, so every shard
+/// fixed sample count (`samples_for_fetch_budget`; its pilot is deterministic, so every shard
 /// owning a block of the cell computes the same count).
 pub fn run_blocks_with(
     plan: &Plan,

@@ -8,7 +8,7 @@
 //! - the scalar PDF coefficient, the running mean of the mean over channels of `|f - g|` (§4.2);
 //! - the record counter `C` (`u32`, saturating: 1e7 records into one cell are far from overflow).
 //!
-//! Layout: the RGB coefficients and the counter of a cell sit together (one [`Cell`]: a record
+//! Layout: the RGB coefficients and the counter of a cell sit together (one `Cell`: a record
 //! reads and writes both, and `g` reads the RGB of the cells around the drawn one), the PDF
 //! coefficients in an array of their own (the cell sampler scans runs of them).
 //!

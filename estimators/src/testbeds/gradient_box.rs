@@ -11,7 +11,7 @@
 //! (`sigma_t = 1e4`, albedo 0.8: the optically thick stability case, SPEC §10).
 //!
 //! References of the other variants are stored long-run Monte Carlo values made by
-//! `mcbench reference gradient-box --variant V` ([`compute_reference`]) and looked up by variant,
+//! `mcbench reference gradient-box --variant V` ([`super::gradient_box_reference::compute_reference`]) and looked up by variant,
 //! resolution and `sigma_t` ([`GradientBox::reference_key`]) in the reference source the caller
 //! gives.
 //!

@@ -255,7 +255,7 @@ pub fn ray_moments(
 /// (SPEC §10, `sigma_samp = 1e-6 x sigma_t`: the double and non-terminating particle models are
 /// unbiased for any `sigma_samp`, but their second moment `exp(int sigma_samp ((1 - r)^2 - 1))`
 /// is `exp(7e5)` there, so no run of any length estimates anything). Checks the exact moments
-/// ([`Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.
+/// ([`crate::estimator::Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.
 pub fn check_finite_variance(
     id: &str,
     est: &dyn crate::estimator::Estimator,

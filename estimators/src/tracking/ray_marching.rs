@@ -2,7 +2,7 @@
 //! step `h` (parameter `step`, default 0.9 as in paper 002 Fig. 9) and one random offset per ray.
 //! Under a fetch budget without an explicit `step`, one ray spends the whole budget: `N = budget`
 //! equal steps; with an explicit `step` the rays keep that step and the budget buys more of them.
-//! Biased by construction (Jensen: E[exp(-X)] > exp(-E[X]), about `T Var(X) / 2`): with a fine step
+//! Biased by construction (Jensen: `E[exp(-X)] > exp(-E[X])`, about `T Var(X) / 2`): with a fine step
 //! on a smooth medium the bias is far below what a run can detect, so the harness's control is a
 //! coarse step (`ray_marching[step=5]`).
 //! On point-light single-scatter integrals the same id marches the primary and shadow rays

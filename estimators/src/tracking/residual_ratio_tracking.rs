@@ -1,4 +1,4 @@
-//! `residual_ratio_tracking` (paper 002 §4.2 `Transmittance`, [NSJ14]): a main part `sigma_main`
+//! `residual_ratio_tracking` (paper 002 §4.2 `Transmittance`, \[NSJ14\]): a main part `sigma_main`
 //! through explorer points (cheap approximate extinction, spaced `explorer_spacing`, default 0.5;
 //! computed once per pixel and reused by all its rays, as the paper reuses explorer data of
 //! neighbouring rays): `control = 1` (default) the piecewise-linear fit of §4, `control = 2` the
