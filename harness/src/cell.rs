@@ -117,6 +117,16 @@ pub struct CellResult {
     /// Sums over estimates of each diagnostic the estimator noted (name, sum).
     #[serde(default)]
     pub diagnostics: Vec<(String, f64)>,
+    /// Over repetitions: each repetition's summed deviation from the reference, over every integral
+    /// and channel (`sum (estimate - reference)`). Repetitions are independent even where the
+    /// integrals of one repetition share adaptive state or channels are correlated, so tests and
+    /// error bars over these are valid everywhere.
+    #[serde(default)]
+    pub rep_dev: Moments,
+    /// Over repetitions: each repetition's mean squared deviation from the reference over integrals
+    /// and channels (their mean is the cell's MSE before the reference-variance correction).
+    #[serde(default)]
+    pub rep_sq: Moments,
 }
 
 impl CellResult {
@@ -149,6 +159,12 @@ impl CellResult {
         }
         if let Some((name, _)) = self.diagnostics.iter().find(|(_, v)| !v.is_finite()) {
             return Err(format!("diagnostic `{name}` is not finite"));
+        }
+        for (name, m) in [("rep_dev", &self.rep_dev), ("rep_sq", &self.rep_sq)] {
+            if m.count() != reps as u64 {
+                return Err(format!("{name} holds {} repetitions, not {reps}", m.count()));
+            }
+            m.check().map_err(|e| format!("{name}: {e}"))?;
         }
         Ok(())
     }

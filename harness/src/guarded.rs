@@ -59,13 +59,21 @@ pub fn sequence(
 /// (pushed in repetition order), with no costs: what the unbiasedness tests need.
 pub fn cell_of(bed: &dyn TestBed, estimator: &str, budget: Budget, seed: u64, per_rep: &[Vec<[f64; 3]>]) -> CellResult {
     let n = bed.integrals();
+    let reference = &bed.reference().value;
     let mut moments = vec![[Moments::new(), Moments::new(), Moments::new()]; n];
+    let (mut rep_dev, mut rep_sq) = (Moments::new(), Moments::new());
     for v in per_rep {
-        for (m, x) in moments.iter_mut().zip(v) {
+        let (mut dev, mut sq) = (estimators::stats::NeumaierSum::new(), estimators::stats::NeumaierSum::new());
+        for (i, (m, x)) in moments.iter_mut().zip(v).enumerate() {
             for c in 0..3 {
                 m[c].push(x[c]);
+                let d = x[c] - reference[i][c];
+                dev.add(d);
+                sq.add(d * d);
             }
         }
+        rep_dev.push(dev.value());
+        rep_sq.push(sq.value() / (3 * n).max(1) as f64);
     }
     CellResult {
         key: CellKey {
@@ -83,5 +91,7 @@ pub fn cell_of(bed: &dyn TestBed, estimator: &str, budget: Budget, seed: u64, pe
         estimates: (per_rep.len() * n) as u64,
         time: Default::default(),
         diagnostics: Vec::new(),
+        rep_dev,
+        rep_sq,
     }
 }

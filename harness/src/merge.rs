@@ -180,6 +180,7 @@ mod tests {
             mode: Mode::Quick,
             baseline: None,
             claims: Vec::new(),
+            bias_tolerance: None,
         };
         let m = Manifest {
             format: shard::FORMAT,

@@ -337,11 +337,24 @@ pub fn run_blocks_with(
             })
             .collect();
         let mut parts = vec![empty_cell(key.clone(), n); chunk.len()];
-        for (&(pos, _, batch), r) in work.iter().zip(items) {
-            let (r, part) = (r?, &mut parts[pos]);
+        let reference = &b.bed.reference().value;
+        // Items come repetition by repetition (every batch of one repetition, then the next), so a
+        // repetition's aggregates are complete when the next one starts.
+        let mut rep_acc: Option<(usize, usize, RepAggregate)> = None;
+        for (&(pos, rep, batch), r) in work.iter().zip(items) {
+            let r = r?;
+            if rep_acc.as_ref().is_some_and(|(p, q, _)| (*p, *q) != (pos, rep)) {
+                if let Some((p, _, acc)) = rep_acc.take() {
+                    acc.push_into(&mut parts[p]);
+                }
+            }
+            let acc = &mut rep_acc.get_or_insert_with(|| (pos, rep, RepAggregate::default())).2;
+            let part = &mut parts[pos];
             for (k, v) in r.values.iter().enumerate() {
+                let i = batch * per_item * frames + k;
                 for c in 0..3 {
-                    part.moments[batch * per_item * frames + k][c].push(v[c]);
+                    part.moments[i][c].push(v[c]);
+                    acc.add(v[c] - reference[i][c]);
                 }
             }
             part.estimates += r.values.len() as u64;
@@ -349,11 +362,36 @@ pub fn run_blocks_with(
             part.time.merge(&r.time);
             add_diagnostics(&mut part.diagnostics, &r.diagnostics);
         }
+        if let Some((p, _, acc)) = rep_acc.take() {
+            acc.push_into(&mut parts[p]);
+        }
         for (k, part) in parts.into_iter().enumerate() {
             sink(c * per_chunk + k, part)?;
         }
     }
     Ok(())
+}
+
+/// One repetition's aggregates over every integral and channel, compensated: the summed deviation
+/// from the reference and the sum of squared deviations.
+#[derive(Default)]
+struct RepAggregate {
+    dev: estimators::stats::NeumaierSum,
+    sq: estimators::stats::NeumaierSum,
+    count: u64,
+}
+
+impl RepAggregate {
+    fn add(&mut self, deviation: f64) {
+        self.dev.add(deviation);
+        self.sq.add(deviation * deviation);
+        self.count += 1;
+    }
+    /// Adds the repetition to the cell's per-repetition statistics.
+    fn push_into(self, cell: &mut CellResult) {
+        cell.rep_dev.push(self.dev.value());
+        cell.rep_sq.push(self.sq.value() / self.count.max(1) as f64);
+    }
 }
 
 /// A cell of `n` integrals with no estimates yet.
@@ -365,6 +403,8 @@ fn empty_cell(key: CellKey, n: usize) -> CellResult {
         estimates: 0,
         time: TimeStats::default(),
         diagnostics: Vec::new(),
+        rep_dev: Moments::default(),
+        rep_sq: Moments::default(),
     }
 }
 
@@ -383,6 +423,8 @@ fn merge_into(out: &mut CellResult, p: &CellResult) {
     add(&mut out.costs, &p.costs);
     out.time.merge(&p.time);
     add_diagnostics(&mut out.diagnostics, &p.diagnostics);
+    out.rep_dev.merge(&p.rep_dev);
+    out.rep_sq.merge(&p.rep_sq);
 }
 
 /// Merges the blocks of one cell, in the order given (block order for a bit-reproducible result),

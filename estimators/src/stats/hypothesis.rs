@@ -70,6 +70,40 @@ pub fn one_sample_t(mean: f64, std_err: f64, n: u64, reference: f64) -> TestOutc
     out
 }
 
+/// Two-sided t-test of a difference `diff` with standard error `std_err` and `dof` degrees of
+/// freedom (infinite: a z-test). A zero standard error gives `p = 1` for a zero difference, `0`
+/// otherwise.
+pub fn t_test(diff: f64, std_err: f64, dof: f64) -> TestOutcome {
+    if dof.is_infinite() {
+        return outcome(diff, std_err, dof, two_sided_normal);
+    }
+    outcome(diff, std_err, dof, |t| two_sided_t(t, dof))
+}
+
+/// The upper `p` quantile of Student's t with `dof` degrees of freedom (normal for infinite or
+/// very large `dof`); `NaN` outside `0 < p < 1` or for `dof <= 0`.
+pub fn t_quantile(p: f64, dof: f64) -> f64 {
+    if !(p > 0.0 && p < 1.0) || dof.is_nan() || dof <= 0.0 {
+        return f64::NAN;
+    }
+    if dof > NORMAL_LIMIT_DOF {
+        return Normal::new(0.0, 1.0).map(|n| n.inverse_cdf(p)).unwrap_or(f64::NAN);
+    }
+    StudentsT::new(0.0, 1.0, dof).map(|t| t.inverse_cdf(p)).unwrap_or(f64::NAN)
+}
+
+/// Smallest absolute shift that a two-sided t-test at level `alpha` with `dof` degrees of freedom
+/// detects with probability `power`, given its standard error:
+/// `(t_{1-alpha/2, dof} + t_{power, dof}) * std_err` (the noncentral t approximated by a shifted
+/// central one, as for [`detectable_shift`]).
+pub fn detectable_shift_t(std_err: f64, alpha: f64, power: f64, dof: f64) -> f64 {
+    let in_unit = |x: f64| x > 0.0 && x < 1.0;
+    if !in_unit(alpha) || !in_unit(power) {
+        return f64::NAN;
+    }
+    (t_quantile(1.0 - alpha / 2.0, dof) + t_quantile(power, dof)) * std_err
+}
+
 /// Two-sided z-test of `mean` against `reference` with a known standard error.
 ///
 /// A zero standard error gives `p = 1` if `mean == reference` and `p = 0` otherwise.
