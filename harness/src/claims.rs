@@ -8,19 +8,10 @@ pub fn fit<'a>(report: &'a RunReport, testbed: &str, variant: &str, estimator: &
     report.fits.iter().find(|f| f.testbed == testbed && f.variant == variant && f.estimator == estimator)
 }
 
-/// The test that decides unbiasedness for one (variant, estimator): its Holm test (`holm_t`,
-/// `holm_welch`, with `suffix` appended) when that ran, else its pooled test (`pooled_z` + suffix),
-/// which covers cells too skewed for per-integral t-tests.
+/// The test that decides unbiasedness for one (variant, estimator): its `combined` row (with
+/// `suffix` appended to the name), whose verdict is `pass`, `inconclusive` or `biased`.
 pub fn decisive_test<'a>(tests: &'a [TestRow], variant: &str, estimator: &str, suffix: &str) -> Option<&'a TestRow> {
-    let mine = |t: &&TestRow| t.variant == variant && t.estimator == estimator && t.test.ends_with(suffix);
-    let holm = tests.iter().filter(mine).find(|t| {
-        let base = t.test.trim_end_matches(suffix);
-        base == "holm_t" || base == "holm_welch"
-    });
-    match holm {
-        Some(h) if h.verdict != "untested" => Some(h),
-        _ => tests.iter().filter(mine).find(|t| t.test.trim_end_matches(suffix) == "pooled_z").or(holm),
-    }
+    tests.iter().find(|t| t.variant == variant && t.estimator == estimator && t.test == format!("combined{suffix}"))
 }
 
 fn not_measured(testbed: &str, claim: &str, paper: f64, why: String) -> Claim {
@@ -139,7 +130,9 @@ pub fn speedup_claim(report: &RunReport, tb: (&str, &str), estimator: &str, pape
     }
 }
 
-/// "The biased control is flagged by the unbiasedness test".
+/// "The biased control is flagged by the unbiasedness test" on every variant it ran on: held only
+/// when its deciding test says `biased` on each (the largest p is the value), so a control missed on
+/// one variant does not hold.
 pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
     let mut variants: Vec<&str> = Vec::new();
     for t in report.tests.iter().filter(|t| t.estimator == control) {
@@ -149,19 +142,22 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
     }
     let decisive: Vec<&TestRow> =
         variants.iter().filter_map(|v| decisive_test(&report.tests, v, control, "")).collect();
-    let min_p = decisive.iter().map(|t| t.p_value).filter(|p| !p.is_nan()).fold(f64::INFINITY, f64::min);
+    let max_p = decisive.iter().map(|t| if t.p_value.is_nan() { 1.0 } else { t.p_value }).fold(0.0, f64::max);
+    let missed: Vec<String> =
+        decisive.iter().filter(|t| t.verdict != "biased").map(|t| format!("{}/{}", t.testbed, t.variant)).collect();
     let used: Vec<String> =
-        decisive.iter().map(|t| format!("{}/{}: {} p = {:.2e}", t.testbed, t.variant, t.test, t.p_value)).collect();
+        decisive.iter().map(|t| format!("{}/{}: {} p = {:.2e}", t.testbed, t.variant, t.verdict, t.p_value)).collect();
     Claim {
-        testbed: decisive.first().map(|t| format!("{}/{}", t.testbed, t.variant)).unwrap_or_default(),
-        claim: format!("harness (SPEC §6): the biased control {control} is flagged at p < 1e-6"),
-        paper_value: Some(1e-6),
-        our_value: (!decisive.is_empty()).then_some(min_p),
-        held: (!decisive.is_empty()).then_some(min_p < 1e-6),
-        note: format!(
-            "smallest p of the deciding test per variant (Holm per-integral t-tests, or the pooled z-test where the cell is too skewed for them): {}",
-            used.join("; ")
-        ),
+        testbed: decisive.first().map(|t| t.testbed.clone()).unwrap_or_default(),
+        claim: format!("harness (SPEC §6): the biased control {control} is flagged on every variant it runs on"),
+        paper_value: None,
+        our_value: (!decisive.is_empty()).then_some(max_p),
+        held: (!decisive.is_empty()).then_some(missed.is_empty()),
+        note: if missed.is_empty() {
+            format!("flagged on all {} variants (largest p shown): {}", decisive.len(), used.join("; "))
+        } else {
+            format!("NOT flagged on {}: {}", missed.join(", "), used.join("; "))
+        },
     }
 }
 

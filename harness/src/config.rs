@@ -126,6 +126,17 @@ pub struct Sweep {
     /// Claims judged on the finished run ([`ClaimSpec`]).
     #[serde(default)]
     pub claims: Vec<ClaimSpec>,
+    /// The relative bias an unbiasedness `pass` must be able to detect with 80% power (default
+    /// [`crate::analysis::DEFAULT_TOLERANCE`], 1%).
+    #[serde(default)]
+    pub bias_tolerance: Option<f64>,
+}
+
+impl Sweep {
+    /// The unbiasedness tolerance of this sweep.
+    pub fn tolerance(&self) -> f64 {
+        self.bias_tolerance.unwrap_or(crate::analysis::DEFAULT_TOLERANCE)
+    }
 }
 
 /// `4^k` for `k` in `ks`: the papers' spp sweep.
@@ -168,6 +179,8 @@ pub struct SweepFile {
     pub estimators: Option<Vec<EstimatorSpec>>,
     /// Claims judged on the finished run (`[[claims]]` tables, [`ClaimSpec`]).
     pub claims: Option<Vec<ClaimSpec>>,
+    /// The relative bias an unbiasedness `pass` must be able to detect (default 0.01).
+    pub bias_tolerance: Option<f64>,
 }
 
 impl SweepFile {
@@ -199,6 +212,7 @@ impl SweepFile {
                 mode,
                 baseline: None,
                 claims: Vec::new(),
+                bias_tolerance: None,
             },
         };
         if let Some(name) = self.name {
@@ -228,6 +242,9 @@ impl SweepFile {
         }
         if let Some(c) = self.claims {
             sweep.claims = c;
+        }
+        if self.bias_tolerance.is_some() {
+            sweep.bias_tolerance = self.bias_tolerance;
         }
         Ok(sweep)
     }
@@ -304,6 +321,11 @@ impl Sweep {
         for (i, n) in names.iter().enumerate() {
             if names[..i].contains(n) {
                 return Err(ConfigError::invalid("estimators", n, "listed twice").into());
+            }
+        }
+        if let Some(t) = self.bias_tolerance {
+            if !(t > 0.0 && t < 1.0) {
+                return Err(ConfigError::invalid("bias_tolerance", t, "must lie in (0, 1): a relative bias").into());
             }
         }
         if let Some(b) = &self.baseline {

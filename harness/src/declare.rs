@@ -57,6 +57,8 @@ pub struct ExperimentFile {
     pub estimators: Option<Vec<EstimatorSpec>>,
     /// Claims judged on every run of it (`[[claims]]`).
     pub claims: Option<Vec<ClaimSpec>>,
+    /// The relative bias an unbiasedness `pass` must detect (default 0.01).
+    pub bias_tolerance: Option<f64>,
     /// Overrides for `--quick`.
     #[serde(default)]
     pub quick: SweepFile,
@@ -83,6 +85,7 @@ impl ExperimentFile {
             testbeds: self.testbeds.clone(),
             estimators: self.estimators.clone(),
             claims: self.claims.clone(),
+            bias_tolerance: self.bias_tolerance,
         };
         let base = shared.apply(None, mode)?;
         let mut overrides = match mode {

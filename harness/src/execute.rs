@@ -139,7 +139,8 @@ pub fn finish(
             });
         }
         if Some(cell.key.budget.amount) == last_budget {
-            tests.extend(analysis::unbiasedness(cell, reference, est.entry.bias));
+            let gate = previous_budget_gate(run, *bi, *ei, cell);
+            tests.extend(analysis::unbiasedness(cell, reference, est.entry.bias, gate.as_ref(), sweep.tolerance()));
             integrals.extend(integral_rows(cell, bed, est));
         }
     }
@@ -211,6 +212,19 @@ pub fn finish(
         draw_with(&report, &plots_dir, &results_dir, extra_plots)?;
     }
     Ok(Outcome { report, results_dir, plots_dir })
+}
+
+/// The gate of a cell's unbiasedness tests from the same pair at the previous budget of the sweep
+/// (independent streams), its spread scaled by `sqrt(previous budget / budget)`; `None` for a
+/// one-budget sweep.
+fn previous_budget_gate(run: &RunResults, bi: usize, ei: usize, cell: &CellResult) -> Option<analysis::Gate> {
+    let previous = run
+        .cells
+        .iter()
+        .filter(|(b, e, c)| (*b, *e) == (bi, ei) && c.key.budget.amount < cell.key.budget.amount)
+        .max_by_key(|(_, _, c)| c.key.budget.amount)?;
+    let scale = (previous.2.key.budget.amount as f64 / cell.key.budget.amount as f64).sqrt();
+    Some(analysis::Gate::from_cell(&previous.2, "previous budget", scale))
 }
 
 /// Draws the plots and the report of a finished run into `plots_dir` and commits them.

@@ -328,6 +328,7 @@ mod tests {
             claim: "unbiased".into(),
             agrees: true,
             untested: 3,
+            ..Default::default()
         };
         let text = serde_json::to_string(&row).expect("serialises");
         assert!(text.contains("\"p_value\":null"), "{text}");

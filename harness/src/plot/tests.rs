@@ -60,6 +60,7 @@ pub fn synthetic_report() -> RunReport {
         claim: "unbiased".into(),
         agrees: verdict == "pass",
         untested: 0,
+        ..Default::default()
     };
     RunReport {
         meta: Meta {

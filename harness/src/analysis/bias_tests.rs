@@ -1,0 +1,178 @@
+//! Unit tests of the unbiasedness tests and their verdicts.
+
+use super::*;
+use crate::analysis::reps_for;
+use crate::cell::{CellKey, TimeStats};
+use estimators::budget::Budget;
+use estimators::math::Rgb;
+use estimators::stats::NeumaierSum;
+use rand::{Rng, SeedableRng};
+
+/// A cell from per-repetition estimates of every integral (what the runner reduces).
+pub(crate) fn cell_from(per_rep: &[Vec<[f64; 3]>], reference: &Reference) -> CellResult {
+    let n = reference.value.len();
+    let mut moments = vec![[Moments::default(), Moments::default(), Moments::default()]; n];
+    let (mut rep_dev, mut rep_sq) = (Moments::default(), Moments::default());
+    for v in per_rep {
+        let (mut d, mut q) = (NeumaierSum::new(), NeumaierSum::new());
+        for (i, x) in v.iter().enumerate() {
+            for c in 0..3 {
+                moments[i][c].push(x[c]);
+                let e = x[c] - reference.value[i][c];
+                d.add(e);
+                q.add(e * e);
+            }
+        }
+        rep_dev.push(d.value());
+        rep_sq.push(q.value() / (3 * n) as f64);
+    }
+    let key = CellKey {
+        testbed: "t".into(),
+        variant: "v".into(),
+        testbed_params: "{}".into(),
+        estimator: "e".into(),
+        budget: Budget::samples(4).unwrap(),
+        reps: per_rep.len(),
+        seed: 1,
+        version: "0".into(),
+    };
+    CellResult {
+        key,
+        moments,
+        costs: Default::default(),
+        estimates: (per_rep.len() * n) as u64,
+        time: TimeStats::default(),
+        diagnostics: Vec::new(),
+        rep_dev,
+        rep_sq,
+    }
+}
+
+pub(crate) fn exact(values: &[[f64; 3]]) -> Reference {
+    Reference {
+        kind: ReferenceKind::Exact { method: "test".into(), bound: 0.0 },
+        value: values.iter().map(|v| Rgb(*v)).collect(),
+        std_err: vec![Rgb::ZERO; values.len()],
+    }
+}
+
+/// `reps` repetitions of `n` integrals of value `mean + noise` (normal noise of `sd`), seeded.
+fn normal_reps(seed: u64, n: usize, reps: usize, mean: f64, sd: f64) -> Vec<Vec<[f64; 3]>> {
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+    let mut normal = || {
+        let (u, v): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    };
+    (0..reps).map(|_| (0..n).map(|_| [0; 3].map(|_| mean + sd * normal())).collect()).collect()
+}
+
+fn decision(rows: &[TestRow]) -> &TestRow {
+    rows.iter().find(|t| t.test == "combined").expect("combined row")
+}
+
+#[test]
+fn an_unbiased_cell_passes_behind_an_independent_gate_and_not_without_one() {
+    let reference = exact(&[[1.0; 3]; 16]);
+    let cell = cell_from(&normal_reps(1, 16, 256, 1.0, 0.05), &reference);
+    let pilot = cell_from(&normal_reps(2, 16, 256, 1.0, 0.05), &reference);
+    let gate = Gate::from_cell(&pilot, "pilot", 1.0);
+    let with = unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), DEFAULT_TOLERANCE);
+    let d = decision(&with);
+    assert_eq!((d.verdict.as_str(), d.agrees), ("pass", true), "{d:?}");
+    assert!(d.detectable_rel_bias < DEFAULT_TOLERANCE && d.detectable_rel_bias > 0.0);
+    // The same cell with no independent gate cannot pass: it is inconclusive, never a pass.
+    let without = unbiasedness(&cell, &reference, Bias::Unbiased, None, DEFAULT_TOLERANCE);
+    let d = decision(&without);
+    assert_eq!((d.verdict.as_str(), d.agrees), ("inconclusive", false), "{d:?}");
+    assert!(d.reason.contains("no independent gate"));
+}
+
+#[test]
+fn a_row_that_cannot_detect_the_tolerance_is_inconclusive_with_the_repetitions_it_needs() {
+    let reference = exact(&[[1.0; 3]; 4]);
+    let cell = cell_from(&normal_reps(3, 4, 64, 1.0, 0.5), &reference);
+    let gate = Gate::from_cell(&cell_from(&normal_reps(4, 4, 64, 1.0, 0.5), &reference), "pilot", 1.0);
+    let d = decision(&unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), 0.01)).clone();
+    assert_eq!(d.verdict, "inconclusive", "{d:?}");
+    assert!(d.detectable_rel_bias > 0.01);
+    let needed = d.reps_needed.expect("repetitions that resolve 1%");
+    // The detectable bias falls like 1/sqrt(R): about (d / 0.01)^2 x 64 repetitions.
+    let expect = 64.0 * (d.detectable_rel_bias / 0.01).powi(2);
+    assert!((needed / expect - 1.0).abs() < 0.3, "{needed} vs {expect}");
+    // A looser tolerance that the row resolves makes it pass.
+    let loose = decision(&unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), 0.5)).verdict.clone();
+    assert_eq!(loose, "pass");
+}
+
+#[test]
+fn a_shift_is_flagged_and_a_control_agrees() {
+    let reference = exact(&[[1.0; 3]; 8]);
+    let cell = cell_from(&normal_reps(5, 8, 64, 1.05, 0.05), &reference);
+    let rows = unbiasedness(&cell, &reference, Bias::Biased, None, DEFAULT_TOLERANCE);
+    let d = decision(&rows);
+    assert_eq!((d.verdict.as_str(), d.agrees), ("biased", true), "{d:?}");
+    assert!((d.rel_bias - 0.05).abs() < 5.0 * d.rel_bias_se, "{} ± {}", d.rel_bias, d.rel_bias_se);
+    let unbiased = unbiasedness(&cell, &reference, Bias::Unbiased, None, DEFAULT_TOLERANCE);
+    assert!(!decision(&unbiased).agrees);
+}
+
+/// A rare-hit estimator (10 with probability 0.05 per repetition and integral, else 0; mean 0.5):
+/// the repetitions of the tested cell never saw a hit, so its own spread is zero and a t-test on it
+/// alone would call it biased; a pilot that saw the hits gates the test out (too skewed at this
+/// many repetitions) and widens the spread, so the verdict is inconclusive, not biased.
+#[test]
+fn a_pilot_that_saw_the_tail_keeps_a_cell_that_missed_it_from_being_flagged() {
+    let reference = exact(&[[0.5; 3]]);
+    let missed: Vec<Vec<[f64; 3]>> = (0..16).map(|_| vec![[0.0; 3]]).collect();
+    let cell = cell_from(&missed, &reference);
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(9);
+    let pilot_reps: Vec<Vec<[f64; 3]>> =
+        (0..64).map(|_| vec![[if rng.gen::<f64>() < 0.05 { 10.0 } else { 0.0 }; 3]]).collect();
+    assert!(pilot_reps.iter().any(|r| r[0][0] > 0.0), "the pilot saw the tail");
+    let gate = Gate::from_cell(&cell_from(&pilot_reps, &reference), "pilot", 1.0);
+    let d = decision(&unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), 0.01)).clone();
+    assert_eq!(d.verdict, "inconclusive", "{d:?}");
+    assert!(d.reps_needed.is_some());
+    // Without the pilot the same cell is (wrongly) flagged: the gate is what protects it.
+    let alone = decision(&unbiasedness(&cell, &reference, Bias::Unbiased, None, 0.01)).verdict.clone();
+    assert_eq!(alone, "biased");
+}
+
+/// A zero-variance estimator: inside an exact reference's bound it passes its tests' p-values (no
+/// evidence of bias), outside it is flagged; its rows round-trip through summary.json.
+#[test]
+fn zero_variance_cells_and_the_exact_bound() {
+    let mut reference = exact(&[[0.5; 3]]);
+    let same: Vec<Vec<[f64; 3]>> = (0..8).map(|_| vec![[0.5 + 1e-16; 3]]).collect();
+    let cell = cell_from(&same, &reference);
+    reference.kind = ReferenceKind::Exact { method: "closed form".into(), bound: 1e-13 };
+    let gate = Gate::from_cell(&cell, "pilot", 1.0);
+    let ok = unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), DEFAULT_TOLERANCE);
+    assert_eq!(decision(&ok).verdict, "pass", "{:?}", decision(&ok));
+    let off = cell_from(&(0..8).map(|_| vec![[3.0; 3]]).collect::<Vec<_>>(), &exact(&[[0.5; 3]]));
+    let rows = unbiasedness(&off, &exact(&[[0.5; 3]]), Bias::Biased, None, DEFAULT_TOLERANCE);
+    let d = decision(&rows);
+    assert_eq!((d.verdict.as_str(), d.p_value), ("biased", 0.0), "{d:?}");
+    let back: TestRow = serde_json::from_str(&serde_json::to_string(&rows[0]).unwrap()).unwrap();
+    assert_eq!(back.verdict, rows[0].verdict);
+}
+
+#[test]
+fn a_stored_reference_adds_its_variance_and_uses_welch() {
+    let mut reference = exact(&[[1.0; 3]; 4]);
+    reference.kind = ReferenceKind::Stored { command: "x".into(), samples: 64 };
+    reference.std_err = vec![Rgb::splat(0.01); 4];
+    let cell = cell_from(&normal_reps(11, 4, 128, 1.0, 0.05), &reference);
+    let rows = unbiasedness(&cell, &reference, Bias::Unbiased, None, DEFAULT_TOLERANCE);
+    assert_eq!(rows[0].test, "holm_welch");
+    let exact_rows = unbiasedness(&cell, &exact(&[[1.0; 3]; 4]), Bias::Unbiased, None, DEFAULT_TOLERANCE);
+    // The reference's own error widens what the pooled test can detect.
+    assert!(rows[1].detectable_rel_bias > exact_rows[1].detectable_rel_bias);
+}
+
+#[test]
+fn repetitions_for_a_tolerance() {
+    assert_eq!(reps_for(0.02, 100, 1.0, 0.01), Some(400.0));
+    assert_eq!(reps_for(0.005, 100, 1.0, 0.01), None, "already resolved");
+    assert_eq!(reps_for(0.02, 100, 0.1, 0.01), None, "the reference alone is too noisy");
+}
