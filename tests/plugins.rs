@@ -89,6 +89,7 @@ fn one_file_and_one_registration_are_enough() {
         mode: Mode::Quick,
         baseline: None,
         claims: Vec::new(),
+        bias_tolerance: None,
     };
     let plan = mcbench::plan::Plan::prepare(sweep(Params::new().with("tilt", 0.5)), &registry).expect("plans");
     let bad = mcbench::plan::Plan::prepare(sweep(Params::new().with("tlit", 0.5)), &registry);

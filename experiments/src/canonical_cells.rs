@@ -73,15 +73,15 @@ pub struct Measured {
     pub test: Option<Verdict>,
 }
 
-/// The deciding unbiasedness test of a cell: the Holm t-test where it ran, else the pooled z-test
-/// (the cell is too skewed for per-integral t-tests, `analysis.rs`).
+/// The deciding unbiasedness test of a cell: the harness's combined verdict (Holm per-integral
+/// t-tests and the pooled t-test over repetitions, [`mcbench::analysis::unbiasedness`]).
 #[derive(Clone, Debug)]
 pub struct Verdict {
-    /// `holm_t` or `pooled_z`.
+    /// `combined`.
     pub test: String,
-    /// Its p-value (smallest Holm-adjusted for `holm_t`).
+    /// Its p-value (Bonferroni over the tests that ran).
     pub p: f64,
-    /// `pass`, `biased` or `untested`.
+    /// `pass`, `inconclusive` or `biased`.
     pub verdict: String,
     /// The relative bias the test detects with 80% power.
     pub detectable: f64,

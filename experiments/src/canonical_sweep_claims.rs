@@ -50,8 +50,8 @@ fn unbiased_cells_pass(a: &Analysis) -> Claim {
         .collect();
     let test = |r: &CellRow| r.measured.as_ref().and_then(|m| m.test.clone());
     let p: Vec<f64> = tested.iter().filter_map(|r| test(r).map(|t| t.p)).filter(|p| !p.is_nan()).collect();
-    let pooled = tested.iter().filter(|r| test(r).is_some_and(|t| t.test == "pooled_z")).count();
-    let untested = tested.iter().filter(|r| r.verdict() == Some("untested")).count();
+    let pooled = tested.iter().filter(|r| test(r).is_some_and(|t| t.test.contains("pooled_t"))).count();
+    let untested = tested.iter().filter(|r| r.verdict() == Some("inconclusive")).count();
     let flagged: Vec<String> = tested
         .iter()
         .filter(|r| r.verdict() == Some("biased"))

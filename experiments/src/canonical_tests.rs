@@ -139,6 +139,7 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
         mode: Mode::Quick,
         baseline: None,
         claims: Vec::new(),
+        bias_tolerance: None,
     };
     let registry = crate::test_registry();
     let opts = ExecOptions {

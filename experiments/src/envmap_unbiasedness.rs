@@ -10,10 +10,8 @@
 use estimators::budget::Budget;
 use estimators::params::Params;
 use estimators::rng::StreamKey;
-use estimators::stats::Moments;
 use estimators::task::Task;
 use mcbench::analysis::{unbiasedness, TestRow};
-use mcbench::cell::{CellKey, CellResult};
 use mcbench::config::Mode;
 use mcbench::error::Result;
 use mcbench::registry::Registry;
@@ -31,8 +29,12 @@ fn cases() -> Vec<(&'static str, Params)> {
     ]
 }
 
-/// Runs the check; one `holm_t` and one `pooled_z` row per (variant, estimator), test names
-/// suffixed `_dedicated`.
+/// The relative bias the dedicated check must resolve to pass (it runs thousands of repetitions).
+const DEDICATED_TOLERANCE: f64 = 0.01;
+
+/// Runs the check, each cell gated by a pilot of as many repetitions on its own seed; one
+/// `holm_t`, one `pooled_t` and one `combined` row per (variant, estimator), test names suffixed
+/// `_dedicated`.
 pub fn check(mode: Mode, seed: u64, registry: &Registry) -> Result<Vec<TestRow>> {
     let reps: u64 = if mode == Mode::Quick { 3000 } else { 20_000 };
     let n = 4u64;
@@ -46,63 +48,45 @@ pub fn check(mode: Mode, seed: u64, registry: &Registry) -> Result<Vec<TestRow>>
             let entry = registry.estimator(id)?;
             let est = (entry.build)(&p)?;
             let label = format!("{id}-dedicated");
-            let per_rep: Vec<Vec<[f64; 3]>> = (0..reps)
-                .into_par_iter()
-                .map(|rep| {
-                    let mut out = Vec::with_capacity(bed.integrals());
-                    for s in 0..seqs {
-                        let key = StreamKey {
-                            seed,
-                            testbed: variant,
-                            estimator: &label,
-                            budget: n,
-                            rep,
-                            integral: (s * f) as u64,
-                        };
-                        let tasks: Vec<Task<'_>> = (s * f..(s + 1) * f)
-                            .map(|i| {
-                                Task::new(
-                                    bed.as_ref(),
-                                    i,
-                                    Budget { kind: estimators::budget::BudgetKind::Samples, amount: n },
-                                )
-                            })
-                            .collect();
-                        match est.estimate_sequence(&tasks, &mut key.rng()) {
-                            Ok(v) => out.extend(v.into_iter().map(|x| x.0)),
-                            Err(_) => out.extend(std::iter::repeat_n([f64::NAN; 3], f)),
+            let per_rep_of = |seed: u64| -> Vec<Vec<[f64; 3]>> {
+                (0..reps)
+                    .into_par_iter()
+                    .map(|rep| {
+                        let mut out = Vec::with_capacity(bed.integrals());
+                        for s in 0..seqs {
+                            let key = StreamKey {
+                                seed,
+                                testbed: variant,
+                                estimator: &label,
+                                budget: n,
+                                rep,
+                                integral: (s * f) as u64,
+                            };
+                            let tasks: Vec<Task<'_>> = (s * f..(s + 1) * f)
+                                .map(|i| {
+                                    Task::new(
+                                        bed.as_ref(),
+                                        i,
+                                        Budget { kind: estimators::budget::BudgetKind::Samples, amount: n },
+                                    )
+                                })
+                                .collect();
+                            match est.estimate_sequence(&tasks, &mut key.rng()) {
+                                Ok(v) => out.extend(v.into_iter().map(|x| x.0)),
+                                Err(_) => out.extend(std::iter::repeat_n([f64::NAN; 3], f)),
+                            }
                         }
-                    }
-                    out
-                })
-                .collect();
-            let mut m = vec![[Moments::default(), Moments::default(), Moments::default()]; bed.integrals()];
-            for r in &per_rep {
-                for (i, v) in r.iter().enumerate() {
-                    for c in 0..3 {
-                        m[i][c].push(v[c]);
-                    }
-                }
-            }
-            let reference = bed.reference();
-            let cell = CellResult {
-                key: CellKey {
-                    testbed: "envmap-sequence".into(),
-                    variant: variant.into(),
-                    testbed_params: String::new(),
-                    estimator: id.into(),
-                    budget: Budget::samples(n)?,
-                    reps: reps as usize,
-                    seed,
-                    version: env!("CARGO_PKG_VERSION").into(),
-                },
-                moments: m,
-                costs: Default::default(),
-                estimates: reps * bed.integrals() as u64,
-                time: Default::default(),
-                diagnostics: Vec::new(),
+                        out
+                    })
+                    .collect()
             };
-            for mut row in unbiasedness(&cell, reference, entry.bias) {
+            let reference = bed.reference();
+            let budget = Budget::samples(n)?;
+            let cell = mcbench::guarded::cell_of(bed.as_ref(), id, budget, seed, &per_rep_of(seed));
+            let pilot_seed = mcbench::unbiasedness::run::pilot_seed(seed);
+            let pilot = mcbench::guarded::cell_of(bed.as_ref(), id, budget, pilot_seed, &per_rep_of(pilot_seed));
+            let gate = mcbench::analysis::Gate::from_cell(&pilot, "pilot", 1.0);
+            for mut row in unbiasedness(&cell, reference, entry.bias, Some(&gate), DEDICATED_TOLERANCE) {
                 row.test.push_str("_dedicated");
                 // The self-normalised control is only biased for L_r; its L_ns estimate is unbiased.
                 if entry.bias == estimators::estimator::Bias::Biased && variant.ends_with("-lns") {

@@ -16,7 +16,6 @@
 //! experiment's sweep (what `--config` overrides); the others run in its analysis ([`run`]) into
 //! the same results folder, summary rows and tests.
 
-pub mod reps;
 pub mod run;
 pub mod stats;
 pub mod table;
@@ -96,6 +95,7 @@ pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
                     mode,
                     baseline: None,
                     claims: Vec::new(),
+                    bias_tolerance: None,
                 },
             }
         })
@@ -117,6 +117,7 @@ fn first_part(registry: &Registry, mode: Mode) -> Sweep {
             mode,
             baseline: None,
             claims: Vec::new(),
+            bias_tolerance: None,
         };
     }
     all.swap_remove(0).sweep

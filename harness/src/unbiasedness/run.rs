@@ -7,7 +7,6 @@
 //! applies to every part when it differs from the first part's default; `--config` changes the
 //! first part only. `--threads` is honoured through the run's thread count (`meta.threads`).
 
-use super::reps::pooled_over_repetitions;
 use super::table;
 use super::{parts, Row};
 use crate::config::Sweep;
@@ -21,37 +20,37 @@ use crate::runner::{self, RunOptions, RunResults};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// The rows of a finished plan's cells (and their tests, when `with_tests`: the harness already
-/// added the first part's). Whole-image sequences also get `pooled_z_rep`
-/// ([`crate::unbiasedness_reps`]), recomputed on `threads` threads.
-fn rows_of(
-    plan: &Plan,
-    run: &RunResults,
-    report: &mut RunReport,
-    with_tests: bool,
-    registry: &Registry,
-) -> Result<Vec<Row>> {
-    let threads = report.meta.threads;
+/// The seed of a part's pilot: independent streams for the same pairs, cells and repetitions.
+pub fn pilot_seed(seed: u64) -> u64 {
+    seed ^ 0x5049_4c4f_545f_5345
+}
+
+/// The rows of a finished plan's cells, each tested behind the gate of its pilot cell (the same
+/// pair on [`pilot_seed`]), and the tests (added to the report when `with_tests`; the harness
+/// already added the first part's, gated by nothing, and they are replaced here).
+fn rows_of(plan: &Plan, run: &RunResults, pilot: &RunResults, report: &mut RunReport, registry: &Registry) -> Vec<Row> {
     let mut rows = Vec::new();
-    for (bi, ei, cell) in &run.cells {
+    for ((bi, ei, cell), (_, _, pilot_cell)) in run.cells.iter().zip(&pilot.cells) {
         let bed = plan.beds[*bi].bed.as_ref();
-        let reference = bed.reference();
         let bias = plan.estimators[*ei].entry.bias;
-        let mut tests = table::tests_of(cell, reference, bias, bed.sequence_length());
-        if let Some(template) = tests.iter().find(|t| t.test == "pooled_z").cloned() {
-            if let Some(mut t) = pooled_over_repetitions(plan, *bi, *ei, threads, &template)? {
-                table::set_claim(&mut t, bias);
-                tests.push(t);
-            }
-        }
+        let gate = crate::analysis::Gate::from_cell(pilot_cell, "pilot", 1.0);
+        let tests = crate::analysis::unbiasedness(cell, bed.reference(), bias, Some(&gate), plan.sweep.tolerance());
         let exempt = exemption(registry, &plan.estimators[*ei].spec.id, &cell.key.testbed, &cell.key.variant);
-        rows.push(table::row_from_tests(cell, reference, bias, &tests, exempt));
-        if with_tests {
-            report.rows.push(plan.summary_row(*bi, *ei, cell));
-            report.tests.extend(tests);
-        }
+        rows.push(table::row_from_tests(cell, bias, &tests, exempt));
+        report.tests.retain(|t| {
+            !(t.estimator == cell.key.estimator
+                && t.testbed == cell.key.testbed
+                && t.variant == cell.key.variant
+                && t.budget == cell.key.budget.amount)
+        });
+        report.tests.extend(tests);
     }
-    Ok(rows)
+    rows
+}
+
+/// A part's sweep on its pilot seed.
+fn pilot_of(sweep: &Sweep) -> Sweep {
+    Sweep { seed: pilot_seed(sweep.seed), ..sweep.clone() }
 }
 
 /// Why a biased control `id` is not required to be flagged on `testbed/variant`, if its registry
@@ -115,16 +114,28 @@ fn other_parts(registry: &Registry, first: &Sweep) -> Vec<(String, Sweep)> {
 
 /// Checks, before the run writes anything, every stored cell the other parts will read back.
 pub fn preflight(registry: &Registry, first: &Sweep, cells: &Path) -> Result<()> {
-    for (_, sweep) in other_parts(registry, first) {
-        let (plans, _) = prepare_valid(sweep, registry)?;
-        for p in &plans {
-            runner::preload(p, Some(cells))?;
+    let parts = other_parts(registry, first).into_iter().map(|(_, s)| s);
+    for sweep in std::iter::once(first.clone()).chain(parts) {
+        for s in [pilot_of(&sweep), sweep] {
+            let (plans, _) = prepare_valid(s, registry)?;
+            for p in &plans {
+                runner::preload(p, Some(cells))?;
+            }
         }
     }
     Ok(())
 }
 
-/// Runs the other parts and writes the table (see the module docs).
+/// Runs `plan`'s cells (stored ones read back) with progress on a terminal.
+fn run_plan(p: &Plan, results: &OutputDir, threads: usize) -> Result<RunResults> {
+    let progress = Progress::default();
+    let opts = RunOptions { threads: Some(threads), cell_dir: Some(results.join("cells")), observer: &progress };
+    let r = runner::run(p, &opts);
+    progress.finish();
+    r
+}
+
+/// Runs the pilots, the other parts and writes the table (see the module docs).
 pub fn post(
     plan: &Plan,
     run: &RunResults,
@@ -133,7 +144,9 @@ pub fn post(
     _plots: Option<&Path>,
     registry: &Registry,
 ) -> Result<Vec<PathBuf>> {
-    let mut rows = rows_of(plan, run, report, false, registry)?;
+    let threads = report.meta.threads;
+    let first_pilot = run_plan(&Plan::prepare(pilot_of(&plan.sweep), registry)?, results, threads)?;
+    let mut rows = rows_of(plan, run, &first_pilot, report, registry);
     let first_bed = plan.sweep.testbeds.first().map(|t| t.id.clone()).unwrap_or_default();
     let mut notes = vec![format!("part {first_bed}... ({} reps)", plan.sweep.reps)];
     for (label, sweep) in other_parts(registry, &plan.sweep) {
@@ -141,15 +154,12 @@ pub fn post(
         let (plans, invalid) = prepare_valid(sweep, registry)?;
         rows.extend(invalid);
         for p in plans {
-            let progress = Progress::default();
-            let opts = RunOptions {
-                threads: Some(report.meta.threads),
-                cell_dir: Some(results.join("cells")),
-                observer: &progress,
-            };
-            let r = runner::run(&p, &opts)?;
-            progress.finish();
-            rows.extend(rows_of(&p, &r, report, true, registry)?);
+            let pilot = run_plan(&Plan::prepare(pilot_of(&p.sweep), registry)?, results, threads)?;
+            let r = run_plan(&p, results, threads)?;
+            for (bi, ei, cell) in &r.cells {
+                report.rows.push(p.summary_row(*bi, *ei, cell));
+            }
+            rows.extend(rows_of(&p, &r, &pilot, report, registry));
             report.skipped.extend(p.skipped.iter().cloned());
             for e in &p.estimators {
                 if !report.labels.iter().any(|(n, _)| n == &e.name) {
@@ -159,7 +169,11 @@ pub fn post(
         }
         notes.push(format!("{label} {:.1} s", t0.elapsed().as_secs_f64()));
     }
-    report.meta.notes.push(format!("unbiasedness parts: {}", notes.join(", ")));
+    report.meta.notes.push(format!(
+        "unbiasedness parts (each with a pilot of as many repetitions on seed {}): {}",
+        pilot_seed(plan.sweep.seed),
+        notes.join(", ")
+    ));
     table::write_csv(results, "unbiasedness.csv", &rows)?;
     let md = table::markdown(&rows);
     results.write("unbiasedness.md", md.as_bytes())?;

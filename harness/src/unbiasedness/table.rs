@@ -2,14 +2,13 @@
 //! tests, judged against what the paper claims (registry [`Bias`]); `unbiasedness.csv`, the
 //! per-row `paper` entries and the per-control claims of summary.json.
 
-pub use super::stats::{combined, measured, pooled_over_sequences, reps_for_target, TARGET_REL_BIAS};
-use crate::analysis::{unbiasedness, TestRow, UNBIASEDNESS_ALPHA};
+pub use super::stats::{reps_for_target, TARGET_REL_BIAS};
+use crate::analysis::TestRow;
 use crate::cell::CellResult;
 use crate::error::Result;
 use crate::folder::OutputDir;
 use crate::output::Claim;
 use estimators::estimator::Bias;
-use estimators::testbed::Reference;
 use serde::Serialize;
 
 /// One row of `unbiasedness.csv`.
@@ -23,11 +22,11 @@ pub struct Row {
     pub variant: String,
     /// What the paper claims (registry): `unbiased`, `consistent`, `biased`.
     pub paper_bias: String,
-    /// The deciding test (`holm_t`, `holm_welch`, `pooled_z`), empty when not run.
+    /// The tests that ran (`holm_t` / `holm_welch`, `pooled_t`), empty when none did.
     pub test: String,
     /// Its p-value (Holm-adjusted minimum for the Holm tests); NaN when nothing was tested.
     pub p_value: f64,
-    /// `pass`, `biased`, `untested` or `not-run`.
+    /// `pass`, `inconclusive`, `biased` or `not-run`.
     pub verdict: String,
     /// Relative bias the deciding test detects with 80% power.
     pub detectable_rel_bias: f64,
@@ -44,97 +43,55 @@ pub struct Row {
     pub rel_bias: f64,
     /// Its standard error (channels taken as independent).
     pub rel_bias_se: f64,
-    /// Whether the verdict agrees with what is expected here (empty: consistent, untested, not run).
+    /// Whether the verdict agrees with what is expected here (empty: consistent, inconclusive for
+    /// an unbiased id, not run).
     pub agrees: Option<bool>,
     /// How to read the row.
     pub note: String,
+    /// The relative bias a `pass` must detect.
+    pub tolerance: f64,
+    /// Repetitions that would resolve the tolerance (and the skewness gate) when inconclusive.
+    pub reps_for_tolerance: Option<f64>,
+    /// Where the tests' gate came from (`pilot`, `previous budget`, `none`).
+    pub gate: String,
     /// For a biased control: why it is not required to be flagged here (its registry entry's
     /// exemption), if it is not.
     #[serde(skip)]
     pub exempt: Option<&'static str>,
 }
 
-/// Sets a test row's claim and whether its verdict agrees with it.
-pub fn set_claim(t: &mut TestRow, bias: Bias) {
-    t.claim = bias.name().into();
-    t.agrees = match bias {
-        Bias::Unbiased => t.verdict != "biased",
-        Bias::Biased => t.verdict == "biased",
-        Bias::Consistent => true,
-    };
-}
-
-/// The SPEC §6 tests of one cell: the harness's, plus `pooled_z_seq` where integrals come in
-/// sequences of `sequence > 1` (the independent-integral `pooled_z` stays in summary.json and in
-/// the note but does not decide: [`combined`] prefers the sequence-aware tests).
-pub fn tests_of(cell: &CellResult, reference: &Reference, bias: Bias, sequence: usize) -> Vec<TestRow> {
-    let mut tests = unbiasedness(cell, reference, bias);
-    if sequence > 1 {
-        if let Some(mut t) = pooled_over_sequences(cell, reference, sequence) {
-            set_claim(&mut t, bias);
-            tests.push(t);
-        }
-    }
-    tests
-}
-
-/// The row of one cell: its SPEC §6 tests (also returned, for summary.json) and the judgement.
-pub fn row(
-    cell: &CellResult,
-    reference: &Reference,
-    bias: Bias,
-    sequence: usize,
-    exempt: Option<&'static str>,
-) -> (Row, Vec<TestRow>) {
-    let tests = tests_of(cell, reference, bias, sequence);
-    (row_from_tests(cell, reference, bias, &tests, exempt), tests)
-}
-
-/// The row of one cell from its tests (see [`tests_of`]; more may be added, e.g. `pooled_z_rep`).
-pub fn row_from_tests(
-    cell: &CellResult,
-    reference: &Reference,
-    bias: Bias,
-    tests: &[TestRow],
-    exempt: Option<&'static str>,
-) -> Row {
-    let (rel_bias, rel_bias_se, share) = measured(cell, reference);
+/// The row of one cell from its SPEC §6 tests ([`crate::analysis::unbiasedness`], the
+/// `combined` row decides).
+pub fn row_from_tests(cell: &CellResult, bias: Bias, tests: &[TestRow], exempt: Option<&'static str>) -> Row {
     let k = &cell.key;
-    let (test, p_value, detectable) = combined(tests);
-    let verdict = if p_value.is_nan() {
-        "untested"
-    } else if p_value < UNBIASEDNESS_ALPHA {
-        "biased"
-    } else {
-        "pass"
-    };
+    let decision = tests.iter().find(|t| t.test == "combined");
+    let ran: Vec<&str> =
+        tests.iter().filter(|t| t.test != "combined" && !t.p_value.is_nan()).map(|t| t.test.as_str()).collect();
+    let (p_value, verdict, detectable) = decision
+        .map_or((f64::NAN, "inconclusive", f64::NAN), |d| (d.p_value, d.verdict.as_str(), d.detectable_rel_bias));
     let mut r = Row {
         estimator: k.estimator.clone(),
         testbed: k.testbed.clone(),
         variant: k.variant.clone(),
         paper_bias: bias.name().into(),
-        test,
+        test: ran.join("+"),
         p_value,
         verdict: verdict.into(),
         detectable_rel_bias: detectable,
         reps: k.reps,
         reps_for_target: None,
         budget: k.budget.amount,
-        rel_bias,
-        rel_bias_se,
+        rel_bias: decision.map_or(f64::NAN, |d| d.rel_bias),
+        rel_bias_se: decision.map_or(f64::NAN, |d| d.rel_bias_se),
         agrees: None,
-        note: String::new(),
+        note: decision.map_or(String::new(), |d| d.reason.clone()),
+        tolerance: decision.map_or(f64::NAN, |d| d.tolerance),
+        reps_for_tolerance: decision.and_then(|d| d.reps_needed),
+        gate: decision.map_or("none".into(), |d| d.gate.clone()),
         exempt,
     };
-    r.reps_for_target = reps_for_target(r.detectable_rel_bias, r.reps, share);
+    r.reps_for_target = reps_for_target(r.detectable_rel_bias, r.reps, 1.0);
     judge(&mut r);
-    let shared = r.test.contains("pooled_z_seq") || r.test.contains("pooled_z_rep");
-    if let (true, Some(z)) = (shared, tests.iter().find(|t| t.test == "pooled_z")) {
-        r.note.push_str(&format!(
-            "; pooled z taking integrals as independent (not valid under shared state): p = {:.2e}",
-            z.p_value
-        ));
-    }
     r
 }
 
@@ -142,51 +99,40 @@ fn pct(x: f64) -> String {
     format!("{}%", crate::report::sig(100.0 * x, 2))
 }
 
-/// Fills `agrees` and `note`: unbiased ids must pass, controls must be flagged (except where
-/// the row's exemption says why they are not a control there), consistent ids are reported.
+/// Fills `agrees` and `note`: unbiased ids must `pass` (an inconclusive row neither agrees nor
+/// fails), controls must be flagged (except where the row's exemption says why they are not a
+/// control there; not flagged, whether `pass` or `inconclusive`, is a miss), consistent ids are
+/// reported.
 pub fn judge(r: &mut Row) {
-    let measured = format!("measured relative bias {} ± {}", pct(r.rel_bias), pct(r.rel_bias_se));
+    let measured = if r.rel_bias.is_nan() {
+        String::new()
+    } else {
+        format!("; measured relative bias {} ± {}", pct(r.rel_bias), pct(r.rel_bias_se))
+    };
     let p = if r.p_value.is_nan() { "-".to_string() } else { format!("{:.2e}", r.p_value) };
-    let exempt = r.exempt;
-    let weak = exempt.is_some_and(|w| w.starts_with("a weak control"));
-    // Exempt controls are expected to pass (unbiased by construction there), weak ones either way.
-    let expect = match (r.paper_bias.as_str(), exempt) {
+    let weak = r.exempt.is_some_and(|w| w.starts_with("a weak control"));
+    let expect = match (r.paper_bias.as_str(), r.exempt) {
         ("biased", None) => "biased",
         ("biased", Some(_)) if weak => "either",
         ("biased", Some(_)) => "unbiased",
         (claim, _) => claim,
     };
+    let why = r.note.clone();
     let (agrees, mut note) = match (expect, r.verdict.as_str()) {
-        (_, "not-run") => (None, r.note.clone()),
-        (_, "untested") => {
-            (None, "no valid test: every integral too skewed for a t-test and no pooled test".to_string())
-        }
+        (_, "not-run") => (None, why),
         ("consistent", "biased") => {
-            (None, format!("flagged ({} p = {p}): reported as consistent only (SPEC §6); {measured}", r.test))
+            (None, format!("flagged (p = {p}): reported as consistent only (SPEC §6){measured}"))
         }
-        ("consistent", _) => (None, format!("no bias detected (consistent id); {measured}")),
-        ("either", v) => (None, format!("{v} ({} p = {p}); {measured}", r.test)),
-        ("biased", "biased") => (Some(true), format!("control flagged ({} p = {p}); {measured}", r.test)),
-        ("biased", _) => (
-            Some(false),
-            format!("control NOT flagged ({} p = {p}); {measured}, detectable {}", r.test, pct(r.detectable_rel_bias)),
-        ),
-        (_, "biased") => (Some(false), format!("the claim of unbiasedness FAILS here: {} p = {p}; {measured}", r.test)),
-        _ => (Some(true), format!("no bias detected; {measured}")),
+        ("consistent", v) => (None, format!("{v} (consistent id): {why}{measured}")),
+        ("either", v) => (None, format!("{v} (p = {p}): {why}{measured}")),
+        ("biased", "biased") => (Some(true), format!("control flagged (p = {p}){measured}")),
+        ("biased", v) => (Some(false), format!("control NOT flagged ({v}, p = {p}): {why}{measured}")),
+        (_, "biased") => (Some(false), format!("the claim of unbiasedness FAILS here: p = {p}{measured}")),
+        (_, "pass") => (Some(true), format!("{why}{measured}")),
+        (_, _) => (None, format!("inconclusive: {why}{measured}")),
     };
-    if let Some(why) = exempt {
+    if let Some(why) = r.exempt {
         note = format!("{why}; {note}");
-    }
-    if r.verdict != "not-run" && r.verdict != "untested" {
-        let reach = if r.detectable_rel_bias <= TARGET_REL_BIAS {
-            "0.1% resolved".to_string()
-        } else {
-            match r.reps_for_target {
-                Some(n) => format!("0.1% not resolved: needs about {} reps", crate::report::sig(n, 2)),
-                None => "0.1% not resolvable: the stored reference's own error is larger".to_string(),
-            }
-        };
-        note = format!("{note}; {reach}");
     }
     r.agrees = agrees;
     r.note = note;
@@ -217,6 +163,9 @@ pub fn not_run(
         rel_bias_se: f64::NAN,
         agrees: None,
         note: format!("not run: {reason}"),
+        tolerance: f64::NAN,
+        reps_for_tolerance: None,
+        gate: String::new(),
         exempt,
     };
     judge(&mut r);
@@ -270,7 +219,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
             note: if missed.is_empty() {
                 format!("flagged on all {} test beds (rows with an exemption reason excluded)", mine.len())
             } else {
-                format!("NOT flagged (or untested) on: {}", missed.join(", "))
+                format!("NOT flagged (inconclusive or passing) on: {}", missed.join(", "))
             },
         });
     }
@@ -280,15 +229,23 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
         .filter(|r| r.agrees == Some(false))
         .map(|r| format!("{} on {}/{}", r.estimator, r.testbed, r.variant))
         .collect();
-    let untested = unbiased.iter().filter(|r| r.agrees.is_none()).count();
+    let passed = unbiased.iter().filter(|r| r.verdict == "pass").count();
+    let inconclusive = unbiased.len() - passed - failed.len();
     out.push(Claim {
         testbed: "all".into(),
         claim: "papers: every estimator they call unbiased passes the SPEC §6 test on every test bed".into(),
         paper_value: None,
-        our_value: Some((unbiased.len() - failed.len() - untested) as f64),
-        held: Some(failed.is_empty()),
+        our_value: Some(passed as f64),
+        // Held only when every row passes; a flag fails it; inconclusive rows leave it open.
+        held: if !failed.is_empty() {
+            Some(false)
+        } else if inconclusive == 0 {
+            Some(true)
+        } else {
+            None
+        },
         note: format!(
-            "{} rows, {} flagged{}, {untested} without a valid test",
+            "{} rows: {passed} pass, {} flagged{}, {inconclusive} inconclusive (cannot detect the tolerance yet; see each row)",
             unbiased.len(),
             failed.len(),
             if failed.is_empty() { String::new() } else { format!(" ({})", failed.join("; ")) }
