@@ -231,7 +231,7 @@ pub fn main_with_args(registry: Registry, args: impl IntoIterator<Item = impl In
 fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
     match cli.command {
         None => {
-            let names: Vec<String> = registry.experiments().iter().map(|e| e.name.clone()).collect();
+            let names: Vec<String> = registry.suite().map(|e| e.name.clone()).collect();
             if names.is_empty() {
                 return Err(estimators::error::ConfigError::invalid(
                     "experiment",

@@ -101,6 +101,8 @@ pub struct Registry {
     estimators: Vec<&'static EstimatorEntry>,
     test_beds: Vec<&'static TestBedEntry>,
     experiments: Vec<Experiment>,
+    /// Names of experiments that run only when named (not in the default suite).
+    on_demand: Vec<String>,
     references: Arc<dyn ReferenceSource>,
 }
 
@@ -110,6 +112,7 @@ impl Default for Registry {
             estimators: Vec::new(),
             test_beds: Vec::new(),
             experiments: Vec::new(),
+            on_demand: Vec::new(),
             references: Arc::new(ReferenceDir::new(DEFAULT_REFERENCES)),
         }
     }
@@ -146,11 +149,13 @@ impl Registry {
             ..Registry::default()
         }
         .with_experiment(crate::unbiasedness::experiment())
+        .with_experiment_on_demand(crate::calibration::experiment())
     }
 
     /// The same without any named experiment (to register them in another order).
     pub fn without_experiments(mut self) -> Self {
         self.experiments.clear();
+        self.on_demand.clear();
         self
     }
 
@@ -183,6 +188,14 @@ impl Registry {
         self
     }
 
+    /// Adds a named experiment that runs only when named (`mcbench run NAME`), not in the default
+    /// suite: for long measurements such as `calibration`.
+    pub fn with_experiment_on_demand(mut self, experiment: Experiment) -> Self {
+        self.on_demand.push(experiment.name.clone());
+        self.experiments.push(experiment);
+        self
+    }
+
     /// Checks that no id or name is registered twice (the CLI refuses to start otherwise).
     pub fn check(&self) -> std::result::Result<(), ConfigError> {
         fn dup<'a>(kind: &'static str, names: impl Iterator<Item = &'a str>) -> std::result::Result<(), ConfigError> {
@@ -210,9 +223,15 @@ impl Registry {
         &self.test_beds
     }
 
-    /// Every named experiment, in registration order (the order of the default suite).
+    /// Every named experiment, in registration order.
     pub fn experiments(&self) -> &[Experiment] {
         &self.experiments
+    }
+
+    /// The experiments of the default suite, in its order: every named experiment but those
+    /// registered on demand.
+    pub fn suite(&self) -> impl Iterator<Item = &Experiment> {
+        self.experiments.iter().filter(|e| !self.on_demand.contains(&e.name))
     }
 
     /// An estimator by id; unknown ids list the valid ones.

@@ -158,7 +158,18 @@ pub fn reference(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Referenc
     if let Some(r) = load_stored(bed, refs)? {
         return Ok(r);
     }
-    Ok(compute(bed, &Settings::of(bed.field())))
+    // The nested quadrature takes seconds per bed; a process that builds the same bed again (the
+    // pilot and the main plan of an experiment, a sweep re-planned per estimator) reuses it.
+    static COMPUTED: std::sync::OnceLock<std::sync::Mutex<Vec<(String, Reference)>>> = std::sync::OnceLock::new();
+    let settings = Settings::of(bed.field());
+    let key = format!("{:?}|{}", bed.reference_key(), settings.method());
+    let cache = COMPUTED.get_or_init(Default::default);
+    if let Some((_, r)) = cache.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(k, _)| *k == key) {
+        return Ok(r.clone());
+    }
+    let r = compute(bed, &settings);
+    cache.lock().unwrap_or_else(|e| e.into_inner()).push((key, r.clone()));
+    Ok(r)
 }
 
 /// Computes the reference of every pixel with `s` (threads over pixels).

@@ -1,11 +1,11 @@
 //! The `unbiasedness` experiment (SPEC §6): every registered estimator on every test-bed case it
-//! runs on, with the SPEC §6 test matched to the reference kind (exact: per-integral t-tests with
-//! Holm-Bonferroni; stored: Welch against the stored run; both combined by Bonferroni with the
-//! pooled z-test, see [`table::combined`]), the biased controls in the same run and required to be
-//! flagged (except where their registry entry exempts a test bed, [`estimators::registry::Checks`]).
-//! One table, `unbiasedness.csv`: estimator x test bed -> p-value, verdict, the relative bias the
-//! run could detect with 80% power, the repetitions that would resolve a 0.1% relative bias, and
-//! whether the registry calls the estimator unbiased.
+//! runs on, each cell tested by [`crate::analysis::unbiasedness`] (per-integral Holm t / Welch and
+//! the pooled per-repetition t-test, combined by Bonferroni) behind the gate of a pilot on its own
+//! seed, with the biased controls in the same run and required to be flagged (except where their
+//! registry entry exempts a test bed, [`estimators::registry::Checks`]). One table,
+//! `unbiasedness.csv`: estimator x test bed -> p-value, verdict (`pass`, `inconclusive`,
+//! `biased`), the relative bias the row could detect with 80% power, the repetitions that would
+//! resolve the tolerance, and whether the registry calls the estimator unbiased.
 //!
 //! Nothing here names an estimator or a test bed: the experiment is derived from the registry it
 //! runs over ([`parts`]), so a plug-in registered from any crate is in it. Each test bed declares

@@ -65,7 +65,7 @@ pub fn exemption(registry: &Registry, id: &str, testbed: &str, variant: &str) ->
 /// the whole sweep bad input; here it becomes a `not-run` row with the reason, and the rest runs:
 /// the sweep is split per test bed, and a failing test bed per estimator (streams do not depend on
 /// how a sweep is split, so the cells are the same).
-fn prepare_valid(sweep: Sweep, registry: &Registry) -> Result<(Vec<Plan>, Vec<Row>)> {
+pub(crate) fn prepare_valid(sweep: Sweep, registry: &Registry) -> Result<(Vec<Plan>, Vec<Row>)> {
     if let Ok(p) = Plan::prepare(sweep.clone(), registry) {
         return Ok((vec![p], Vec::new()));
     }

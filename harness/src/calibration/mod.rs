@@ -1,0 +1,215 @@
+//! The `calibration` experiment: the unbiasedness tests' own operating characteristics, measured.
+//!
+//! For each row family (an estimator on a test-bed case at the samples and repetitions of its
+//! `unbiasedness` row) it runs the harness's test, gated by a pilot exactly as that experiment
+//! does, on many independent seeds ([`measure`]), with no bias, with injected relative biases
+//! ([`Scaled`]) and with a firefly rejection ([`FireflyRejection`]), and reports
+//! ([`table`]): the false-flag rate at a nominal 5% with its interval, the power at 1% and 3%, the
+//! detectable bias the rows report beside the bias measured to be flagged in 80% of seeds, and how
+//! often each control is flagged.
+//!
+//! Families are derived from the registry like the `unbiasedness` parts: for every test-bed case,
+//! the first unbiased estimators that run on it (registry order; one in quick mode, two in full,
+//! [`unbiased_per_case`]) and every
+//! biased control not exempted there. The experiment's own sweep is the first `unbiasedness` part's
+//! first case at one seed; the analysis ([`post`]) measures every family.
+
+pub mod measure;
+pub mod table;
+pub mod wrap;
+
+pub use wrap::{FireflyRejection, Scaled};
+
+use crate::config::{Mode, Sweep};
+use crate::error::Result;
+use crate::folder::OutputDir;
+use crate::output::RunReport;
+use crate::plan::Plan;
+use crate::registry::{Experiment, Registry, Sweeps};
+use estimators::estimator::Bias;
+use measure::Family;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The experiment's name.
+pub const NAME: &str = "calibration";
+/// Unbiased estimators per test-bed case in a mode.
+pub fn unbiased_per_case(mode: Mode) -> usize {
+    match mode {
+        Mode::Quick => 1,
+        Mode::Full => 2,
+    }
+}
+
+/// Seeds per family in a mode.
+pub fn seeds(mode: Mode) -> usize {
+    match mode {
+        Mode::Quick => 100,
+        Mode::Full => 400,
+    }
+}
+
+/// The `calibration` experiment over whatever registry it runs in.
+pub fn experiment() -> Experiment {
+    Experiment {
+        name: NAME.into(),
+        reproduces: "SPEC §6: size, power and detectable bias of the unbiasedness tests, measured".into(),
+        summary: "the unbiasedness tests over many seeds with injected biases: false-flag rate, power, detectable bias, controls".into(),
+        sweeps: Sweeps::Derived(first_sweep),
+        claims: None,
+        post: Some(post),
+        preflight: None,
+    }
+}
+
+/// The row families of a registry in a mode (see the module docs).
+pub fn families(registry: &Registry, mode: Mode) -> Vec<Family> {
+    let mut out = Vec::new();
+    for part in crate::unbiasedness::parts(registry, mode) {
+        for bed in &part.sweep.testbeds {
+            let one = Sweep { testbeds: vec![bed.clone()], ..part.sweep.clone() };
+            let Ok((plans, _)) = crate::unbiasedness::run::prepare_valid(one, registry) else { continue };
+            let mut unbiased = 0;
+            for plan in &plans {
+                for &(_, ei) in &plan.pairs {
+                    let e = &plan.estimators[ei];
+                    let variant = bed.variant.clone().unwrap_or_default();
+                    let take = match e.entry.bias {
+                        Bias::Unbiased if unbiased < unbiased_per_case(mode) => {
+                            unbiased += 1;
+                            true
+                        }
+                        Bias::Biased => {
+                            crate::unbiasedness::run::exemption(registry, &e.spec.id, &bed.id, &variant).is_none()
+                        }
+                        _ => false,
+                    };
+                    if take {
+                        out.push(Family {
+                            bed: bed.clone(),
+                            estimator: e.spec.clone(),
+                            samples: part.samples,
+                            reps: part.sweep.reps,
+                            bias: e.entry.bias,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The families a run measures: every derived family when the run's sweep is the experiment's own,
+/// otherwise the pairs of the sweep given (`--config`) at each of its sample budgets and its
+/// repetitions: a researcher calibrates the rows of their own sweep.
+pub fn families_of_run(plan: &Plan, registry: &Registry) -> Vec<Family> {
+    let own = first_sweep(registry, plan.sweep.mode);
+    let s = &plan.sweep;
+    if s.testbeds == own.testbeds && s.estimators == own.estimators && s.budgets == own.budgets && s.reps == own.reps {
+        return families(registry, plan.sweep.mode);
+    }
+    let mut out = Vec::new();
+    for budget in s.budgets.iter().filter(|b| b.kind == estimators::budget::BudgetKind::Samples) {
+        for &(bi, ei) in &plan.pairs {
+            out.push(Family {
+                bed: s.testbeds[bi].clone(),
+                estimator: plan.estimators[ei].spec.clone(),
+                samples: budget.amount,
+                reps: s.reps,
+                bias: plan.estimators[ei].entry.bias,
+            });
+        }
+    }
+    out
+}
+
+/// The experiment's own sweep: the first `unbiasedness` part on its first test-bed case (cheap to
+/// derive: no test bed is built).
+fn first_sweep(registry: &Registry, mode: Mode) -> Sweep {
+    let mut s = crate::unbiasedness::parts(registry, mode).into_iter().next().map(|p| p.sweep).unwrap_or(Sweep {
+        experiment: NAME.into(),
+        testbeds: Vec::new(),
+        estimators: Vec::new(),
+        budgets: Vec::new(),
+        reps: 2,
+        seed: 1,
+        mode,
+        baseline: None,
+        claims: Vec::new(),
+        bias_tolerance: None,
+    });
+    s.experiment = NAME.into();
+    s.testbeds.truncate(1);
+    s
+}
+
+/// Measures every family and writes `calibration.csv` and `calibration.md`, and the claims.
+pub fn post(
+    plan: &Plan,
+    _run: &crate::runner::RunResults,
+    report: &mut RunReport,
+    results: &OutputDir,
+    _plots: Option<&Path>,
+    registry: &Registry,
+) -> Result<Vec<PathBuf>> {
+    let t0 = Instant::now();
+    let mode = plan.sweep.mode;
+    let n = seeds(mode);
+    let tolerance = plan.sweep.tolerance();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(report.meta.threads.max(1)).build();
+    let mut rows = Vec::new();
+    let mut timing = Vec::new();
+    for family in families_of_run(plan, registry) {
+        let t = Instant::now();
+        let m = match &pool {
+            Ok(p) => p.install(|| measure::measure(&family, n, plan.sweep.seed, tolerance, mode, registry)),
+            Err(_) => measure::measure(&family, n, plan.sweep.seed, tolerance, mode, registry),
+        }?;
+        rows.push(table::row(&family, &m, &family.estimator.name()));
+        timing.push(format!("{}/{} {:.1} s", family.bed.id, family.estimator.name(), t.elapsed().as_secs_f64()));
+    }
+    let header = format!(
+        "{n} seeds per family (cell and pilot of the family's repetitions each, seed {}), tolerance {:.2}%, \
+         alpha {} for verdicts, 5% for the false-flag rate; {:.0} s",
+        plan.sweep.seed,
+        100.0 * tolerance,
+        crate::analysis::UNBIASEDNESS_ALPHA,
+        t0.elapsed().as_secs_f64()
+    );
+    results.write_csv("calibration.csv", &rows)?;
+    results.write("calibration.md", table::markdown(&rows, &header).as_bytes())?;
+    report.meta.notes.push(format!("calibration: {header}; per family: {}", timing.join(", ")));
+    report.paper.extend(table::claims(&rows));
+    Ok(Vec::new())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every case gets at most one unbiased family in quick mode, every control that is not exempted is a
+    /// family somewhere, and each family carries its row's samples and repetitions.
+    #[test]
+    fn families_cover_the_controls_and_few_unbiased_estimators_per_case() {
+        let registry = Registry::builtin().with_references(crate::references::ReferenceDir::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../results/references"
+        )));
+        let all = families(&registry, Mode::Quick);
+        let mut per_case = std::collections::HashMap::new();
+        for f in all.iter().filter(|f| f.bias == Bias::Unbiased) {
+            *per_case.entry((f.bed.id.clone(), f.bed.variant.clone())).or_insert(0) += 1;
+        }
+        assert!(per_case.values().all(|&n| n <= unbiased_per_case(Mode::Quick)), "{per_case:?}");
+        for e in registry.estimators().iter().filter(|e| e.bias == Bias::Biased) {
+            assert!(all.iter().any(|f| f.estimator.id == e.id), "control {} is in no family", e.id);
+        }
+        let parts = crate::unbiasedness::parts(&registry, Mode::Quick);
+        for f in &all {
+            assert!(parts
+                .iter()
+                .any(|p| p.samples == f.samples && p.sweep.reps == f.reps && p.sweep.testbeds.contains(&f.bed)));
+        }
+    }
+}

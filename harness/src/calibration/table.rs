@@ -1,0 +1,302 @@
+//! The calibration table: per row family, the measured false-flag rate, power and 80% point beside
+//! what the unbiasedness rows report, and the checks they are held to.
+
+use super::measure::{bias_grid, Family, Measured, NOMINAL};
+use crate::output::Claim;
+use estimators::estimator::Bias;
+use serde::{Deserialize, Serialize};
+
+/// One family's row of `calibration.csv`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// What the registry claims (`unbiased`, `biased`).
+    pub claim: String,
+    /// Samples per estimate.
+    pub samples: u64,
+    /// Repetitions per cell (and per pilot).
+    pub reps: usize,
+    /// Independent seeds (cell and pilot pairs).
+    pub seeds: usize,
+    /// Seeds in which the pooled test ran (its skewness gate let it).
+    pub tested_fraction: f64,
+    /// Unbiased families, no injected bias, seeds whose pooled test ran: the fraction with the
+    /// combined p-value below the nominal level (5%).
+    pub false_flag_rate: f64,
+    /// Its 95% Wilson interval.
+    pub false_flag_lo: f64,
+    /// Its 95% Wilson interval.
+    pub false_flag_hi: f64,
+    /// No injected bias: the fraction of seeds flagged `biased` at the harness's alpha (for a
+    /// control: its detection rate).
+    pub flag_rate: f64,
+    /// No injected bias: the fraction of seeds whose verdict is `pass`.
+    pub pass_rate: f64,
+    /// The fraction of seeds in which a +1% bias is flagged.
+    pub power_1pct: f64,
+    /// The same among the seeds that pass without it (what a `pass` promises).
+    pub power_1pct_on_pass: f64,
+    /// The fraction of seeds in which a +3% bias is flagged.
+    pub power_3pct: f64,
+    /// The median over seeds of the relative bias the row reports it detects with 80% power.
+    pub detectable: f64,
+    /// The injected relative bias flagged in 80% of seeds (interpolated; NaN when even 100% is not).
+    pub measured_80: f64,
+    /// `detectable / measured_80`.
+    pub detectable_ratio: f64,
+    /// The firefly rejection's threshold (the pilot's 99% quantile of values).
+    pub firefly_threshold: f64,
+    /// Its mean relative bias over seeds.
+    pub firefly_rel_bias: f64,
+    /// The fraction of seeds in which it is flagged.
+    pub firefly_flag_rate: f64,
+    /// False-flag rate within 1.5x of nominal (None: fewer than 50 tested seeds, or a control).
+    pub ok_false_flag: Option<bool>,
+    /// Reported detectable within 25% of the measured 80% point (None: the pooled test ran in
+    /// fewer than 80% of seeds, so the rows are inconclusive and the detectable bias decides no pass).
+    pub ok_detectable: Option<bool>,
+    /// A +1% bias flagged in at least 80% of the seeds that pass at 1% (None: no seed passes).
+    pub ok_power: Option<bool>,
+    /// A control flagged in at least 99% of seeds (None: not a control).
+    pub ok_control: Option<bool>,
+    /// What the checks found.
+    pub note: String,
+}
+
+/// The 95% Wilson score interval of `k` successes in `n` trials.
+pub fn wilson(k: usize, n: usize) -> (f64, f64) {
+    if n == 0 {
+        return (0.0, 1.0);
+    }
+    let (z, n, p) = (1.959_963_984_540_054, n as f64, k as f64 / n as f64);
+    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
+    let half = z / (1.0 + z * z / n) * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
+    ((centre - half).max(0.0), (centre + half).min(1.0))
+}
+
+/// The bias flagged in `target` of the seeds, interpolated in log bias between grid points.
+fn point_of(grid: &[f64], rate: &[f64], target: f64) -> f64 {
+    for k in 0..grid.len() {
+        if rate[k] >= target {
+            if k == 0 {
+                return grid[0];
+            }
+            let t = (target - rate[k - 1]) / (rate[k] - rate[k - 1]);
+            return (grid[k - 1].ln() + t * (grid[k].ln() - grid[k - 1].ln())).exp();
+        }
+    }
+    f64::NAN
+}
+
+fn frac(k: usize, n: usize) -> f64 {
+    if n == 0 {
+        f64::NAN
+    } else {
+        k as f64 / n as f64
+    }
+}
+
+/// The row of a measured family.
+pub fn row(family: &Family, m: &Measured, name: &str) -> Row {
+    let s = &m.seeds;
+    let n = s.len();
+    let grid = bias_grid();
+    let at = |b: f64| grid.iter().position(|g| (g / b - 1.0).abs() < 1e-9).expect("1% and 3% are on the grid");
+    let (i1, i3) = (at(0.01), at(0.03));
+    let tested: Vec<_> = s.iter().filter(|o| o.pooled_ran && !o.null.p_value.is_nan()).collect();
+    let ff = tested.iter().filter(|o| o.null.p_value < NOMINAL).count();
+    let (lo, hi) = wilson(ff, tested.len());
+    let passing: Vec<_> = s.iter().filter(|o| o.null.verdict == "pass").collect();
+    let rate: Vec<f64> = (0..grid.len()).map(|g| frac(s.iter().filter(|o| o.flagged[g]).count(), n)).collect();
+    let mut detect: Vec<f64> = s.iter().map(|o| o.null.detectable_rel_bias).filter(|d| d.is_finite()).collect();
+    detect.sort_by(f64::total_cmp);
+    let detectable = detect.get(detect.len() / 2).copied().unwrap_or(f64::NAN);
+    let measured_80 = point_of(&grid, &rate, 0.8);
+    let tested_fraction = frac(tested.len(), n);
+    let flag_rate = frac(s.iter().filter(|o| o.null.verdict == "biased").count(), n);
+    let unbiased = family.bias == Bias::Unbiased;
+    let ok_false_flag = (unbiased && tested.len() >= 50).then(|| {
+        let r = frac(ff, tested.len());
+        (NOMINAL / 1.5..=NOMINAL * 1.5).contains(&r)
+    });
+    let ok_detectable = (unbiased && tested_fraction >= 0.8)
+        .then(|| measured_80.is_finite() && (detectable / measured_80 - 1.0).abs() <= 0.25);
+    let power_1pct_on_pass = frac(passing.iter().filter(|o| o.flagged[i1]).count(), passing.len());
+    let ok_power = (unbiased && !passing.is_empty()).then_some(power_1pct_on_pass >= 0.8);
+    let ok_control = (family.bias == Bias::Biased).then_some(flag_rate >= 0.99);
+    let mut note = Vec::new();
+    if unbiased && tested_fraction < 0.8 {
+        note.push(format!(
+            "pooled test gated out in {:.0}% of seeds (too skewed at {} repetitions)",
+            100.0 * (1.0 - tested_fraction),
+            family.reps
+        ));
+    }
+    if ok_false_flag == Some(false) {
+        note.push(format!(
+            "false-flag rate {:.1}% [{:.1}, {:.1}] at nominal {:.0}%",
+            100.0 * frac(ff, tested.len()),
+            100.0 * lo,
+            100.0 * hi,
+            100.0 * NOMINAL
+        ));
+    }
+    if ok_detectable == Some(false) {
+        note.push(format!(
+            "reports {:.3}% detectable, measured 80% point {:.3}%",
+            100.0 * detectable,
+            100.0 * measured_80
+        ));
+    }
+    if ok_control == Some(false) {
+        note.push(format!("control flagged in {:.1}% of seeds", 100.0 * flag_rate));
+    }
+    Row {
+        testbed: family.bed.id.clone(),
+        variant: family.bed.variant.clone().unwrap_or_default(),
+        estimator: name.into(),
+        claim: family.bias.name().into(),
+        samples: family.samples,
+        reps: family.reps,
+        seeds: n,
+        tested_fraction,
+        false_flag_rate: frac(ff, tested.len()),
+        false_flag_lo: lo,
+        false_flag_hi: hi,
+        flag_rate,
+        pass_rate: frac(passing.len(), n),
+        power_1pct: rate[i1],
+        power_1pct_on_pass,
+        power_3pct: rate[i3],
+        detectable,
+        measured_80,
+        detectable_ratio: detectable / measured_80,
+        firefly_threshold: m.threshold,
+        firefly_rel_bias: s.iter().map(|o| o.firefly_rel).sum::<f64>() / n.max(1) as f64,
+        firefly_flag_rate: frac(s.iter().filter(|o| o.firefly_flagged).count(), n),
+        ok_false_flag,
+        ok_detectable,
+        ok_power,
+        ok_control,
+        note: if note.is_empty() { "ok".into() } else { note.join("; ") },
+    }
+}
+
+fn pct(x: f64) -> String {
+    if x.is_nan() {
+        "-".into()
+    } else {
+        format!("{:.1}", 100.0 * x)
+    }
+}
+
+fn mark(x: Option<bool>) -> &'static str {
+    match x {
+        Some(true) => "yes",
+        Some(false) => "NO",
+        None => "-",
+    }
+}
+
+/// `calibration.md`: the table with the checks.
+pub fn markdown(rows: &[Row], header: &str) -> String {
+    let mut s = format!("# calibration\n\n{header}\n\n");
+    s.push_str("| test bed | estimator | claim | reps | seeds | tested % | false flags % at 5% [95% CI] | flagged % | pass % | power 1% | power 1% on pass | power 3% | detectable % | measured 80% point % | firefly bias % / flagged % | checks |\n");
+    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for r in rows {
+        let checks = format!(
+            "size {} / detectable {} / power {} / control {}",
+            mark(r.ok_false_flag),
+            mark(r.ok_detectable),
+            mark(r.ok_power),
+            mark(r.ok_control)
+        );
+        s.push_str(&format!(
+            "| {}/{} | {} | {} | {} | {} | {} | {} [{}, {}] | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} |\n",
+            r.testbed,
+            r.variant,
+            r.estimator,
+            r.claim,
+            r.reps,
+            r.seeds,
+            pct(r.tested_fraction),
+            pct(r.false_flag_rate),
+            pct(r.false_flag_lo),
+            pct(r.false_flag_hi),
+            pct(r.flag_rate),
+            pct(r.pass_rate),
+            pct(r.power_1pct),
+            pct(r.power_1pct_on_pass),
+            pct(r.power_3pct),
+            pct(r.detectable),
+            pct(r.measured_80),
+            pct(r.firefly_rel_bias),
+            pct(r.firefly_flag_rate),
+            checks
+        ));
+    }
+    s
+}
+
+/// The claims: one per check over every family it applies to.
+pub fn claims(rows: &[Row]) -> Vec<Claim> {
+    type Check = fn(&Row) -> Option<bool>;
+    let checks: [(&str, Check); 4] = [
+        ("false-flag rate within 1.5x of the nominal 5% on every unbiased family whose pooled test runs", |r| {
+            r.ok_false_flag
+        }),
+        ("reported detectable bias within 25% of the measured 80% point on every resolved family", |r| r.ok_detectable),
+        ("a 1% bias flagged in at least 80% of the seeds of every row that passes at 1%", |r| r.ok_power),
+        ("every control flagged in at least 99% of seeds", |r| r.ok_control),
+    ];
+    checks
+        .iter()
+        .map(|(text, check)| {
+            let judged: Vec<&Row> = rows.iter().filter(|r| check(r).is_some()).collect();
+            let failed: Vec<String> = judged
+                .iter()
+                .filter(|r| check(r) == Some(false))
+                .map(|r| format!("{} on {}/{}", r.estimator, r.testbed, r.variant))
+                .collect();
+            Claim {
+                testbed: "all".into(),
+                claim: format!("harness: {text}"),
+                paper_value: None,
+                our_value: Some((judged.len() - failed.len()) as f64),
+                held: (!judged.is_empty()).then_some(failed.is_empty()),
+                note: if judged.is_empty() {
+                    "no family this check applies to".into()
+                } else if failed.is_empty() {
+                    format!("holds on all {} families it applies to", judged.len())
+                } else {
+                    format!("fails on {} of {}: {}", failed.len(), judged.len(), failed.join(", "))
+                },
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wilson_interval_matches_known_values() {
+        let (lo, hi) = wilson(10, 200);
+        assert!((lo - 0.0274).abs() < 5e-4 && (hi - 0.0898).abs() < 5e-4, "{lo} {hi}");
+        assert_eq!(wilson(0, 0), (0.0, 1.0));
+    }
+
+    #[test]
+    fn the_80_point_is_interpolated_in_log_bias() {
+        let grid = [0.01, 0.1, 1.0];
+        assert!((point_of(&grid, &[0.0, 0.6, 1.0], 0.8) - 10f64.powf(-0.5)).abs() < 1e-12);
+        assert_eq!(point_of(&grid, &[0.9, 1.0, 1.0], 0.8), 0.01);
+        assert!(point_of(&grid, &[0.0, 0.1, 0.2], 0.8).is_nan());
+    }
+}
