@@ -3,7 +3,7 @@ use crate::analysis::{fits, SpeedUp, TestRow};
 use crate::output::{Claim, Diagnostic, Meta};
 use crate::plan::Skipped;
 
-fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
+pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
     let variance = rmse * rmse * 0.9;
     SummaryRow {
         testbed: "gradient-plane".into(),
@@ -34,6 +34,7 @@ fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
         estimator_id: String::new(),
         params: String::new(),
         testbed_params: String::new(),
+        mse_se: rmse * rmse * 0.3,
     }
 }
 
