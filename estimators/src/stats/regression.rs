@@ -288,7 +288,8 @@ mod tests {
         assert!((f.slope - 2.0).abs() < 1e-12 && (f.intercept - 1.0).abs() < 1e-12, "{f:?}");
         assert!(f.slope_se > 0.0 && f.r2 == 1.0);
         // Scatter far beyond the variances: the interval grows by sqrt(chi2 / dof) and t(n - 2).
-        let bent: Vec<f64> = x.iter().map(|&v| 1.0 + 2.0 * v + if v as u32 % 2 == 0 { 1.0 } else { -1.0 }).collect();
+        let bent: Vec<f64> =
+            x.iter().map(|&v| 1.0 + 2.0 * v + if (v as u32).is_multiple_of(2) { 1.0 } else { -1.0 }).collect();
         let g = weighted_linear_fit(&x, &bent, &var, f64::INFINITY).unwrap();
         assert!(g.slope_se > 10.0 * f.slope_se, "{g:?} vs {f:?}");
         assert!(matches!(
