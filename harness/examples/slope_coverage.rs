@@ -1,15 +1,16 @@
 //! Coverage of the convergence-slope intervals (SPEC §5): how often the 95% interval of independent
 //! MC's slope holds the true -1/2, over many seeds, for the whole-range and the right-end fit, by
-//! ordinary least squares of log RMSE (the fit before result format 0.4.1) and by the weighted fit
+//! ordinary least squares of log RMSE (the fit before `summary.csv` had `mse_se`) and by the weighted fit
 //! with delta-method variances that `mcbench::analysis::fits` makes now.
 //!
 //! ```text
-//! cargo run --release -p mcbench --example slope_coverage -- [seeds] [threads]
+//! cargo run --release -p mcbench --example slope_coverage -- [seeds] [threads] [resolution] [case] [first seed]
 //! ```
 //!
 //! Cases: `gradient-plane/default` with 16 repetitions (light tails) and `gradient-plane/stiff` with
-//! 8 repetitions (heavy tails), estimator `is0_cv0`, resolution 8, spp 4, 16, ..., 4096. Seeds are
-//! 1..=seeds (default 200); everything is deterministic.
+//! 8 repetitions (heavy tails), estimator `is0_cv0`, spp 4, 16, ..., 4096, at `resolution` x
+//! `resolution` pixels (default 8); `case` is `default`, `stiff` or `all` (default). Seeds are
+//! `first seed` (default 1) and the `seeds - 1` (default 199) after it; everything is deterministic.
 
 use estimators::params::Params;
 use estimators::stats::log_log_fit;
@@ -91,7 +92,8 @@ fn main() {
     let seeds: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(200);
     let threads: usize = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
     let resolution: f64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(8.0);
-    let only: Option<String> = args.next();
+    let only: Option<String> = args.next().filter(|o| o != "all");
+    let first: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
     let registry = Registry::builtin();
     println!("| case | fit | method | seeds | covers -0.5 | mean slope | mean width |");
     println!("|---|---|---|---|---|---|---|");
@@ -101,7 +103,7 @@ fn main() {
         }
         let case = format!("gradient-plane/{variant}, {reps} reps, {resolution}x{resolution}");
         let mut t: [Tally; 4] = Default::default();
-        for seed in 1..=seeds {
+        for seed in first..first + seeds {
             let r = rows(&registry, variant, reps, seed, threads, resolution);
             let f = &fits(&r)[0];
             assert_eq!(f.method, "wls", "seed {seed}: rows without mse_se");

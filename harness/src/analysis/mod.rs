@@ -24,10 +24,10 @@ pub const RIGHT_END_BUDGETS: usize = 3;
 /// log RMSE carries its own variance, known from the spread of the per-repetition squared errors,
 /// and is corrected for the bias of a logarithm of a noisy mean. `slope`, `slope_ci_low` and
 /// `slope_ci_high` keep their meaning (the whole-range slope and its 95% interval) but come from this
-/// fit since result format 0.4.1; before, they were ordinary least squares, whose interval ignored the
-/// points' unequal noise and undercovered under heavy tails. Rows without `mse_se` (files written
-/// before it, one repetition, or an error with no spread) are fitted by ordinary least squares, and
-/// `method` says which.
+/// fit since `summary.csv` has `mse_se`; before, they were ordinary least squares, whose interval
+/// ignored the points' unequal noise and undercovered under heavy tails. Rows without `mse_se`
+/// (files written before it, one repetition, or an error with no spread) are fitted by ordinary
+/// least squares, and `method` says which. Formulas and measured coverage: `docs/slope-fits.md`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Fit {
     /// Test bed id.
