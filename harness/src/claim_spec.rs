@@ -17,6 +17,14 @@
 //! text = "my estimator converges faster than independent MC"
 //!
 //! [[claims]]
+//! kind = "slope"
+//! range = "right"                      # judged on the last three budgets (default "whole")
+//! testbed = "gradient-plane/diffuse"
+//! estimator = "my_estimator"
+//! value = -0.94
+//! text = "my estimator reaches slope -0.94"
+//!
+//! [[claims]]
 //! kind = "speedup"                     # against the sweep's baseline at the largest budget
 //! testbed = "gradient-plane/diffuse"
 //! estimator = "my_estimator"
@@ -28,6 +36,7 @@
 //! estimator = "clamped_is0_cv0"
 //! ```
 
+use crate::analysis::SlopeRange;
 use crate::claims;
 use crate::output::{Claim, RunReport};
 use serde::{Deserialize, Serialize};
@@ -47,6 +56,10 @@ pub enum ClaimSpec {
         value: f64,
         /// The claim in words.
         text: String,
+        /// `whole` (default: every budget) or `right` (the last three budgets: a slope a method
+        /// "reaches").
+        #[serde(default)]
+        range: SlopeRange,
     },
     /// `estimator` converges faster than slope `value`: held when its interval lies below.
     SlopeBelow {
@@ -58,6 +71,9 @@ pub enum ClaimSpec {
         value: f64,
         /// The claim in words.
         text: String,
+        /// `whole` (default) or `right`, as for `slope`.
+        #[serde(default)]
+        range: SlopeRange,
     },
     /// `estimator` is `value` times as efficient as the sweep's baseline at the largest budget
     /// (the papers' speed-up).
@@ -86,16 +102,53 @@ impl ClaimSpec {
     /// Judges the claim on a finished run.
     pub fn judge(&self, report: &RunReport) -> Claim {
         match self {
-            ClaimSpec::Slope { testbed, estimator, value, text } => {
-                claims::slope_matches(report, split(testbed), estimator, *value, text)
+            ClaimSpec::Slope { testbed, estimator, value, text, range } => {
+                claims::slope_matches_over(report, split(testbed), (estimator, *range), *value, text)
             }
-            ClaimSpec::SlopeBelow { testbed, estimator, value, text } => {
-                claims::slope_steeper_than(report, split(testbed), estimator, *value, text)
+            ClaimSpec::SlopeBelow { testbed, estimator, value, text, range } => {
+                claims::slope_steeper_than(report, split(testbed), (estimator, *range), *value, text)
             }
             ClaimSpec::Speedup { testbed, estimator, value, text } => {
                 claims::speedup_claim(report, split(testbed), estimator, *value, text)
             }
             ClaimSpec::ControlFlagged { estimator } => claims::control_flagged(report, estimator),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec(extra: &str, kind: &str) -> ClaimSpec {
+        let text = format!(
+            "kind = '{kind}'\n{extra}testbed = 'gradient-plane/default'\nestimator = 'is1_cv2'\nvalue = -0.94\ntext = 't'"
+        );
+        toml::from_str(&text).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn slope_claims_are_judged_on_the_range_they_name() {
+        let mut report = crate::plot::tests::synthetic_report();
+        let f = report.fits.iter_mut().find(|f| f.estimator == "is1_cv2").expect("fit");
+        (f.slope, f.slope_ci_low, f.slope_ci_high) = (-0.8, -0.85, -0.75);
+        (f.slope_right, f.slope_right_ci_low, f.slope_right_ci_high) = (-0.93, -0.97, -0.89);
+        let whole = spec("", "slope").judge(&report);
+        assert_eq!((whole.held, whole.our_value), (Some(false), Some(-0.8)), "{whole:?}");
+        assert!(whole.note.contains("whole-range fit") && whole.note.contains("right-end slope -0.930"), "{whole:?}");
+        let right = spec("range = 'right'\n", "slope").judge(&report);
+        assert_eq!((right.held, right.our_value), (Some(true), Some(-0.93)), "{right:?}");
+        assert!(right.note.contains("right-end fit"), "{right:?}");
+        // slope_below -0.94: the right end's interval reaches above it, the whole range's is far above.
+        assert_eq!(spec("range = 'right'\n", "slope_below").judge(&report).held, Some(false));
+        assert_eq!(spec("range = \"whole\"\n", "slope_below").judge(&report).held, Some(false));
+        // No right-end slope (too few budgets): not measured, not failed.
+        let f = report.fits.iter_mut().find(|f| f.estimator == "is1_cv2").expect("fit");
+        f.slope_right = f64::NAN;
+        let none = spec("range = 'right'\n", "slope").judge(&report);
+        assert_eq!(none.held, None, "{none:?}");
+        // Unknown ranges are refused.
+        let bad = "kind = 'slope'\nrange = 'left'\ntestbed = 'a/b'\nestimator = 'e'\nvalue = -0.5\ntext = 't'";
+        assert!(toml::from_str::<ClaimSpec>(bad).is_err());
     }
 }

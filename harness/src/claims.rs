@@ -1,6 +1,6 @@
 //! Judging paper claims against a run: slope claims and speed-up claims.
 
-use crate::analysis::{Fit, TestRow};
+use crate::analysis::{Fit, SlopeRange, TestRow};
 use crate::output::{Claim, RunReport};
 
 /// The fit of an estimator on a test bed, if the run has one.
@@ -36,72 +36,117 @@ pub fn last_segment_slope(report: &RunReport, testbed: &str, variant: &str, esti
     Some((b.rmse / a.rmse).ln() / (b.budget as f64 / a.budget as f64).ln())
 }
 
-/// A claim judged on an estimator's fit: `judge` gives (held, note); not measured without a fit.
+/// A claim judged on an estimator's slope over `range`: `judge` gets (slope, CI low, CI high) and
+/// gives (held, note); not measured without a fit or without a slope over that range (a right-end
+/// slope needs 3 budgets).
 fn slope_claim(
     report: &RunReport,
     tb: (&str, &str),
-    estimator: &str,
+    (estimator, range): (&str, SlopeRange),
     paper: f64,
     claim: &str,
-    judge: impl Fn(&Fit) -> (bool, String),
+    judge: impl Fn(f64, f64, f64) -> (bool, String),
 ) -> Claim {
     match fit(report, tb.0, tb.1, estimator) {
         None => not_measured(tb.0, claim, paper, format!("{estimator} did not run (not available or skipped)")),
         Some(f) => {
-            let (held, note) = judge(f);
+            let (slope, lo, hi) = f.range(range);
+            if !(slope.is_finite() && lo.is_finite() && hi.is_finite()) {
+                return not_measured(
+                    tb.0,
+                    claim,
+                    paper,
+                    format!("no {} slope of {estimator} (too few budgets)", range.describe()),
+                );
+            }
+            let (held, note) = judge(lo, hi, slope);
+            let budgets = f.budgets_of(range);
+            let over = format!(
+                "{} fit over budgets {}..{} ({})",
+                range.describe(),
+                budgets.first().copied().unwrap_or(0),
+                budgets.last().copied().unwrap_or(0),
+                if f.method.is_empty() { "ols" } else { &f.method }
+            );
+            let beside = match range {
+                SlopeRange::Whole if f.slope_right.is_finite() => format!(
+                    "; right-end slope {:.3} [{:.3}, {:.3}]",
+                    f.slope_right, f.slope_right_ci_low, f.slope_right_ci_high
+                ),
+                SlopeRange::Right => {
+                    format!("; whole-range slope {:.3} [{:.3}, {:.3}]", f.slope, f.slope_ci_low, f.slope_ci_high)
+                }
+                _ => String::new(),
+            };
             Claim {
                 testbed: format!("{}/{}", tb.0, tb.1),
                 claim: claim.into(),
                 paper_value: Some(paper),
-                our_value: Some(f.slope),
+                our_value: Some(slope),
                 held: Some(held),
-                note,
+                note: format!("{note}; {over}{beside}"),
             }
         }
     }
 }
 
-/// "Estimator X converges with slope `paper`": held when our 95% CI contains the paper's slope
-/// (the local slope over the last two budgets is given in the note).
+/// "Estimator X converges with slope `paper`": held when our 95% CI over the whole range contains
+/// the paper's slope (the right-end slope and the slope over the last two budgets are in the note).
 pub fn slope_matches(report: &RunReport, tb: (&str, &str), estimator: &str, paper: f64, claim: &str) -> Claim {
+    slope_matches_over(report, tb, (estimator, SlopeRange::Whole), paper, claim)
+}
+
+/// "Estimator X reaches slope `paper`": [`slope_matches`] judged on the right-end fit (the last
+/// [`crate::analysis::RIGHT_END_BUDGETS`] budgets), where a method's asymptotic order shows.
+pub fn slope_reaches(report: &RunReport, tb: (&str, &str), estimator: &str, paper: f64, claim: &str) -> Claim {
+    slope_matches_over(report, tb, (estimator, SlopeRange::Right), paper, claim)
+}
+
+/// [`slope_matches`] over a chosen range of budgets.
+pub fn slope_matches_over(
+    report: &RunReport,
+    tb: (&str, &str),
+    (estimator, range): (&str, SlopeRange),
+    paper: f64,
+    claim: &str,
+) -> Claim {
     let last =
         last_segment_slope(report, tb.0, tb.1, estimator).map(|s| format!("{s:.3}")).unwrap_or_else(|| "-".into());
-    slope_claim(report, tb, estimator, paper, claim, |f| {
-        let note = format!(
-            "held if the 95% CI [{:.3}, {:.3}] over budgets {}..{} contains {paper}; slope over the last two budgets {last}",
-            f.slope_ci_low,
-            f.slope_ci_high,
-            f.budgets.first().copied().unwrap_or(0),
-            f.budgets.last().copied().unwrap_or(0),
-        );
-        (f.slope_ci_low <= paper && paper <= f.slope_ci_high, note)
+    slope_claim(report, tb, (estimator, range), paper, claim, |lo, hi, _| {
+        let note =
+            format!("held if the 95% CI [{lo:.3}, {hi:.3}] contains {paper}; slope over the last two budgets {last}");
+        (lo <= paper && paper <= hi, note)
     })
 }
 
-/// "Estimator X converges faster than independent MC": held when our CI lies below -0.5; the
-/// paper's slope `paper` is compared in the note (and judged by [`slope_matches`]).
+/// "Estimator X converges faster than independent MC": held when our whole-range CI lies below
+/// -0.5; the paper's slope `paper` is compared in the note (and judged by [`slope_matches`]).
 pub fn slope_steeper(report: &RunReport, tb: (&str, &str), estimator: &str, paper: f64, claim: &str) -> Claim {
-    slope_claim(report, tb, estimator, paper, claim, |f| {
-        let place = if paper < f.slope_ci_low {
+    slope_claim(report, tb, (estimator, SlopeRange::Whole), paper, claim, |lo, hi, _| {
+        let place = if paper < lo {
             "steeper than"
-        } else if paper > f.slope_ci_high {
+        } else if paper > hi {
             "shallower than"
         } else {
             "inside"
         };
-        let note = format!(
-            "held if the 95% CI [{:.3}, {:.3}] lies below -0.5; the paper's {paper} is {place} our CI",
-            f.slope_ci_low, f.slope_ci_high
-        );
-        (f.slope_ci_high < -0.5, note)
+        let note =
+            format!("held if the 95% CI [{lo:.3}, {hi:.3}] lies below -0.5; the paper's {paper} is {place} our CI");
+        (hi < -0.5, note)
     })
 }
 
-/// "Estimator X converges faster than slope `below`": held when our CI lies below `below`.
-pub fn slope_steeper_than(report: &RunReport, tb: (&str, &str), estimator: &str, below: f64, claim: &str) -> Claim {
-    slope_claim(report, tb, estimator, below, claim, |f| {
-        let note = format!("held if the 95% CI [{:.3}, {:.3}] lies below {below}", f.slope_ci_low, f.slope_ci_high);
-        (f.slope_ci_high < below, note)
+/// "Estimator X converges faster than slope `below`": held when our CI over `range` lies below
+/// `below`.
+pub fn slope_steeper_than(
+    report: &RunReport,
+    tb: (&str, &str),
+    (estimator, range): (&str, SlopeRange),
+    below: f64,
+    claim: &str,
+) -> Claim {
+    slope_claim(report, tb, (estimator, range), below, claim, |lo, hi, _| {
+        (hi < below, format!("held if the 95% CI [{lo:.3}, {hi:.3}] lies below {below}"))
     })
 }
 

@@ -29,6 +29,11 @@ pub fn print_summary(r: &crate::output::RunReport, seconds: f64) {
                 format!("{}/{}", f.testbed, f.variant),
                 f.estimator.clone(),
                 format!("{:.3} [{:.3}, {:.3}]", f.slope, f.slope_ci_low, f.slope_ci_high),
+                if f.slope_right.is_finite() {
+                    format!("{:.3} [{:.3}, {:.3}]", f.slope_right, f.slope_right_ci_low, f.slope_right_ci_high)
+                } else {
+                    "-".into()
+                },
                 p(holm),
                 holm.map(|t| format!("{} ({})", t.verdict, t.claim)).unwrap_or_else(|| "-".into()),
                 p(pooled),
@@ -43,6 +48,7 @@ pub fn print_summary(r: &crate::output::RunReport, seconds: f64) {
                 "test bed",
                 "estimator",
                 "slope [95% CI]",
+                "right-end slope [95% CI]",
                 "Holm p",
                 "Holm verdict (claim)",
                 "pooled p",

@@ -73,6 +73,11 @@ pub struct SummaryRow {
     /// The test bed's parameters with every default filled in, as JSON.
     #[serde(default)]
     pub testbed_params: String,
+    /// Standard error of `mse`: `sqrt(s^2 / reps)` with `s^2` the sample variance over repetitions
+    /// of each repetition's mean squared deviation (the cell's `rep_sq`); it weights the slope fits.
+    /// NaN in files written before it and for fewer than 2 repetitions.
+    #[serde(default = "crate::output::nan")]
+    pub mse_se: f64,
 }
 
 /// Column names whose values depend on the wall clock (excluded from determinism checks).
@@ -152,5 +157,6 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         estimator_id: String::new(),
         params: String::new(),
         testbed_params: String::new(),
+        mse_se: if cell.rep_sq.count() >= 2 { (cell.rep_sq.variance() / reps).sqrt() } else { f64::NAN },
     }
 }

@@ -209,6 +209,7 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "estimator_id",
     "params",
     "testbed_params",
+    "mse_se",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).
@@ -267,6 +268,11 @@ pub fn write_integrals_csv(dir: &OutputDir, rows: &[IntegralRow]) -> Result<()> 
 pub fn write_summary_json(dir: &OutputDir, report: &RunReport) -> Result<()> {
     let text = serde_json::to_string_pretty(report).map_err(|e| HarnessError::write(dir.join("summary.json"), e))?;
     dir.write("summary.json", text.as_bytes()).map(|_| ())
+}
+
+/// NaN, the value of a number that a file written before the number existed does not hold.
+pub fn nan() -> f64 {
+    f64::NAN
 }
 
 /// Reads back a number of summary.json that serde_json wrote as `null` (it writes NaN and the

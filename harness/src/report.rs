@@ -158,9 +158,27 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
             format!("[{:.3}, {:.3}]", f.slope_ci_low, f.slope_ci_high),
             format!("{:.4}", f.r2),
             budgets.join(", "),
+            if f.slope_right.is_finite() { format!("{:.3}", f.slope_right) } else { "-".into() },
+            if f.slope_right.is_finite() {
+                format!("[{:.3}, {:.3}]", f.slope_right_ci_low, f.slope_right_ci_high)
+            } else {
+                "-".into()
+            },
+            if f.method.is_empty() { "ols".into() } else { f.method.clone() },
         ]
     });
-    let header = ["testbed", "variant", "estimator", "slope", "95% CI", "r2", "budgets"];
+    let header = [
+        "testbed",
+        "variant",
+        "estimator",
+        "slope",
+        "95% CI",
+        "r2",
+        "budgets",
+        "right-end slope (last 3 budgets)",
+        "right-end 95% CI",
+        "fit",
+    ];
     section(&mut out, "Convergence fits", &header, fits.collect(), "No fits (a fit needs 3 budgets with RMSE > 0).");
 
     let speedups = report.speedups.iter().map(|s| {

@@ -57,17 +57,17 @@ pub enum StatsError {
     /// A fit input is infinite or NaN.
     #[error("non-finite {axis} value {value} at index {index}")]
     NonFinite {
-        /// `"x"` or `"y"`.
+        /// `"x"`, `"y"` or `"var"` (a weighted fit's variances).
         axis: &'static str,
         /// Index of the point.
         index: usize,
         /// The value.
         value: f64,
     },
-    /// A log-log fit input is zero or negative.
-    #[error("{axis} value {value} at index {index} is not > 0, so its logarithm is undefined")]
+    /// A log-log fit input (its logarithm is taken) or a weighted fit's variance is zero or negative.
+    #[error("{axis} value {value} at index {index} is not > 0 (a logarithm or a weight needs it)")]
     NonPositive {
-        /// `"x"` or `"y"`.
+        /// `"x"`, `"y"` or `"var"`.
         axis: &'static str,
         /// Index of the point.
         index: usize,

@@ -19,4 +19,4 @@ pub use hypothesis::{
     t_test_skewness_limit, welch, z_test, TestOutcome,
 };
 pub use moments::{Moments, NeumaierSum};
-pub use regression::{linear_fit, log_log_fit, SlopeFit};
+pub use regression::{linear_fit, log_log_fit, weighted_linear_fit, SlopeFit};

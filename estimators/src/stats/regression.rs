@@ -86,6 +86,79 @@ pub fn linear_fit(x: &[f64], y: &[f64]) -> Result<SlopeFit, StatsError> {
     Ok(SlopeFit { slope, intercept, slope_ci_low: slope - half, slope_ci_high: slope + half, slope_se, r2, points: n })
 }
 
+/// Weighted least squares of `y` on `x` when each `y[i]` has its own (estimated) variance `var[i]`:
+/// weights `w_i = 1 / var[i]`, slope `sum w (x - xw)(y - yw) / S` with `S = sum w (x - xw)^2` and
+/// `xw`, `yw` the weighted means.
+///
+/// The slope's variance is `1 / S` when the variances are right. The residual chi-square
+/// `chi2 = sum w r^2` has `n - 2` degrees of freedom under that model; when the points scatter more
+/// than their variances say (`chi2 / (n - 2) > 1`: variances underestimated, or the line is not
+/// straight) the variance is inflated by that ratio, so the interval is never narrower than the
+/// model's nor than the scatter's. The 95% interval takes the Student t quantile with `var_dof`
+/// degrees of freedom (those of the variance estimates; `f64::INFINITY` for known variances) while
+/// the variances explain the scatter, and `n - 2` once the scatter sets the width.
+///
+/// `r2` is the weighted coefficient of determination.
+///
+/// # Errors
+/// Mismatched lengths, fewer than 3 points, a non-finite value, a variance that is not `> 0`
+/// (reported as a non-positive `var` value), or all `x` equal.
+pub fn weighted_linear_fit(x: &[f64], y: &[f64], var: &[f64], var_dof: f64) -> Result<SlopeFit, StatsError> {
+    if x.len() != y.len() {
+        return Err(StatsError::LengthMismatch { what: "y", left: y.len(), right: x.len() });
+    }
+    if x.len() != var.len() {
+        return Err(StatsError::LengthMismatch { what: "var", left: var.len(), right: x.len() });
+    }
+    let n = x.len();
+    if n < 3 {
+        return Err(StatsError::TooFewPoints { got: n, needed: 3 });
+    }
+    check_finite("x", x)?;
+    check_finite("y", y)?;
+    check_finite("var", var)?;
+    if let Some(index) = var.iter().position(|&v| v <= 0.0) {
+        return Err(StatsError::NonPositive { axis: "var", index, value: var[index] });
+    }
+    let w: Vec<f64> = var.iter().map(|v| 1.0 / v).collect();
+    let sw: f64 = w.iter().sum();
+    let mx = w.iter().zip(x).map(|(w, x)| w * x).sum::<f64>() / sw;
+    let my = w.iter().zip(y).map(|(w, y)| w * y).sum::<f64>() / sw;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for ((&wi, &xi), &yi) in w.iter().zip(x).zip(y) {
+        let (dx, dy) = (xi - mx, yi - my);
+        sxx += wi * dx * dx;
+        sxy += wi * dx * dy;
+        syy += wi * dy * dy;
+    }
+    if sxx <= 0.0 {
+        return Err(StatsError::DegenerateX);
+    }
+    let slope = sxy / sxx;
+    let intercept = my - slope * mx;
+    let chi2: f64 = w
+        .iter()
+        .zip(x)
+        .zip(y)
+        .map(|((&wi, &xi), &yi)| {
+            let r = yi - (intercept + slope * xi);
+            wi * r * r
+        })
+        .sum();
+    let dof = n as f64 - 2.0;
+    let ratio = chi2 / dof;
+    let (scale, t_dof) = if ratio > 1.0 { (ratio, dof) } else { (1.0, var_dof.max(1.0)) };
+    let slope_se = (scale / sxx).sqrt();
+    let t = if t_dof.is_finite() {
+        StudentsT::new(0.0, 1.0, t_dof).map(|d| d.inverse_cdf(0.975)).unwrap_or(f64::NAN)
+    } else {
+        1.959_963_984_540_054
+    };
+    let half = t * slope_se;
+    let r2 = if syy > 0.0 { (1.0 - chi2 / syy).clamp(0.0, 1.0) } else { 1.0 };
+    Ok(SlopeFit { slope, intercept, slope_ci_low: slope - half, slope_ci_high: slope + half, slope_se, r2, points: n })
+}
+
 /// Least squares of `ln y` on `ln x` (a power law `y = C x^slope`), as [`linear_fit`] on the logs.
 ///
 /// # Errors
@@ -187,6 +260,42 @@ mod tests {
         let rate = covered as f64 / trials as f64;
         // Binomial sd at 4000 trials is 0.0034; allow about 5 sd.
         assert!((rate - 0.95).abs() < 0.018, "coverage {rate}");
+    }
+
+    #[test]
+    fn weighted_fit_covers_with_known_variances_and_widens_with_excess_scatter() {
+        use rand::distributions::Distribution;
+        let x: Vec<f64> = (1..=6).map(|k| k as f64).collect();
+        // Variances spanning 100x: the noisy points must not pull the fit.
+        let var: Vec<f64> = (0..6).map(|k| 0.01 * 10f64.powf(-(k as f64) / 2.5)).collect();
+        let mut rng = Pcg64::seed_from_u64(11);
+        let z = Normal::new(0.0, 1.0).unwrap();
+        let trials = 2000;
+        let covered = (0..trials)
+            .filter(|_| {
+                let y: Vec<f64> =
+                    x.iter().zip(&var).map(|(&v, s2)| 0.3 - 0.5 * v + s2.sqrt() * z.sample(&mut rng)).collect();
+                let f = weighted_linear_fit(&x, &y, &var, f64::INFINITY).unwrap();
+                f.slope_ci_low <= -0.5 && -0.5 <= f.slope_ci_high
+            })
+            .count();
+        let rate = covered as f64 / trials as f64;
+        // Known variances: 95% unless the scatter inflates the interval (then more).
+        assert!((0.94..=0.99).contains(&rate), "coverage {rate}");
+        // Exact line: the slope, and an interval of the model's width.
+        let y: Vec<f64> = x.iter().map(|&v| 1.0 + 2.0 * v).collect();
+        let f = weighted_linear_fit(&x, &y, &var, f64::INFINITY).unwrap();
+        assert!((f.slope - 2.0).abs() < 1e-12 && (f.intercept - 1.0).abs() < 1e-12, "{f:?}");
+        assert!(f.slope_se > 0.0 && f.r2 == 1.0);
+        // Scatter far beyond the variances: the interval grows by sqrt(chi2 / dof) and t(n - 2).
+        let bent: Vec<f64> =
+            x.iter().map(|&v| 1.0 + 2.0 * v + if (v as u32).is_multiple_of(2) { 1.0 } else { -1.0 }).collect();
+        let g = weighted_linear_fit(&x, &bent, &var, f64::INFINITY).unwrap();
+        assert!(g.slope_se > 10.0 * f.slope_se, "{g:?} vs {f:?}");
+        assert!(matches!(
+            weighted_linear_fit(&x, &y, &[1.0, 1.0, 0.0, 1.0, 1.0, 1.0], 5.0),
+            Err(StatsError::NonPositive { axis: "var", index: 2, .. })
+        ));
     }
 
     #[test]

@@ -6,7 +6,7 @@ pub mod bias;
 pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE};
 
 use crate::metrics::SummaryRow;
-use estimators::stats::log_log_fit;
+use estimators::stats::{log_log_fit, weighted_linear_fit, SlopeFit};
 use serde::{Deserialize, Serialize};
 
 /// Family-wise significance of the unbiasedness tests (SPEC §6).
@@ -14,7 +14,20 @@ pub const UNBIASEDNESS_ALPHA: f64 = 1e-3;
 /// Power at which the detectable bias is reported.
 pub const POWER: f64 = 0.8;
 
-/// A convergence-slope fit of log RMSE on log budget.
+/// How many of the largest budgets the right-end fit uses.
+pub const RIGHT_END_BUDGETS: usize = 3;
+
+/// A convergence-slope fit of log RMSE on log budget (SPEC §5), over the whole range of budgets and
+/// over its right end (the last [`RIGHT_END_BUDGETS`] budgets), where a method "reaches" its order.
+///
+/// Both fits are weighted least squares with delta-method variances ([`rmse_fit`]): each budget's
+/// log RMSE carries its own variance, known from the spread of the per-repetition squared errors,
+/// and is corrected for the bias of a logarithm of a noisy mean. `slope`, `slope_ci_low` and
+/// `slope_ci_high` keep their meaning (the whole-range slope and its 95% interval) but come from this
+/// fit since `summary.csv` has `mse_se`; before, they were ordinary least squares, whose interval
+/// ignored the points' unequal noise and undercovered under heavy tails. Rows without `mse_se`
+/// (files written before it, one repetition, or an error with no spread) are fitted by ordinary
+/// least squares, and `method` says which. Formulas and measured coverage: `docs/slope-fits.md`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Fit {
     /// Test bed id.
@@ -23,16 +36,16 @@ pub struct Fit {
     pub variant: String,
     /// Estimator name.
     pub estimator: String,
-    /// Fitted slope (the order of convergence is -slope).
+    /// Fitted slope over every budget (the order of convergence is -slope).
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub slope: f64,
-    /// 95% confidence interval, low end.
+    /// 95% confidence interval of `slope`, low end.
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub slope_ci_low: f64,
-    /// 95% confidence interval, high end.
+    /// 95% confidence interval of `slope`, high end.
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub slope_ci_high: f64,
-    /// Coefficient of determination.
+    /// Coefficient of determination (weighted, for a weighted fit).
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub r2: f64,
     /// Intercept of the fit (log RMSE at budget 1).
@@ -40,28 +53,117 @@ pub struct Fit {
     pub intercept: f64,
     /// Budgets used.
     pub budgets: Vec<u64>,
+    /// Slope over the last [`RIGHT_END_BUDGETS`] budgets (the order the method reaches); NaN for a
+    /// series with fewer budgets than that, and in files written before it.
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub slope_right: f64,
+    /// 95% confidence interval of `slope_right`, low end.
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub slope_right_ci_low: f64,
+    /// 95% confidence interval of `slope_right`, high end.
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub slope_right_ci_high: f64,
+    /// Budgets of the right-end fit.
+    #[serde(default)]
+    pub budgets_right: Vec<u64>,
+    /// `wls` (weighted least squares with delta-method variances) or `ols` (ordinary least squares,
+    /// where the rows carry no usable `mse_se`); empty in files written before it.
+    #[serde(default)]
+    pub method: String,
 }
 
-/// Fits every (test bed, variant, estimator) series of rows (at least 3 budgets with RMSE > 0).
+impl Fit {
+    /// The slope and its 95% interval over `range`.
+    pub fn range(&self, range: SlopeRange) -> (f64, f64, f64) {
+        match range {
+            SlopeRange::Whole => (self.slope, self.slope_ci_low, self.slope_ci_high),
+            SlopeRange::Right => (self.slope_right, self.slope_right_ci_low, self.slope_right_ci_high),
+        }
+    }
+
+    /// The budgets the fit over `range` used.
+    pub fn budgets_of(&self, range: SlopeRange) -> &[u64] {
+        match range {
+            SlopeRange::Whole => &self.budgets,
+            SlopeRange::Right => &self.budgets_right,
+        }
+    }
+}
+
+/// Which budgets a slope is fitted over.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SlopeRange {
+    /// Every budget of the series.
+    #[default]
+    Whole,
+    /// The last [`RIGHT_END_BUDGETS`] budgets: the slope a method "reaches".
+    Right,
+}
+
+impl SlopeRange {
+    /// How result tables and notes name it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            SlopeRange::Whole => "whole-range",
+            SlopeRange::Right => "right-end",
+        }
+    }
+}
+
+/// Fits log RMSE on log budget over `rows` (one series, budgets increasing), and says how.
+///
+/// With every row's MSE `m_k > 0` and its standard error `se_k` (`mse_se`) finite and `> 0`, by
+/// weighted least squares with delta-method variances: the relative variance of the estimated MSE
+/// is `rho_k = se_k^2 / m_k^2` (`Var(e) / (R m_k^2)` with `e` a repetition's mean squared error and
+/// `R` the repetitions), so `log RMSE_k = log(m_k) / 2` has variance `rho_k / 4`, and since
+/// `E[log m_hat] ≈ log m - rho / 2`, the point `log(m_k) / 2 + rho_k / 4` is unbiased to that order.
+/// Weights are `4 / rho_k`; the interval is [`weighted_linear_fit`]'s (Student t with `R - 1` degrees
+/// of freedom, widened by the residual chi-square per degree of freedom when the points scatter
+/// more than their variances say). Otherwise by ordinary least squares of `log RMSE` ([`log_log_fit`]).
+pub fn rmse_fit(rows: &[&SummaryRow]) -> Option<(SlopeFit, &'static str)> {
+    let pts: Vec<&SummaryRow> = rows.iter().copied().filter(|r| r.rmse > 0.0).collect();
+    let x: Vec<f64> = pts.iter().map(|r| (r.budget as f64).ln()).collect();
+    let weighted = pts.iter().all(|r| r.mse > 0.0 && r.mse_se.is_finite() && r.mse_se > 0.0);
+    if weighted && pts.iter().all(|r| r.budget > 0) {
+        let rho: Vec<f64> = pts.iter().map(|r| (r.mse_se / r.mse).powi(2)).collect();
+        let y: Vec<f64> = pts.iter().zip(&rho).map(|(r, rho)| 0.5 * r.mse.ln() + rho / 4.0).collect();
+        let var: Vec<f64> = rho.iter().map(|rho| rho / 4.0).collect();
+        let reps = pts.iter().map(|r| r.reps).min().unwrap_or(0);
+        if let Ok(f) = weighted_linear_fit(&x, &y, &var, reps.saturating_sub(1) as f64) {
+            return Some((f, "wls"));
+        }
+    }
+    let b: Vec<f64> = pts.iter().map(|r| r.budget as f64).collect();
+    let y: Vec<f64> = pts.iter().map(|r| r.rmse).collect();
+    log_log_fit(&b, &y).ok().map(|f| (f, "ols"))
+}
+
+/// Fits every (test bed, variant, estimator) series of rows with at least 3 budgets with RMSE > 0,
+/// over the whole range and over its right end ([`rmse_fit`]).
 pub fn fits(rows: &[SummaryRow]) -> Vec<Fit> {
     let mut out = Vec::new();
     for series in group(rows) {
         let pts: Vec<&SummaryRow> = series.into_iter().filter(|r| r.rmse > 0.0).collect();
-        let x: Vec<f64> = pts.iter().map(|r| r.budget as f64).collect();
-        let y: Vec<f64> = pts.iter().map(|r| r.rmse).collect();
-        if let Ok(f) = log_log_fit(&x, &y) {
-            out.push(Fit {
-                testbed: pts[0].testbed.clone(),
-                variant: pts[0].variant.clone(),
-                estimator: pts[0].estimator.clone(),
-                slope: f.slope,
-                slope_ci_low: f.slope_ci_low,
-                slope_ci_high: f.slope_ci_high,
-                r2: f.r2,
-                intercept: f.intercept,
-                budgets: pts.iter().map(|r| r.budget).collect(),
-            });
-        }
+        let Some((f, method)) = rmse_fit(&pts) else { continue };
+        let right = &pts[pts.len().saturating_sub(RIGHT_END_BUDGETS)..];
+        let r = if right.len() == RIGHT_END_BUDGETS { rmse_fit(right).map(|(f, _)| f) } else { None };
+        out.push(Fit {
+            testbed: pts[0].testbed.clone(),
+            variant: pts[0].variant.clone(),
+            estimator: pts[0].estimator.clone(),
+            slope: f.slope,
+            slope_ci_low: f.slope_ci_low,
+            slope_ci_high: f.slope_ci_high,
+            r2: f.r2,
+            intercept: f.intercept,
+            budgets: pts.iter().map(|r| r.budget).collect(),
+            slope_right: r.as_ref().map_or(f64::NAN, |r| r.slope),
+            slope_right_ci_low: r.as_ref().map_or(f64::NAN, |r| r.slope_ci_low),
+            slope_right_ci_high: r.as_ref().map_or(f64::NAN, |r| r.slope_ci_high),
+            budgets_right: if r.is_some() { right.iter().map(|r| r.budget).collect() } else { Vec::new() },
+            method: method.to_string(),
+        });
     }
     out
 }
@@ -191,6 +293,60 @@ mod tests {
         assert!((exact_row.mse - row.mse - 1e-4).abs() < 1e-12);
     }
 
+    /// A series whose per-repetition mean squared errors are `(1 / n) chi2_d / d` (mean `1 / n`,
+    /// so the true slope of RMSE is -1/2), summarised as the harness does (mean and its standard
+    /// error over repetitions).
+    fn synthetic_series(rng: &mut rand_pcg::Pcg64, reps: usize, d: usize) -> Vec<SummaryRow> {
+        use rand::Rng;
+        let normal = |rng: &mut rand_pcg::Pcg64| {
+            let (u, v): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
+            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+        };
+        (1..=6)
+            .map(|k| {
+                let n = 4f64.powi(k);
+                let mut m = estimators::stats::Moments::new();
+                for _ in 0..reps {
+                    let chi2: f64 = (0..d).map(|_| normal(rng).powi(2)).sum();
+                    m.push(chi2 / d as f64 / n);
+                }
+                let mut r = crate::plot::tests::row("x", n as u64, m.mean().sqrt(), 1.0);
+                r.reps = reps;
+                r.mse = m.mean();
+                r.mse_se = (m.variance() / reps as f64).sqrt();
+                r
+            })
+            .collect()
+    }
+
+    #[test]
+    fn weighted_fits_cover_the_true_slope_where_per_point_noise_differs() {
+        use rand::SeedableRng;
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(2024);
+        let trials = 200;
+        let (mut whole, mut right, mut sum) = (0, 0, 0.0);
+        for _ in 0..trials {
+            let rows = synthetic_series(&mut rng, 8, 2);
+            let f = &fits(&rows)[0];
+            assert_eq!(f.method, "wls");
+            assert_eq!(f.budgets_right, vec![256, 1024, 4096]);
+            whole += usize::from(f.slope_ci_low <= -0.5 && -0.5 <= f.slope_ci_high);
+            right += usize::from(f.slope_right_ci_low <= -0.5 && -0.5 <= f.slope_right_ci_high);
+            sum += f.slope;
+        }
+        let (whole, right) = (whole as f64 / trials as f64, right as f64 / trials as f64);
+        assert!(whole >= 0.9 && right >= 0.9, "coverage whole {whole}, right end {right}");
+        assert!((sum / trials as f64 + 0.5).abs() < 0.01, "mean slope {}", sum / trials as f64);
+        // Without standard errors (files written before them) the fit is ordinary least squares.
+        let mut rows = synthetic_series(&mut rng, 8, 2);
+        rows.iter_mut().for_each(|r| r.mse_se = f64::NAN);
+        let f = &fits(&rows)[0];
+        assert_eq!(f.method, "ols");
+        let x: Vec<f64> = rows.iter().map(|r| r.budget as f64).collect();
+        let y: Vec<f64> = rows.iter().map(|r| r.rmse).collect();
+        assert_eq!(f.slope, log_log_fit(&x, &y).unwrap().slope);
+    }
+
     #[test]
     fn speedup_uses_the_baseline_fit() {
         let mk = |est: &str, budget: u64, rmse: f64, seconds: f64| SummaryRow {
@@ -222,6 +378,7 @@ mod tests {
             estimator_id: String::new(),
             params: String::new(),
             testbed_params: String::new(),
+            mse_se: f64::NAN,
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {

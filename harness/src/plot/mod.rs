@@ -216,6 +216,12 @@ fn figure(
             let fit = report.fits.iter().find(|f| f.testbed == testbed && f.variant == variant && f.estimator == *name);
             if let Some(f) = fit.filter(|f| f.slope.is_finite()) {
                 label.push_str(&format!("  slope {:.2} [{:.2}, {:.2}]", f.slope, f.slope_ci_low, f.slope_ci_high));
+                if f.slope_right.is_finite() {
+                    label.push_str(&format!(
+                        ", right end {:.2} [{:.2}, {:.2}]",
+                        f.slope_right, f.slope_right_ci_low, f.slope_right_ci_high
+                    ));
+                }
             }
         }
         series.push(Series { label, style, points });

@@ -3,7 +3,7 @@ use crate::analysis::{fits, SpeedUp, TestRow};
 use crate::output::{Claim, Diagnostic, Meta};
 use crate::plan::Skipped;
 
-fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
+pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
     let variance = rmse * rmse * 0.9;
     SummaryRow {
         testbed: "gradient-plane".into(),
@@ -34,6 +34,7 @@ fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> SummaryRow {
         estimator_id: String::new(),
         params: String::new(),
         testbed_params: String::new(),
+        mse_se: rmse * rmse * 0.3,
     }
 }
 
@@ -133,7 +134,9 @@ fn writes_svg_and_png_for_every_plot() {
     }
     let svg = std::fs::read_to_string(dir.path().join("gradient-plane_default_rmse.svg")).unwrap();
     assert!(svg.contains("MCMC (independent MC)  slope -0.4"), "legend text missing");
-    assert!(svg.contains("IS1 + CV2  slope -0.90 [-0.90, -0.90]"));
+    // The points lie on a line; the interval is the one their standard errors give.
+    assert!(svg.contains("IS1 + CV2  slope -0.90 ["), "legend slope missing");
+    assert!(svg.contains(", right end -0.90 ["), "legend right-end slope missing");
     assert!(svg.contains("samples per pixel (spp)"));
     // No temp files are left behind.
     let names: Vec<String> =
