@@ -32,7 +32,10 @@ pub struct SummaryRow {
     pub variance: f64,
     /// Pooled bias (mean over integrals and channels of mean - reference).
     pub bias: f64,
-    /// Standard error of the pooled bias.
+    /// Standard error of the pooled bias, from the spread of the per-repetition summed deviations
+    /// (so integrals and channels that a repetition shares, frames of one sequence or correlated
+    /// colour channels, count once), plus the stored reference's variance; from the per-integral
+    /// variances as if independent only for cells stored without per-repetition aggregates.
     pub bias_se: f64,
     /// Samples per estimate.
     pub samples: f64,
@@ -140,7 +143,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         mse: mse_v,
         variance,
         bias: bias.value() / m,
-        bias_se: bias_var.value().sqrt() / m,
+        bias_se: pooled_bias_se(cell, ref_var.value()).unwrap_or(bias_var.value().sqrt()) / m,
         samples: per(cell.costs.samples),
         fetches,
         rays: per(cell.costs.rays),
@@ -159,4 +162,11 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         testbed_params: String::new(),
         mse_se: if cell.rep_sq.count() >= 2 { (cell.rep_sq.variance() / reps).sqrt() } else { f64::NAN },
     }
+}
+
+/// The standard error of the summed deviation of a cell from its per-repetition aggregates (and
+/// the reference's summed variance `ref_var`); `None` without them.
+fn pooled_bias_se(cell: &CellResult, ref_var: f64) -> Option<f64> {
+    let r = cell.rep_dev.count();
+    (r >= 2).then(|| (cell.rep_dev.variance() / r as f64 + ref_var).sqrt())
 }
