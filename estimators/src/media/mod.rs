@@ -9,7 +9,8 @@
 //! - `transmittance` (camera b): orthographic along +y over x in [-10, 10], z in [0, 20]; pixel =
 //!   `T(chord) L_env(+y)` (scattering ignored, paper Fig. 9-10);
 //! - `multiple`: the same camera, pixel = radiance with multiple scattering (paper Fig. 6-7),
-//!   stored long-run reference made by `mcbench reference <id> --variant multiple`;
+//!   stored long-run reference made by `mcbench reference <id> --variant multiple` with an
+//!   integrator that shares no code with the tracking estimators ([`independent_reference`]);
 //! - `single-scatter`: the same camera, pixel = radiance scattered once from the point light of
 //!   SPEC §3.3 (paper 002 §4.3, Eq. 22 without the background term, Fig. 12), reference by nested
 //!   adaptive quadrature ([`scatter_reference`]).
@@ -21,6 +22,7 @@
 
 pub mod density;
 pub mod environment;
+pub mod independent_reference;
 pub mod moments;
 pub mod params;
 pub mod reference;
@@ -79,7 +81,7 @@ pub static EQ21: TestBedEntry = TestBedEntry {
     provides: Needs::MEDIUM.and(Needs::POINT_LIGHT),
     summary: "paper 002 Eq. 21 medium in a sphere, Rayleigh, albedo 0.7: central ray T(s), transmittance image, multiple scattering, point-light single scattering",
     build: |v, p, refs| Ok(Box::new(MediumBed::new(Field::Eq21, v, p, refs)?)),
-    compute_reference: Some(|v, p, n, t| reference::compute_stored(Field::Eq21, v, p, n, t)),
+    compute_reference: Some(|v, p, n, t| independent_reference::compute_stored(Field::Eq21, v, p, n, t)),
     params: ParamSpec::of::<params::MediumParams>(),
     cases: &[
         BedCase { variant: "transmittance", params: &[("resolution", 4.0)], role: CaseRole::Stability },
@@ -107,7 +109,7 @@ pub static PERLIN: TestBedEntry = TestBedEntry {
     provides: Needs::MEDIUM.and(Needs::POINT_LIGHT),
     summary: "12-octave Perlin fbm medium (max 1, mostly < 0.6), Rayleigh, albedo 0.9; cheap = first 3 octaves; same variants",
     build: |v, p, refs| Ok(Box::new(MediumBed::new(Field::Perlin, v, p, refs)?)),
-    compute_reference: Some(|v, p, n, t| reference::compute_stored(Field::Perlin, v, p, n, t)),
+    compute_reference: Some(|v, p, n, t| independent_reference::compute_stored(Field::Perlin, v, p, n, t)),
     params: ParamSpec::of::<params::MediumParams>(),
     cases: &[
         BedCase { variant: "central-ray", params: &[("points", 8.0)], role: TRACKING_PART },

@@ -4,21 +4,13 @@
 //!   initial panel per unit. Perlin, along axis-aligned rays (every transmittance ray of the test
 //!   beds): one panel per crossing of a lattice plane of any octave (each
 //!   octave is a polynomial between crossings) and per kink of the clamp to [0, 1];
-//! - multiple scattering: stored long-run Monte Carlo (delta tracking, SPEC §4.2) with per-pixel
-//!   standard errors in `results/references/<id>_multiple.json`, made by
-//!   `mcbench reference <id> --variant multiple`.
+//! - multiple scattering: stored long-run Monte Carlo with per-pixel standard errors in
+//!   `results/references/<id>_multiple.json`, made by `mcbench reference <id> --variant multiple`
+//!   ([`super::independent_reference`], which shares no code with the tracking estimators).
 
 use super::{clip_sphere, density, Field, MediumBed};
-use crate::budget::Budget;
-use crate::error::ConfigError;
-use crate::estimator::Estimator;
 use crate::math::{Rgb, Vec3};
-use crate::params::Params;
 use crate::quadrature::{gauss_kronrod_multi, Quadrature};
-use crate::references::{ReferenceKey, StoredReference};
-use crate::rng::StreamKey;
-use crate::stats::Moments;
-use crate::task::Task;
 use crate::testbed::{MediumQuantity, Reference, ReferenceKind, TestBed};
 
 /// Absolute tolerance on the optical depth (relative error of T <= 1e-12 with margin).
@@ -168,73 +160,10 @@ pub fn transmittance_reference(bed: &MediumBed) -> Reference {
     }
 }
 
-/// Computes the stored multiple-scattering reference by long-run delta tracking (`samples` paths
-/// per pixel, default 20000 for Eq. 21 and 4000 for Perlin), seeded per pixel, for the test bed's
-/// `params`.
-pub fn compute_stored(
-    field: Field,
-    variant: &str,
-    params: &Params,
-    samples: Option<u64>,
-    threads: usize,
-) -> Result<(ReferenceKey, StoredReference), ConfigError> {
-    if variant != "multiple" {
-        return Err(ConfigError::invalid(
-            "variant",
-            variant,
-            "only `multiple` has a stored Monte Carlo reference (the others are exact)",
-        ));
-    }
-    let default_n = if field == Field::Eq21 { 20_000 } else { 4_000 };
-    let samples = samples.unwrap_or(default_n);
-    if samples > 100_000_000 {
-        return Err(ConfigError::invalid("samples", samples, "must be a whole number in [1, 100000000]"));
-    }
-    let bed = MediumBed::without_reference(field, variant, params)?;
-    let key = bed.reference_key();
-    let res = bed.resolution().0;
-    let tracker = crate::tracking::delta_tracking::DeltaTracking { sigma_samp: crate::tracking::SigmaSamp::Majorant };
-    let n = bed.integrals();
-    let out = crate::parallel::map_indices(n, threads, |i| {
-        let key = StreamKey {
-            seed: 20_170_001,
-            testbed: field.id(),
-            estimator: "reference",
-            budget: samples,
-            rep: 0,
-            integral: i as u64,
-        };
-        let mut rng = key.rng();
-        let mut m = [Moments::default(), Moments::default(), Moments::default()];
-        for _ in 0..samples {
-            let task = Task::new(&bed, i, Budget { kind: crate::budget::BudgetKind::Samples, amount: 1 });
-            let v = tracker.estimate(&task, &mut rng).unwrap_or(Rgb::splat(f64::NAN));
-            (0..3).for_each(|c| m[c].push(v[c]));
-        }
-        (Rgb(m.each_ref().map(|x| x.mean())), Rgb(m.each_ref().map(|x| x.std_err())))
-    });
-    let command = format!("{} --samples {samples} (delta tracking, seed 20170001)", key.command());
-    let reference = Reference {
-        kind: ReferenceKind::Stored { command: command.clone(), samples },
-        value: out.iter().map(|x| x.0).collect(),
-        std_err: out.iter().map(|x| x.1).collect(),
-    };
-    Ok((
-        key.clone(),
-        StoredReference {
-            testbed: key.testbed,
-            variant: key.variant,
-            params: key.params,
-            command,
-            resolution: (res, res),
-            reference,
-        },
-    ))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::params::Params;
     use crate::quadrature::gauss_legendre;
 
     /// Independent composite Gauss-Legendre (many panels, 20 nodes) agrees with the adaptive

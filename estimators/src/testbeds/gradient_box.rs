@@ -10,10 +10,12 @@
 //! so the reference is exact), `albedo-0` (single attenuation `exp(-sigma_t) c0`, exact) and `thick`
 //! (`sigma_t = 1e4`, albedo 0.8: the optically thick stability case, SPEC §10).
 //!
-//! References of the other variants are stored long-run Monte Carlo values made by
-//! `mcbench reference gradient-box --variant V` ([`super::gradient_box_reference::compute_reference`]) and looked up by variant,
-//! resolution and `sigma_t` ([`GradientBox::reference_key`]) in the reference source the caller
-//! gives.
+//! References of the other variants are stored long-run Monte Carlo values of Eq. 6 made by
+//! `mcbench reference gradient-box --variant V` with an integrator that shares no sampling code
+//! with any estimator ([`super::gradient_box_independent::compute_reference`]: analytic
+//! transmittance, forced collisions, uniform-sphere directions weighted by the phase function),
+//! looked up by variant, resolution and `sigma_t` ([`GradientBox::reference_key`]) in the
+//! reference source the caller gives.
 //!
 //! The whole image is one sequence ([`TestBed::sequence_length`] = pixels): estimators that share
 //! one adaptive structure across the image (paper 000 §4.3) get every pixel's task at once.
@@ -40,7 +42,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     provides: Needs::MEDIUM,
     summary: "homogeneous box under a gradient sky, orthographic 16x16, stored MC reference (paper 000 §5)",
     build: |variant, params, refs| Ok(Box::new(GradientBox::new(variant, params, refs)?)),
-    compute_reference: Some(super::gradient_box_reference::compute_reference),
+    compute_reference: Some(super::gradient_box_independent::compute_reference),
     params: ParamSpec::of::<GradientBoxParams>(),
     cases: &[
         BedCase { variant: "furnace", params: &[("resolution", 2.0)], role: CaseRole::Stability },

@@ -9,7 +9,7 @@ pub mod checker_reference;
 pub mod envmap_reference;
 pub mod envmap_sequence;
 pub mod gradient_box;
-pub mod gradient_box_reference;
+pub mod gradient_box_independent;
 pub mod gradient_plane;
 pub mod phong_lobe;
 pub mod pinhole;
