@@ -9,8 +9,18 @@ use std::process::{Command, Output};
 /// The repository's stored references.
 const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
 
+/// Runs the copied binary. A freshly written executable can be "busy" for a moment when another
+/// test thread forked while its file was open for writing (ETXTBSY): retried, not failed.
 fn run(bin: &Path, dir: &Path, args: &[&str]) -> Output {
-    Command::new(bin).current_dir(dir).args(args).output().expect("binary runs")
+    for _ in 0..50 {
+        match Command::new(bin).current_dir(dir).args(args).output() {
+            Err(e) if e.kind() == std::io::ErrorKind::ExecutableFileBusy => {
+                std::thread::sleep(std::time::Duration::from_millis(20))
+            }
+            r => return r.expect("binary runs"),
+        }
+    }
+    panic!("{} stayed busy", bin.display())
 }
 
 fn stderr(o: &Output) -> String {

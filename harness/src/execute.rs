@@ -218,13 +218,23 @@ pub fn finish(
 /// (independent streams), its spread scaled by `sqrt(previous budget / budget)`; `None` for a
 /// one-budget sweep.
 fn previous_budget_gate(run: &RunResults, bi: usize, ei: usize, cell: &CellResult) -> Option<analysis::Gate> {
-    let previous = run
-        .cells
-        .iter()
-        .filter(|(b, e, c)| (*b, *e) == (bi, ei) && c.key.budget.amount < cell.key.budget.amount)
-        .max_by_key(|(_, _, c)| c.key.budget.amount)?;
-    let scale = (previous.2.key.budget.amount as f64 / cell.key.budget.amount as f64).sqrt();
-    Some(analysis::Gate::from_cell(&previous.2, "previous budget", scale))
+    let same = |c: &CellResult| c.key.budget.kind == cell.key.budget.kind;
+    let mine = || run.cells.iter().filter(|(b, e, c)| (*b, *e) == (bi, ei) && same(c));
+    let (source, other) = match mine()
+        .filter(|(_, _, c)| c.key.budget.amount < cell.key.budget.amount)
+        .max_by_key(|(_, _, c)| c.key.budget.amount)
+    {
+        Some(p) => ("previous budget", p),
+        // The first budget is gated by the next one (its streams are independent too).
+        None => (
+            "next budget",
+            mine()
+                .filter(|(_, _, c)| c.key.budget.amount > cell.key.budget.amount)
+                .min_by_key(|(_, _, c)| c.key.budget.amount)?,
+        ),
+    };
+    let scale = (other.2.key.budget.amount as f64 / cell.key.budget.amount as f64).sqrt();
+    Some(analysis::Gate::from_cell(&other.2, source, scale))
 }
 
 /// Draws the plots and the report of a finished run into `plots_dir` and commits them.

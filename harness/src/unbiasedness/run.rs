@@ -34,7 +34,12 @@ fn rows_of(plan: &Plan, run: &RunResults, pilot: &RunResults, report: &mut RunRe
         let bed = plan.beds[*bi].bed.as_ref();
         let bias = plan.estimators[*ei].entry.bias;
         let gate = crate::analysis::Gate::from_cell(pilot_cell, "pilot", 1.0);
-        let tests = crate::analysis::unbiasedness(cell, bed.reference(), bias, Some(&gate), plan.sweep.tolerance());
+        let mut tests = crate::analysis::unbiasedness(cell, bed.reference(), bias, Some(&gate), plan.sweep.tolerance());
+        if let estimators::testbed::ReferenceKind::Stored { command, .. } = &bed.reference().kind {
+            if made_by(command, &plan.estimators[*ei].spec.id) {
+                judged_against_itself(&mut tests, command);
+            }
+        }
         let exempt = exemption(registry, &plan.estimators[*ei].spec.id, &cell.key.testbed, &cell.key.variant);
         rows.push(table::row_from_tests(cell, bias, &tests, exempt));
         report.tests.retain(|t| {
@@ -46,6 +51,23 @@ fn rows_of(plan: &Plan, run: &RunResults, pilot: &RunResults, report: &mut RunRe
         report.tests.extend(tests);
     }
     rows
+}
+
+/// Whether a stored reference's command names `id` (underscores read as spaces) as what made it:
+/// the row would judge the estimator against its own sampling code.
+pub fn made_by(command: &str, id: &str) -> bool {
+    let norm = |s: &str| s.to_lowercase().replace('_', " ");
+    norm(command).contains(&norm(id))
+}
+
+/// A row judged against a reference made by the estimator itself: a bias shared by both cannot
+/// show, so it can be flagged but never pass.
+fn judged_against_itself(tests: &mut [crate::analysis::TestRow], command: &str) {
+    for t in tests.iter_mut().filter(|t| t.verdict == "pass") {
+        t.verdict = "inconclusive".into();
+        t.agrees = false;
+        t.reason = format!("the stored reference is made by this estimator's own sampling (`{command}`): a shared bias cannot show, so it cannot pass");
+    }
 }
 
 /// A part's sweep on its pilot seed.

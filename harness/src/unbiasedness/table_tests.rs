@@ -165,3 +165,12 @@ fn every_built_in_variant_is_in_a_part() {
         }
     }
 }
+
+#[test]
+fn a_reference_made_by_the_estimator_is_recognised_from_its_command() {
+    use super::super::run::made_by;
+    let delta = "mcbench reference perlin-medium --variant multiple --samples 20000 (delta tracking, seed 20170001)";
+    assert!(made_by(delta, "delta_tracking"));
+    assert!(!made_by(delta, "ratio_tracking"));
+    assert!(!made_by("an integrator without null collisions", "delta_tracking"));
+}
