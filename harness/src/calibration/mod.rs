@@ -127,18 +127,7 @@ pub fn families_of_run(plan: &Plan, registry: &Registry) -> Vec<Family> {
 /// The experiment's own sweep: the first `unbiasedness` part on its first test-bed case (cheap to
 /// derive: no test bed is built).
 fn first_sweep(registry: &Registry, mode: Mode) -> Sweep {
-    let mut s = crate::unbiasedness::parts(registry, mode).into_iter().next().map(|p| p.sweep).unwrap_or(Sweep {
-        experiment: NAME.into(),
-        testbeds: Vec::new(),
-        estimators: Vec::new(),
-        budgets: Vec::new(),
-        reps: 2,
-        seed: 1,
-        mode,
-        baseline: None,
-        claims: Vec::new(),
-        bias_tolerance: None,
-    });
+    let mut s = crate::unbiasedness::experiment().sweep(registry, mode);
     s.experiment = NAME.into();
     s.testbeds.truncate(1);
     s
