@@ -70,7 +70,10 @@ pub struct RunResults {
 struct Item {
     values: Vec<Rgb>,
     costs: Costs,
+    /// Wall-clock seconds per estimate.
     time: TimeStats,
+    /// The estimating thread's CPU seconds per estimate.
+    cpu_time: TimeStats,
     diagnostics: Vec<(String, f64)>,
 }
 
@@ -99,7 +102,9 @@ struct CellRun<'a> {
     samples: Option<u64>,
 }
 
-/// One sequence of integrals (`frames` long, from integral `first`) estimated on its own stream.
+/// One sequence of integrals (`frames` long, from integral `first`) estimated on its own stream;
+/// its wall-clock and CPU time (the calling thread's clock, which does not advance while the thread
+/// waits for a core or sleeps) are split evenly over its estimates.
 fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> Result<()> {
     let CellRun { plan, label, bi, ei, budget, samples } = *cell;
     let (b, e) = (&plan.beds[bi], &plan.estimators[ei]);
@@ -118,9 +123,10 @@ fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> R
         None => Task::new(b.bed.as_ref(), i, budget),
     };
     let tasks: Vec<Task<'_>> = (first..first + frames).map(task).collect();
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), crate::cputime::thread_seconds());
     let values = e.estimator.estimate_sequence(&tasks, &mut rng);
     let seconds = t0.elapsed().as_secs_f64() / frames as f64;
+    let cpu_seconds = (crate::cputime::thread_seconds() - c0).max(0.0) / frames as f64;
     let wrap = |source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.to_string(), source };
     let values = values.map_err(wrap)?;
     if values.len() != frames {
@@ -135,6 +141,7 @@ fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> R
             task.note("samples_per_estimate", n as f64);
         }
         out.time.push(seconds);
+        out.cpu_time.push(cpu_seconds);
         add(&mut out.costs, &task.costs());
         add_diagnostics(&mut out.diagnostics, &task.diagnostics());
         out.values.push(v);
@@ -360,6 +367,9 @@ pub fn run_blocks_with(
             part.estimates += r.values.len() as u64;
             add(&mut part.costs, &r.costs);
             part.time.merge(&r.time);
+            if let Some(t) = &mut part.cpu_time {
+                t.merge(&r.cpu_time);
+            }
             add_diagnostics(&mut part.diagnostics, &r.diagnostics);
         }
         if let Some((p, _, acc)) = rep_acc.take() {
@@ -402,6 +412,7 @@ fn empty_cell(key: CellKey, n: usize) -> CellResult {
         costs: Costs::default(),
         estimates: 0,
         time: TimeStats::default(),
+        cpu_time: Some(TimeStats::default()),
         diagnostics: Vec::new(),
         rep_dev: Moments::default(),
         rep_sq: Moments::default(),
@@ -422,6 +433,7 @@ fn merge_into(out: &mut CellResult, p: &CellResult) {
     out.estimates += p.estimates;
     add(&mut out.costs, &p.costs);
     out.time.merge(&p.time);
+    out.merge_cpu_time(p);
     add_diagnostics(&mut out.diagnostics, &p.diagnostics);
     out.rep_dev.merge(&p.rep_dev);
     out.rep_sq.merge(&p.rep_sq);
