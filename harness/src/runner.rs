@@ -243,9 +243,10 @@ fn samples_for_time_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) ->
 }
 
 /// Repetitions per block. A cell's repetitions are reduced block by block (Welford pushes in
-/// repetition order inside a block, [`Moments::merge`] of the blocks in block order), so the block
-/// is the unit a shard (`--shard i/n`) can own: the split is fixed by the sweep's `reps` alone,
-/// never by the thread or shard count, and a merge of shards reproduces a single run bit for bit.
+/// repetition order inside a block, [`Moments::merge`](estimators::stats::Moments::merge) of the
+/// blocks in block order), so the block is the unit a shard (`--shard i/n`) can own: the split is
+/// fixed by the sweep's `reps` alone, never by the thread or shard count, and a merge of shards
+/// reproduces a single run bit for bit.
 /// A cell of at most `REP_BLOCK` repetitions is one block, reduced exactly as before blocks existed.
 pub const REP_BLOCK: usize = 16;
 
