@@ -50,17 +50,21 @@ struct Table2Row<'a> {
     method: &'a str,
     /// Samples per pixel.
     spp: u64,
-    /// Seconds for the whole image (the paper's T; ours: seconds per estimate x pixels).
+    /// Seconds for the whole image (the paper's T; ours: CPU seconds per estimate x pixels, the T
+    /// of our P-Eff).
     image_seconds: f64,
     /// Perceptual error Err (ours: mean over pixels of MSE / tvi(reference luminance)).
     err: f64,
     /// P-Eff = 1 / (image seconds x Err) (empty when ours has no timing).
     p_eff: Option<f64>,
-    /// Our plain efficiency 1 / (MSE x seconds per estimate) (empty for the paper's rows and
+    /// Our plain efficiency 1 / (MSE x CPU seconds per estimate) (empty for the paper's rows and
     /// without timing).
     efficiency_mse: Option<f64>,
     /// Our RMSE (empty for the paper's rows).
     rmse: Option<f64>,
+    /// Ours: wall-clock seconds per estimate x pixels, which machine load inflates (empty for the
+    /// paper's rows).
+    image_seconds_wall: Option<f64>,
 }
 
 /// One row of `alpha_maps.csv`: the PMC-HI mixture weights of one pixel after one estimate of
@@ -98,6 +102,7 @@ fn table2(report: &RunReport) -> Vec<Table2Row<'_>> {
             p_eff: Some(p_eff),
             efficiency_mse: None,
             rmse: None,
+            image_seconds_wall: None,
         });
     }
     for r in report.rows.iter().filter(|r| r.testbed == "checker-direct") {
@@ -107,11 +112,12 @@ fn table2(report: &RunReport) -> Vec<Table2Row<'_>> {
             variant: &r.variant,
             method: &r.estimator,
             spp: r.budget,
-            image_seconds: r.seconds * r.integrals as f64,
+            image_seconds: r.metric_seconds() * r.integrals as f64,
             err: r.p_err,
             p_eff: r.p_eff,
             efficiency_mse: r.efficiency_mse,
             rmse: Some(r.rmse),
+            image_seconds_wall: Some(r.seconds * r.integrals as f64),
         });
     }
     rows

@@ -1,5 +1,6 @@
 //! One cell of a sweep, (test bed, variant, estimator, budget), and its sufficient statistics:
-//! per-integral moments over repetitions, cost totals, and a log-histogram of estimate times.
+//! per-integral moments over repetitions, cost totals, and log-histograms of estimate times (wall
+//! clock and the thread's CPU clock).
 //! Cells are what the harness stores for resuming and what shards will merge.
 
 use estimators::budget::Budget;
@@ -52,7 +53,7 @@ impl CellKey {
 /// Estimate times: total and a histogram of `round(16 log2(seconds))` for medians.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct TimeStats {
-    /// Sum of single-thread seconds.
+    /// Sum of seconds (one thread's, per estimate).
     pub total: f64,
     /// Number of timed estimates.
     pub count: u64,
@@ -112,8 +113,13 @@ pub struct CellResult {
     pub costs: Costs,
     /// Number of estimates (reps x integrals).
     pub estimates: u64,
-    /// Estimate times.
+    /// Estimate times on the wall clock.
     pub time: TimeStats,
+    /// Estimate times on the estimating thread's CPU clock ([`crate::cputime::thread_seconds`]):
+    /// what time-based metrics use, since load from other processes does not inflate it. `None`
+    /// in cells stored before it was measured (their metrics fall back to [`Self::time`]).
+    #[serde(default)]
+    pub cpu_time: Option<TimeStats>,
     /// Sums over estimates of each diagnostic the estimator noted (name, sum).
     #[serde(default)]
     pub diagnostics: Vec<(String, f64)>,
@@ -130,6 +136,24 @@ pub struct CellResult {
 }
 
 impl CellResult {
+    /// The times time-based metrics use: CPU times, or wall times for a cell stored before CPU
+    /// times were measured (the second value says which: `true` for CPU).
+    pub fn metric_time(&self) -> (&TimeStats, bool) {
+        match &self.cpu_time {
+            Some(t) => (t, true),
+            None => (&self.time, false),
+        }
+    }
+
+    /// Merges another part's CPU times into this one's; a part without them (stored before they
+    /// were measured) leaves the merged cell without them, so it falls back to wall time as a whole.
+    pub fn merge_cpu_time(&mut self, other: &CellResult) {
+        match (&mut self.cpu_time, &other.cpu_time) {
+            (Some(a), Some(b)) => a.merge(b),
+            _ => self.cpu_time = None,
+        }
+    }
+
     /// Checks a cell read back from a file against what the plan expects of it: `integrals`
     /// integrals with `reps` repetitions each, `reps x integrals` estimates, finite statistics.
     /// `Err` says what is wrong, for a one-line refusal naming the file.
@@ -156,6 +180,11 @@ impl CellResult {
         }
         if self.time.count != self.estimates || !self.time.total.is_finite() || self.time.total < 0.0 {
             return Err("its estimate times do not match its estimates".into());
+        }
+        if let Some(t) = &self.cpu_time {
+            if t.count != self.estimates || !t.total.is_finite() || t.total < 0.0 {
+                return Err("its CPU times do not match its estimates".into());
+            }
         }
         if let Some((name, _)) = self.diagnostics.iter().find(|(_, v)| !v.is_finite()) {
             return Err(format!("diagnostic `{name}` is not finite"));

@@ -90,6 +90,7 @@ pub fn cell_of(bed: &dyn TestBed, estimator: &str, budget: Budget, seed: u64, pe
         costs: Default::default(),
         estimates: (per_rep.len() * n) as u64,
         time: Default::default(),
+        cpu_time: None,
         diagnostics: Vec::new(),
         rep_dev,
         rep_sq,

@@ -75,6 +75,7 @@ pub mod error;
 pub mod execute;
 pub mod folder;
 pub mod guarded;
+pub mod interleave;
 pub mod limits;
 pub mod listing;
 pub mod merge;

@@ -1,6 +1,8 @@
 //! SPEC §5 metrics of one cell against its test bed's reference: RMSE (noise-corrected for
 //! stored references: `E[(X - R)^2] = MSE + Var R`), variance, pooled bias with its standard
-//! error, costs per estimate, efficiency and FoM.
+//! error, costs per estimate, efficiency and FoM. Time-based metrics (efficiency, P-Eff) use the
+//! estimating thread's CPU seconds, which load from other processes does not inflate; wall-clock
+//! seconds are reported beside them.
 
 use crate::cell::CellResult;
 use estimators::stats::NeumaierSum;
@@ -43,9 +45,10 @@ pub struct SummaryRow {
     pub fetches: f64,
     /// Rays per estimate.
     pub rays: f64,
-    /// Mean single-thread seconds per estimate (timing: varies run to run).
+    /// Mean wall-clock seconds per estimate on the thread that computed it (timing: varies run to
+    /// run, and with the load of the machine).
     pub seconds: f64,
-    /// 1 / (variance x seconds) (timing).
+    /// 1 / (variance x CPU seconds per estimate) (`cpu_seconds`; timing).
     pub efficiency: Option<f64>,
     /// 1 / (MSE x fetches per estimate), empty without fetches.
     pub fom: Option<f64>,
@@ -55,16 +58,16 @@ pub struct SummaryRow {
     pub reference_var: f64,
     /// Cheap approximate-extinction fetches per estimate.
     pub cheap_fetches: f64,
-    /// Median single-thread seconds per estimate (timing).
+    /// Median wall-clock seconds per estimate (timing).
     pub seconds_median: f64,
-    /// 1 / (MSE x seconds) (timing).
+    /// 1 / (MSE x CPU seconds per estimate) (`cpu_seconds`; timing).
     pub efficiency_mse: Option<f64>,
     /// Paper 003's perceptual error `Err` = mean over integrals of `MSE / tvi(L_ref)` (channel-mean
     /// MSE; reference luminance).
     #[serde(default)]
     pub p_err: f64,
-    /// Paper 003's `P-Eff = 1 / (T Err)` with `T` the single-thread seconds of a whole image
-    /// (seconds per estimate x integrals) (timing).
+    /// Paper 003's `P-Eff = 1 / (T Err)` with `T` the CPU seconds of a whole image
+    /// (`cpu_seconds` x integrals) (timing).
     #[serde(default)]
     pub p_eff: Option<f64>,
     /// Registered id of the estimator (`estimator` is the id with the parameters given).
@@ -81,10 +84,39 @@ pub struct SummaryRow {
     /// NaN in files written before it and for fewer than 2 repetitions.
     #[serde(default = "crate::output::nan")]
     pub mse_se: f64,
+    /// Mean CPU seconds per estimate: the estimating thread's CPU clock, which does not advance
+    /// while the thread waits for a core or sleeps, so machine load does not inflate it the way it
+    /// inflates `seconds` (timing). Every time-based metric divides by it. For cells stored before
+    /// CPU time was measured it is the wall-clock `seconds` (`time_clock` says `wall`); NaN in files
+    /// written before it.
+    #[serde(default = "crate::output::nan")]
+    pub cpu_seconds: f64,
+    /// 1 / (variance x wall-clock seconds per estimate): the efficiency as it was computed before
+    /// CPU time, which load from other processes lowers (timing).
+    #[serde(default)]
+    pub efficiency_wall: Option<f64>,
+    /// The clock the time-based metrics (`cpu_seconds`, `efficiency`, `efficiency_mse`, `p_eff`)
+    /// use: `cpu`, or `wall` for a cell stored before CPU time was measured (empty in files written
+    /// before this column, whose time-based metrics all used wall-clock seconds).
+    #[serde(default)]
+    pub time_clock: String,
+}
+
+impl SummaryRow {
+    /// Seconds per estimate for time-based metrics: `cpu_seconds`, or the wall-clock `seconds` in
+    /// rows read from files written before CPU time was measured.
+    pub fn metric_seconds(&self) -> f64 {
+        if self.cpu_seconds.is_finite() {
+            self.cpu_seconds
+        } else {
+            self.seconds
+        }
+    }
 }
 
 /// Column names whose values depend on the wall clock (excluded from determinism checks).
-pub const TIMING_COLUMNS: &[&str] = &["seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff"];
+pub const TIMING_COLUMNS: &[&str] =
+    &["seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff", "cpu_seconds", "efficiency_wall"];
 
 fn inverse(x: f64) -> Option<f64> {
     (x > 0.0 && x.is_finite()).then(|| 1.0 / x)
@@ -130,6 +162,8 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
     let mse_v = mse.value() / m;
     let variance = var.value() / m;
     let seconds = cell.time.mean();
+    let (metric_time, cpu) = cell.metric_time();
+    let cpu_seconds = metric_time.mean();
     let fetches = per(cell.costs.fetches);
     SummaryRow {
         testbed: cell.key.testbed.clone(),
@@ -148,19 +182,22 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         fetches,
         rays: per(cell.costs.rays),
         seconds,
-        efficiency: inverse(variance * seconds),
+        efficiency: inverse(variance * cpu_seconds),
         fom: if fetches > 0.0 { inverse(mse_v * fetches) } else { None },
         rel_rmse: (rel.value() / rel_n.max(1) as f64).max(0.0).sqrt(),
         reference_var: ref_var.value() / m,
         cheap_fetches: per(cell.costs.cheap_fetches),
         seconds_median: cell.time.median(),
-        efficiency_mse: inverse(mse_v * seconds),
+        efficiency_mse: inverse(mse_v * cpu_seconds),
         p_err: p_err.value() / cell.moments.len().max(1) as f64,
-        p_eff: inverse(seconds * cell.moments.len() as f64 * p_err.value() / cell.moments.len().max(1) as f64),
+        p_eff: inverse(cpu_seconds * cell.moments.len() as f64 * p_err.value() / cell.moments.len().max(1) as f64),
         estimator_id: String::new(),
         params: String::new(),
         testbed_params: String::new(),
         mse_se: if cell.rep_sq.count() >= 2 { (cell.rep_sq.variance() / reps).sqrt() } else { f64::NAN },
+        cpu_seconds,
+        efficiency_wall: inverse(variance * seconds),
+        time_clock: if cpu { "cpu" } else { "wall" }.to_string(),
     }
 }
 

@@ -210,6 +210,9 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "params",
     "testbed_params",
     "mse_se",
+    "cpu_seconds",
+    "efficiency_wall",
+    "time_clock",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).

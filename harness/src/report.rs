@@ -192,9 +192,22 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
             sr,
             ov,
             su,
+            sig(s.overhead_wall, 4),
+            sig(s.speedup_wall, 4),
         ]
     });
-    let header = ["testbed", "variant", "estimator", "baseline", "budget", "sample ratio", "overhead", "speed-up"];
+    let header = [
+        "testbed",
+        "variant",
+        "estimator",
+        "baseline",
+        "budget",
+        "sample ratio",
+        "overhead (CPU)",
+        "speed-up (CPU)",
+        "overhead (wall)",
+        "speed-up (wall)",
+    ];
     section(&mut out, "Speed-ups", &header, speedups.collect(), "No speed-ups computed.");
 
     let tests = report.tests.iter().map(|t| {
@@ -334,7 +347,7 @@ fn results_table(out: &mut String, report: &RunReport, testbed: &str, variant: &
     if fetches {
         header.push("fetches");
     }
-    header.extend(["seconds", "efficiency"]);
+    header.extend(["seconds (wall)", "seconds (CPU)", "efficiency"]);
     if fetches {
         header.push("FoM");
     }
@@ -352,7 +365,7 @@ fn results_table(out: &mut String, report: &RunReport, testbed: &str, variant: &
             if fetches {
                 v.push(count(r.fetches));
             }
-            v.extend([sig(r.seconds, 4), opt(r.efficiency)]);
+            v.extend([sig(r.seconds, 4), sig(r.cpu_seconds, 4), opt(r.efficiency)]);
             if fetches {
                 v.push(opt(r.fom));
             }

@@ -1,23 +1,24 @@
 //! Executing a [`Plan`]: every cell's repetitions in parallel (rayon) in fixed batches, each
 //! estimate on its own counter-derived stream, reduced in index order so results are bit-identical
-//! whatever the thread count; finished cells are stored and read back on a re-run (resume).
+//! whatever the thread count; the cells of one (test bed, budget) run interleaved
+//! ([`crate::interleave`]) so that machine load falls on the estimators they compare alike; each
+//! estimate's wall and CPU time are measured; finished cells are stored and read back on a re-run
+//! (resume).
 
 use crate::cell::{add_diagnostics, CellKey, CellResult, TimeStats};
 use crate::error::{HarnessError, Result};
+use crate::interleave::empty_cell;
+pub use crate::interleave::{run_group_with, GroupCell};
 use crate::output::write_atomic;
 use crate::plan::Plan;
 use estimators::budget::{Budget, BudgetKind};
 use estimators::error::EstimateError;
 use estimators::math::Rgb;
 use estimators::rng::StreamKey;
-use estimators::stats::Moments;
 use estimators::task::{Costs, Task, FETCH_BUDGET_SAMPLE_CAP};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// Integrals per work item: small enough to balance, large enough to amortise scheduling.
-const BATCH: usize = 16;
 
 /// Receives progress (no-op by default): the CLI draws bars from it.
 ///
@@ -66,15 +67,19 @@ pub struct RunResults {
     pub cells: Vec<(usize, usize, CellResult)>,
 }
 
+/// What one work item (one or more sequences of one repetition) produced.
 #[derive(Default)]
-struct Item {
-    values: Vec<Rgb>,
-    costs: Costs,
-    time: TimeStats,
-    diagnostics: Vec<(String, f64)>,
+pub(crate) struct Item {
+    pub(crate) values: Vec<Rgb>,
+    pub(crate) costs: Costs,
+    /// Wall-clock seconds per estimate.
+    pub(crate) time: TimeStats,
+    /// The estimating thread's CPU seconds per estimate.
+    pub(crate) cpu_time: TimeStats,
+    pub(crate) diagnostics: Vec<(String, f64)>,
 }
 
-fn add(a: &mut Costs, b: &Costs) {
+pub(crate) fn add_costs(a: &mut Costs, b: &Costs) {
     a.samples += b.samples;
     a.fetches += b.fetches;
     a.cheap_fetches += b.cheap_fetches;
@@ -87,20 +92,22 @@ const PILOT_REP: u64 = u64::MAX;
 const PILOT_SEQUENCES: usize = 64;
 
 /// One cell's fixed inputs: which pair, which budget, and the sample count a fetch budget became.
-struct CellRun<'a> {
-    plan: &'a Plan,
+pub(crate) struct CellRun<'a> {
+    pub(crate) plan: &'a Plan,
     /// The test bed's label (stream key and error messages), formatted once per cell rather than
     /// once per sequence (it was a third of the harness's own work per estimate).
-    label: &'a str,
-    bi: usize,
-    ei: usize,
-    budget: Budget,
+    pub(crate) label: &'a str,
+    pub(crate) bi: usize,
+    pub(crate) ei: usize,
+    pub(crate) budget: Budget,
     /// A fetch budget converted into a fixed sample count ([`Task::with_samples`]).
-    samples: Option<u64>,
+    pub(crate) samples: Option<u64>,
 }
 
-/// One sequence of integrals (`frames` long, from integral `first`) estimated on its own stream.
-fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> Result<()> {
+/// One sequence of integrals (`frames` long, from integral `first`) estimated on its own stream;
+/// its wall-clock and CPU time (the calling thread's clock, which does not advance while the thread
+/// waits for a core or sleeps) are split evenly over its estimates.
+pub(crate) fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> Result<()> {
     let CellRun { plan, label, bi, ei, budget, samples } = *cell;
     let (b, e) = (&plan.beds[bi], &plan.estimators[ei]);
     let frames = b.bed.sequence_length().max(1);
@@ -118,9 +125,10 @@ fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> R
         None => Task::new(b.bed.as_ref(), i, budget),
     };
     let tasks: Vec<Task<'_>> = (first..first + frames).map(task).collect();
-    let t0 = Instant::now();
+    let (t0, c0) = (Instant::now(), crate::cputime::thread_seconds());
     let values = e.estimator.estimate_sequence(&tasks, &mut rng);
     let seconds = t0.elapsed().as_secs_f64() / frames as f64;
+    let cpu_seconds = (crate::cputime::thread_seconds() - c0).max(0.0) / frames as f64;
     let wrap = |source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.to_string(), source };
     let values = values.map_err(wrap)?;
     if values.len() != frames {
@@ -135,7 +143,8 @@ fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> R
             task.note("samples_per_estimate", n as f64);
         }
         out.time.push(seconds);
-        add(&mut out.costs, &task.costs());
+        out.cpu_time.push(cpu_seconds);
+        add_costs(&mut out.costs, &task.costs());
         add_diagnostics(&mut out.diagnostics, &task.diagnostics());
         out.values.push(v);
     }
@@ -189,7 +198,7 @@ fn samples_for_fetch_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -
     for p in pilots {
         let p = p?;
         if p.costs.fetches > 0 {
-            add(&mut costs, &p.costs);
+            add_costs(&mut costs, &p.costs);
         }
     }
     let cap = budget.amount.saturating_mul(FETCH_BUDGET_SAMPLE_CAP);
@@ -234,15 +243,12 @@ fn samples_for_time_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) ->
 }
 
 /// Repetitions per block. A cell's repetitions are reduced block by block (Welford pushes in
-/// repetition order inside a block, [`Moments::merge`] of the blocks in block order), so the block
-/// is the unit a shard (`--shard i/n`) can own: the split is fixed by the sweep's `reps` alone,
-/// never by the thread or shard count, and a merge of shards reproduces a single run bit for bit.
+/// repetition order inside a block, [`Moments::merge`](estimators::stats::Moments::merge) of the
+/// blocks in block order), so the block is the unit a shard (`--shard i/n`) can own: the split is
+/// fixed by the sweep's `reps` alone, never by the thread or shard count, and a merge of shards
+/// reproduces a single run bit for bit.
 /// A cell of at most `REP_BLOCK` repetitions is one block, reduced exactly as before blocks existed.
 pub const REP_BLOCK: usize = 16;
-
-/// At most this many work items (one repetition of one batch of integrals) are in flight at once:
-/// blocks run a chunk at a time, so memory does not grow with the repetition count.
-const MAX_ITEMS: usize = 8192;
 
 /// The number of repetition blocks of a sweep with `reps` repetitions.
 pub fn rep_blocks(reps: usize) -> usize {
@@ -275,7 +281,7 @@ pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[u
 /// The sample count a budget becomes before a cell runs: a fetch or time budget is calibrated
 /// by a pilot ([`samples_for_fetch_budget`], [`samples_for_time_budget`]); a sample budget is used
 /// as it is (`None`).
-fn calibrated_samples(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Option<u64>> {
+pub(crate) fn calibrated_samples(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Option<u64>> {
     Ok(match budget.kind {
         BudgetKind::Fetches => Some(samples_for_fetch_budget(plan, bi, ei, budget)?),
         BudgetKind::Micros => Some(samples_for_time_budget(plan, bi, ei, budget)?),
@@ -285,14 +291,8 @@ fn calibrated_samples(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Resu
 
 /// Runs the given repetition blocks of one cell and hands each block's sufficient statistics
 /// (a [`CellResult`] over that block's repetitions, keyed by the whole cell) to `sink` with its
-/// position in `blocks`, in that order, as soon as it is reduced; blocks run a chunk at a time so
-/// that memory stays bounded whatever the repetition count.
-/// Work items are whole sequences (test beds whose integrals come in frames,
-/// [`estimators::testbed::TestBed::sequence_length`]), batched to about `BATCH` integrals; each
-/// sequence draws from the stream of its first integral, so a static test bed (sequence length 1)
-/// keeps exactly the per-integral streams and batches it always had. A fetch budget first becomes a
-/// fixed sample count (`samples_for_fetch_budget`; its pilot is deterministic, so every shard
-/// owning a block of the cell computes the same count).
+/// position in `blocks`, in that order, as soon as it is reduced: [`run_group_with`] with this one
+/// cell.
 pub fn run_blocks_with(
     plan: &Plan,
     bi: usize,
@@ -301,111 +301,7 @@ pub fn run_blocks_with(
     blocks: &[usize],
     mut sink: impl FnMut(usize, CellResult) -> Result<()>,
 ) -> Result<()> {
-    let b = &plan.beds[bi];
-    let n = b.bed.integrals();
-    let frames = b.bed.sequence_length().max(1);
-    let sequences = n / frames;
-    let per_item = BATCH.div_ceil(frames);
-    let reps = plan.sweep.reps;
-    let batches = sequences.div_ceil(per_item);
-    if blocks.is_empty() {
-        return Ok(());
-    }
-    let samples = calibrated_samples(plan, bi, ei, budget)?;
-    let label = b.label();
-    let cell = CellRun { plan, label: &label, bi, ei, budget, samples };
-    let key = cell_key(plan, bi, ei, budget);
-    let per_chunk = (MAX_ITEMS / (REP_BLOCK * batches).max(1)).max(1);
-    for (c, chunk) in blocks.chunks(per_chunk).enumerate() {
-        // (position in `chunk`, repetition, batch), repetition-major inside each block.
-        let work: Vec<(usize, usize, usize)> = chunk
-            .iter()
-            .enumerate()
-            .flat_map(|(pos, &blk)| {
-                (blk * REP_BLOCK..((blk + 1) * REP_BLOCK).min(reps))
-                    .flat_map(move |rep| (0..batches).map(move |batch| (pos, rep, batch)))
-            })
-            .collect();
-        let items: Vec<Result<Item>> = work
-            .par_iter()
-            .map(|&(_, rep, batch)| {
-                let mut out = Item::default();
-                for s in batch * per_item..((batch + 1) * per_item).min(sequences) {
-                    run_sequence(&cell, rep as u64, s * frames, &mut out)?;
-                }
-                Ok(out)
-            })
-            .collect();
-        let mut parts = vec![empty_cell(key.clone(), n); chunk.len()];
-        let reference = &b.bed.reference().value;
-        // Items come repetition by repetition (every batch of one repetition, then the next), so a
-        // repetition's aggregates are complete when the next one starts.
-        let mut rep_acc: Option<(usize, usize, RepAggregate)> = None;
-        for (&(pos, rep, batch), r) in work.iter().zip(items) {
-            let r = r?;
-            if rep_acc.as_ref().is_some_and(|(p, q, _)| (*p, *q) != (pos, rep)) {
-                if let Some((p, _, acc)) = rep_acc.take() {
-                    acc.push_into(&mut parts[p]);
-                }
-            }
-            let acc = &mut rep_acc.get_or_insert_with(|| (pos, rep, RepAggregate::default())).2;
-            let part = &mut parts[pos];
-            for (k, v) in r.values.iter().enumerate() {
-                let i = batch * per_item * frames + k;
-                for c in 0..3 {
-                    part.moments[i][c].push(v[c]);
-                    acc.add(v[c] - reference[i][c]);
-                }
-            }
-            part.estimates += r.values.len() as u64;
-            add(&mut part.costs, &r.costs);
-            part.time.merge(&r.time);
-            add_diagnostics(&mut part.diagnostics, &r.diagnostics);
-        }
-        if let Some((p, _, acc)) = rep_acc.take() {
-            acc.push_into(&mut parts[p]);
-        }
-        for (k, part) in parts.into_iter().enumerate() {
-            sink(c * per_chunk + k, part)?;
-        }
-    }
-    Ok(())
-}
-
-/// One repetition's aggregates over every integral and channel, compensated: the summed deviation
-/// from the reference and the sum of squared deviations.
-#[derive(Default)]
-struct RepAggregate {
-    dev: estimators::stats::NeumaierSum,
-    sq: estimators::stats::NeumaierSum,
-    count: u64,
-}
-
-impl RepAggregate {
-    fn add(&mut self, deviation: f64) {
-        self.dev.add(deviation);
-        self.sq.add(deviation * deviation);
-        self.count += 1;
-    }
-    /// Adds the repetition to the cell's per-repetition statistics.
-    fn push_into(self, cell: &mut CellResult) {
-        cell.rep_dev.push(self.dev.value());
-        cell.rep_sq.push(self.sq.value() / self.count.max(1) as f64);
-    }
-}
-
-/// A cell of `n` integrals with no estimates yet.
-fn empty_cell(key: CellKey, n: usize) -> CellResult {
-    CellResult {
-        key,
-        moments: vec![[Moments::default(), Moments::default(), Moments::default()]; n],
-        costs: Costs::default(),
-        estimates: 0,
-        time: TimeStats::default(),
-        diagnostics: Vec::new(),
-        rep_dev: Moments::default(),
-        rep_sq: Moments::default(),
-    }
+    run_group_with(plan, bi, budget, &[GroupCell { ei, blocks }], |_, pos, part| sink(pos, part))
 }
 
 /// Adds one block's statistics into a cell's (blocks must come in block order for a
@@ -420,8 +316,9 @@ fn merge_into(out: &mut CellResult, p: &CellResult) {
         }
     }
     out.estimates += p.estimates;
-    add(&mut out.costs, &p.costs);
+    add_costs(&mut out.costs, &p.costs);
     out.time.merge(&p.time);
+    out.merge_cpu_time(p);
     add_diagnostics(&mut out.diagnostics, &p.diagnostics);
     out.rep_dev.merge(&p.rep_dev);
     out.rep_sq.merge(&p.rep_sq);
@@ -494,42 +391,69 @@ pub fn run(plan: &Plan, opts: &RunOptions<'_>) -> Result<RunResults> {
     run_preloaded(plan, opts, stored)
 }
 
-/// [`run`] with the stored cells already read by [`preload`].
+/// [`run`] with the stored cells already read by [`preload`]. The missing cells of one (test bed,
+/// budget) run together, interleaved ([`run_group_with`]); each is stored as soon as its group has
+/// finished, and the observer hears of a group's cells (in plan order) when the group is done.
 pub fn run_preloaded(plan: &Plan, opts: &RunOptions<'_>, stored: Vec<Option<CellResult>>) -> Result<RunResults> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
         .build()
         .map_err(|e| HarnessError::write("thread pool", e))?;
-    let total = plan.pairs.len() * plan.sweep.budgets.len();
-    let mut cells = Vec::with_capacity(total);
-    let mut stored = stored.into_iter();
-    for &(bi, ei) in &plan.pairs {
-        for &budget in &plan.sweep.budgets {
-            let key = cell_key(plan, bi, ei, budget);
-            let path = opts.cell_dir.as_ref().map(|d| d.join(key.file_name()));
-            let found = stored.next().flatten();
-            let resumed = found.is_some();
-            let cell = match found {
-                Some(c) => c,
-                None => {
-                    let c = pool.install(|| run_cell(plan, bi, ei, budget))?;
-                    if let Some(p) = &path {
-                        let text = serde_json::to_string(&c).map_err(|e| HarnessError::write(p, e))?;
-                        write_atomic(p, text.as_bytes())?;
-                    }
-                    c
-                }
-            };
-            let label = format!(
-                "{} {} {}={}",
-                plan.beds[bi].label(),
-                plan.estimators[ei].name,
-                budget.kind.name(),
-                budget.amount
-            );
-            opts.observer.cell_done(cells.len() + 1, total, &label, resumed);
-            cells.push((bi, ei, cell));
+    let budgets = plan.sweep.budgets.len();
+    let total = plan.pairs.len() * budgets;
+    let mut slots: Vec<Option<CellResult>> = stored;
+    slots.resize_with(total, || None);
+    let resumed: Vec<bool> = slots.iter().map(Option::is_some).collect();
+    let all_blocks: Vec<usize> = (0..rep_blocks(plan.sweep.reps)).collect();
+    let mut beds: Vec<usize> = Vec::new();
+    for &(bi, _) in &plan.pairs {
+        if !beds.contains(&bi) {
+            beds.push(bi);
         }
+    }
+    let mut done = 0;
+    for &bi in &beds {
+        let pairs: Vec<usize> = (0..plan.pairs.len()).filter(|&p| plan.pairs[p].0 == bi).collect();
+        for (bu, &budget) in plan.sweep.budgets.iter().enumerate() {
+            let missing: Vec<usize> = pairs.iter().copied().filter(|&p| slots[p * budgets + bu].is_none()).collect();
+            let group: Vec<GroupCell<'_>> =
+                missing.iter().map(|&p| GroupCell { ei: plan.pairs[p].1, blocks: &all_blocks }).collect();
+            let mut outs: Vec<CellResult> = missing
+                .iter()
+                .map(|&p| empty_cell(cell_key(plan, bi, plan.pairs[p].1, budget), plan.beds[bi].bed.integrals()))
+                .collect();
+            pool.install(|| {
+                run_group_with(plan, bi, budget, &group, |k, _, part| {
+                    merge_into(&mut outs[k], &part);
+                    Ok(())
+                })
+            })?;
+            for (&p, c) in missing.iter().zip(outs) {
+                if let Some(d) = &opts.cell_dir {
+                    let path = d.join(c.key.file_name());
+                    let text = serde_json::to_string(&c).map_err(|e| HarnessError::write(&path, e))?;
+                    write_atomic(&path, text.as_bytes())?;
+                }
+                slots[p * budgets + bu] = Some(c);
+            }
+            for &p in &pairs {
+                let label = format!(
+                    "{} {} {}={}",
+                    plan.beds[bi].label(),
+                    plan.estimators[plan.pairs[p].1].name,
+                    budget.kind.name(),
+                    budget.amount
+                );
+                done += 1;
+                opts.observer.cell_done(done, total, &label, resumed[p * budgets + bu]);
+            }
+        }
+    }
+    let mut cells = Vec::with_capacity(total);
+    for (c, slot) in slots.into_iter().enumerate() {
+        let (bi, ei) = plan.pairs[c / budgets];
+        let cell = slot.ok_or_else(|| HarnessError::Failed("a cell of the plan was not run".into()))?;
+        cells.push((bi, ei, cell));
     }
     Ok(RunResults { cells })
 }

@@ -254,22 +254,38 @@ pub fn run_shard(
         .build()
         .map_err(|e| HarnessError::write("thread pool", e))?;
     let blocks = runner::rep_blocks(plan.sweep.reps);
-    for (done, (pair, budget, missing)) in todo.iter().enumerate() {
-        let (bi, ei) = plan.pairs[*pair];
+    // The owned cells of one (test bed, budget) run together, interleaved, so that machine load
+    // falls on the estimators they compare alike; the owned blocks of one cell run together, so a
+    // fetch budget's pilot runs once per cell.
+    let mut groups: Vec<(usize, usize, Vec<usize>)> = Vec::new();
+    for (t, (pair, budget, _)) in todo.iter().enumerate() {
+        let bi = plan.pairs[*pair].0;
+        match groups.iter_mut().find(|g| (g.0, g.1) == (bi, *budget)) {
+            Some(g) => g.2.push(t),
+            None => groups.push((bi, *budget, vec![t])),
+        }
+    }
+    let mut done = 0;
+    for (bi, budget, members) in &groups {
         let budget = plan.sweep.budgets[*budget];
-        let key = runner::cell_key(plan, bi, ei, budget);
-        // The owned blocks of one cell run together, so a fetch budget's pilot runs once per cell.
+        let cells: Vec<runner::GroupCell<'_>> =
+            members.iter().map(|&t| runner::GroupCell { ei: plan.pairs[todo[t].0].1, blocks: &todo[t].2 }).collect();
+        let keys: Vec<CellKey> = cells.iter().map(|c| runner::cell_key(plan, *bi, c.ei, budget)).collect();
         pool.install(|| {
-            runner::run_blocks_with(plan, bi, ei, budget, missing, |pos, stats| {
-                let block = missing[pos];
-                let path = dir.join(block_file_name(&key, block));
+            runner::run_group_with(plan, *bi, budget, &cells, |k, pos, stats| {
+                let block = cells[k].blocks[pos];
+                let path = dir.join(block_file_name(&keys[k], block));
                 let file = BlockFile { block, blocks, stats };
                 let text = serde_json::to_string(&file).map_err(|e| HarnessError::write(&path, e))?;
                 write_atomic(&path, text.as_bytes())
             })
         })?;
-        let label = format!("{} {} {}={}", plan.beds[bi].label(), key.estimator, budget.kind.name(), budget.amount);
-        observer.cell_done(done + 1, todo.len(), &label, missing.is_empty());
+        for (c, key) in cells.iter().zip(&keys) {
+            let label =
+                format!("{} {} {}={}", plan.beds[*bi].label(), key.estimator, budget.kind.name(), budget.amount);
+            done += 1;
+            observer.cell_done(done, todo.len(), &label, c.blocks.is_empty());
+        }
     }
     let manifest = Manifest {
         format: FORMAT,

@@ -42,6 +42,7 @@ pub(crate) fn cell_from(per_rep: &[Vec<[f64; 3]>], reference: &Reference) -> Cel
         costs: Default::default(),
         estimates: (per_rep.len() * n) as u64,
         time: TimeStats::default(),
+        cpu_time: None,
         diagnostics: Vec::new(),
         rep_dev,
         rep_sq,

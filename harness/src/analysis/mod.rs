@@ -198,7 +198,8 @@ pub fn reps_for(d: f64, reps: usize, est_share: f64, tolerance: f64) -> Option<f
 
 /// The papers' speed-up at the rightmost budget (paper 000 §5, 001 §5): samples the baseline needs
 /// to reach the method's error (from the baseline's fitted slope) over the method's samples, divided
-/// by the method's overhead (its time per estimate over the baseline's).
+/// by the method's overhead (its CPU time per estimate over the baseline's; the wall-clock ratio is
+/// reported beside it).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SpeedUp {
     /// Test bed id.
@@ -214,12 +215,21 @@ pub struct SpeedUp {
     /// Baseline samples needed for the method's RMSE over the method's samples.
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub sample_ratio: f64,
-    /// Method seconds per estimate over the baseline's at the same budget.
+    /// Method CPU seconds per estimate over the baseline's at the same budget
+    /// ([`SummaryRow::metric_seconds`]).
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub overhead: f64,
     /// sample_ratio / overhead.
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub speedup: f64,
+    /// Method wall-clock seconds per estimate over the baseline's: what `overhead` was before CPU
+    /// time, which depends on how loaded the machine was while each cell ran (NaN in files written
+    /// before it).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub overhead_wall: f64,
+    /// sample_ratio / overhead_wall (NaN in files written before it).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup_wall: f64,
 }
 
 /// Speed-ups of every series against `baseline`.
@@ -242,7 +252,8 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str) -> Vec<SpeedU
         }
         let needed = ((last.rmse.ln() - fit.intercept) / fit.slope).exp();
         let sample_ratio = needed / last.budget as f64;
-        let overhead = last.seconds / base.seconds;
+        let overhead = last.metric_seconds() / base.metric_seconds();
+        let overhead_wall = last.seconds / base.seconds;
         out.push(SpeedUp {
             testbed: last.testbed.clone(),
             variant: last.variant.clone(),
@@ -252,6 +263,8 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str) -> Vec<SpeedU
             sample_ratio,
             overhead,
             speedup: sample_ratio / overhead,
+            overhead_wall,
+            speedup_wall: sample_ratio / overhead_wall,
         });
     }
     out
@@ -379,6 +392,9 @@ mod tests {
             params: String::new(),
             testbed_params: String::new(),
             mse_se: f64::NAN,
+            cpu_seconds: if est == "fast" { 0.75 * seconds } else { seconds },
+            efficiency_wall: None,
+            time_clock: "cpu".into(),
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {
@@ -387,9 +403,15 @@ mod tests {
         }
         let f = fits(&rows);
         let s = speedups(&rows, &f, "base");
-        // At 64 spp the fast method's RMSE 1/64 needs 4096 baseline samples: 64x, overhead 2x.
+        // At 64 spp the fast method's RMSE 1/64 needs 4096 baseline samples: 64x; overhead 1.5x
+        // in CPU time, 2x on the wall clock.
         assert_eq!(s.len(), 1);
-        assert!((s[0].sample_ratio - 64.0).abs() < 1e-6 && (s[0].overhead - 2.0).abs() < 1e-12);
-        assert!((s[0].speedup - 32.0).abs() < 1e-6);
+        assert!((s[0].sample_ratio - 64.0).abs() < 1e-6 && (s[0].overhead - 1.5).abs() < 1e-12);
+        assert!((s[0].speedup - 64.0 / 1.5).abs() < 1e-6);
+        assert!((s[0].overhead_wall - 2.0).abs() < 1e-12 && (s[0].speedup_wall - 32.0).abs() < 1e-6);
+        // Rows read from files written before CPU time: the wall clock, as then.
+        rows.iter_mut().for_each(|r| r.cpu_seconds = f64::NAN);
+        let s = speedups(&rows, &f, "base");
+        assert!((s[0].overhead - 2.0).abs() < 1e-12 && (s[0].speedup - 32.0).abs() < 1e-6);
     }
 }

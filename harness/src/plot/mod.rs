@@ -25,9 +25,9 @@ pub const PLOT_SIZE: (u32, u32) = (900, 650);
 pub enum PlotKind {
     /// RMSE against the budget.
     Rmse,
-    /// Efficiency 1 / (variance x seconds) against the budget.
+    /// Efficiency 1 / (variance x CPU seconds) against the budget.
     Efficiency,
-    /// RMSE against single-thread seconds per estimate.
+    /// RMSE against CPU seconds per estimate.
     RmseVsTime,
 }
 
@@ -188,9 +188,9 @@ fn figure(
     let (what, x_desc, y_desc) = match kind {
         PlotKind::Rmse => ("RMSE vs budget", budget_axis_label(budget_kind), "RMSE"),
         PlotKind::Efficiency => {
-            ("efficiency vs budget", budget_axis_label(budget_kind), "efficiency 1/(variance × seconds)")
+            ("efficiency vs budget", budget_axis_label(budget_kind), "efficiency 1/(variance × CPU seconds)")
         }
-        PlotKind::RmseVsTime => ("RMSE vs time", "seconds per estimate".to_string(), "RMSE"),
+        PlotKind::RmseVsTime => ("RMSE vs time", "CPU seconds per estimate".to_string(), "RMSE"),
     };
     let mut series = Vec::new();
     for (style, name) in estimators.iter().enumerate() {
@@ -203,7 +203,7 @@ fn figure(
             .filter_map(|r| match kind {
                 PlotKind::Rmse => positive(r.budget as f64, r.rmse),
                 PlotKind::Efficiency => r.efficiency.and_then(|e| positive(r.budget as f64, e)),
-                PlotKind::RmseVsTime => positive(r.seconds, r.rmse),
+                PlotKind::RmseVsTime => positive(r.metric_seconds(), r.rmse),
             })
             .collect();
         points.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -35,6 +35,9 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         params: String::new(),
         testbed_params: String::new(),
         mse_se: rmse * rmse * 0.3,
+        cpu_seconds: seconds,
+        efficiency_wall: Some(1.0 / (variance * seconds)),
+        time_clock: "cpu".into(),
     }
 }
 
@@ -97,6 +100,8 @@ pub fn synthetic_report() -> RunReport {
             sample_ratio: 20.0,
             overhead: 1.75,
             speedup: 11.43,
+            overhead_wall: 2.0,
+            speedup_wall: 10.0,
         }],
         skipped: vec![Skipped {
             testbed: "gradient-plane".into(),
