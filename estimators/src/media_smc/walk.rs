@@ -27,21 +27,31 @@ pub enum Flight {
     Collided(Vec3),
 }
 
-/// One free flight (paper 000 Eq. 7) in a homogeneous medium: the extinction is fetched once at
-/// the entry point (one fetch), the distance drawn from `sigma_t exp(-sigma_t s)`.
+/// One free flight (paper 000 Eq. 7): the distance drawn from `sigma_t(s) exp(-tau(0, s))` along
+/// the ray by delta tracking against the scene's majorant (Woodcock; paper 002 Eq. 4-5), so it
+/// is exact in heterogeneous media too. Each tentative collision fetches the extinction once
+/// and is real with probability `sigma_t / majorant`; in a homogeneous medium (`sigma_t` equal
+/// to the majorant) the first tentative collision is real and no acceptance number is drawn.
 pub fn free_flight<R: Rng + ?Sized>(probe: &MediumProbe<'_>, pos: Vec3, dir: Vec3, rng: &mut R) -> Flight {
     let Some((t0, t1)) = probe.clip(pos, dir) else {
         return Flight::Escaped(probe.environment(dir));
     };
-    let sigma = probe.sigma_t(pos + dir * (0.5 * (t0 + t1)));
-    if sigma <= 0.0 {
+    let majorant = probe.majorant();
+    if !(majorant > 0.0) {
+        // `0 <= sigma_t <= majorant`: nothing to collide with.
         return Flight::Escaped(probe.environment(dir));
     }
-    let s = t0 - (1.0 - rng.gen::<f64>()).ln() / sigma;
-    if s >= t1 {
-        Flight::Escaped(probe.environment(dir))
-    } else {
-        Flight::Collided(pos + dir * s)
+    let mut s = t0;
+    loop {
+        s -= (1.0 - rng.gen::<f64>()).ln() / majorant;
+        if s >= t1 {
+            return Flight::Escaped(probe.environment(dir));
+        }
+        let x = pos + dir * s;
+        let sigma = probe.sigma_t(x);
+        if sigma >= majorant || rng.gen::<f64>() * majorant < sigma {
+            return Flight::Collided(x);
+        }
     }
 }
 
