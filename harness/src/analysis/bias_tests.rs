@@ -177,3 +177,20 @@ fn repetitions_for_a_tolerance() {
     assert_eq!(reps_for(0.005, 100, 1.0, 0.01), None, "already resolved");
     assert_eq!(reps_for(0.02, 100, 0.1, 0.01), None, "the reference alone is too noisy");
 }
+
+/// Without a gate the per-integral test does not choose its integrals by their own skewness: it
+/// does not run, and the pooled test decides alone. With one, the decision is the weighted
+/// Bonferroni of the two: the pooled p over `POOLED_SHARE`, the Holm p over the rest.
+#[test]
+fn the_holm_test_needs_a_gate_and_the_decision_splits_alpha_by_share() {
+    let reference = exact(&[[1.0; 3]; 8]);
+    let cell = cell_from(&normal_reps(11, 8, 64, 1.0, 0.3), &reference);
+    let ungated = unbiasedness(&cell, &reference, Bias::Unbiased, None, DEFAULT_TOLERANCE);
+    assert!(ungated[0].p_value.is_nan() && ungated[0].untested == 24, "{:?}", ungated[0]);
+    assert_eq!(ungated[2].p_value, ungated[1].p_value);
+    let gate = Gate::from_cell(&cell_from(&normal_reps(12, 8, 64, 1.0, 0.3), &reference), "pilot", 1.0);
+    let rows = unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), DEFAULT_TOLERANCE);
+    let want = (rows[0].p_value / (1.0 - super::POOLED_SHARE)).min(rows[1].p_value / super::POOLED_SHARE).min(1.0);
+    assert_eq!(rows[2].p_value, want);
+    assert!(!rows[0].p_value.is_nan());
+}

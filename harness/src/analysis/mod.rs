@@ -3,7 +3,7 @@
 
 pub mod bias;
 
-pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE};
+pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE, POOLED_SHARE};
 
 use crate::metrics::SummaryRow;
 use estimators::stats::{log_log_fit, weighted_linear_fit, SlopeFit};
