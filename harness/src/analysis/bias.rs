@@ -92,7 +92,8 @@ pub struct TestRow {
     pub p_value: f64,
     /// `pass`, `inconclusive` or `biased`.
     pub verdict: String,
-    /// Family-wise alpha.
+    /// The level the row is decided at: its share of the family-wise alpha for the Holm and pooled
+    /// rows, the family-wise alpha for the combined row.
     #[serde(deserialize_with = "crate::output::f64_or_nan")]
     pub alpha: f64,
     /// Relative bias the test detects with 80% power (for the pooled and combined rows: over the
@@ -296,18 +297,22 @@ pub fn unbiasedness(
         rel_bias_se: f64::NAN,
         reason: String::new(),
     };
-    let (holm_name, max_t, p_holm, holm_detect, untested) = holm(cell, reference, gate, alpha);
-    let holm_verdict = if p_holm < alpha { "biased" } else { "inconclusive" };
+    // Each test at its share of alpha: the combined p below is below `alpha` exactly when one of
+    // them is below its share.
+    let (alpha_holm, alpha_pooled) = (alpha * (1.0 - POOLED_SHARE), alpha * POOLED_SHARE);
+    let (holm_name, max_t, p_holm, holm_detect, untested) = holm(cell, reference, gate, alpha_holm);
+    let holm_verdict = if p_holm < alpha_holm { "biased" } else { "inconclusive" };
     let mut holm_row = base(&holm_name, max_t, p_holm, holm_verdict, holm_detect);
+    holm_row.alpha = alpha_holm;
     holm_row.untested = untested;
     holm_row.reason = if holm_verdict == "biased" {
         format!("an integral flagged at Holm-adjusted p = {p_holm:.2e}")
     } else {
         "per-integral tests can flag a bias, never pass one: the combined row decides".into()
     };
-    let pl = pooled(cell, reference, gate, alpha, tolerance);
+    let pl = pooled(cell, reference, gate, alpha_pooled, tolerance);
     let p_pooled = if pl.gated_out.is_some() { f64::NAN } else { pl.p };
-    let pooled_verdict = if p_pooled < alpha {
+    let pooled_verdict = if p_pooled < alpha_pooled {
         "biased"
     } else if pl.gated_out.is_none() && gate.is_some() && pl.detectable <= tolerance {
         "pass"
@@ -315,6 +320,7 @@ pub fn unbiasedness(
         "inconclusive"
     };
     let mut pooled_row = base("pooled_t", pl.statistic, p_pooled, pooled_verdict, pl.detectable);
+    pooled_row.alpha = alpha_pooled;
     let p = match (p_holm.is_nan(), p_pooled.is_nan()) {
         (false, false) => (p_holm / (1.0 - POOLED_SHARE)).min(p_pooled / POOLED_SHARE).min(1.0),
         (false, true) => p_holm,
