@@ -20,6 +20,7 @@ pub mod lighting;
 pub mod math;
 pub mod media;
 pub mod media_smc;
+pub mod memo;
 pub mod parallel;
 pub mod params;
 pub mod perception;

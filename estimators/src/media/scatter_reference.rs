@@ -160,16 +160,10 @@ pub fn reference(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Referenc
     }
     // The nested quadrature takes seconds per bed; a process that builds the same bed again (the
     // pilot and the main plan of an experiment, a sweep re-planned per estimator) reuses it.
-    static COMPUTED: std::sync::OnceLock<std::sync::Mutex<Vec<(String, Reference)>>> = std::sync::OnceLock::new();
+    static COMPUTED: crate::memo::Memo<Reference> = crate::memo::Memo::new();
     let settings = Settings::of(bed.field());
     let key = format!("{:?}|{}", bed.reference_key(), settings.method());
-    let cache = COMPUTED.get_or_init(Default::default);
-    if let Some((_, r)) = cache.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(k, _)| *k == key) {
-        return Ok(r.clone());
-    }
-    let r = compute(bed, &settings);
-    cache.lock().unwrap_or_else(|e| e.into_inner()).push((key, r.clone()));
-    Ok(r)
+    Ok(COMPUTED.get_or_compute(key, || compute(bed, &settings)))
 }
 
 /// Computes the reference of every pixel with `s` (threads over pixels).

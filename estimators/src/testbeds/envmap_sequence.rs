@@ -122,6 +122,8 @@ pub struct EnvmapSequence {
     quantity: EnvQuantity,
     maps: Vec<EnvMap>,
     points: Vec<ShadingPoint>,
+    /// Everything the exact pixel references depend on (parameters and BRDF), for the memo.
+    setup: String,
     reference: Reference,
 }
 
@@ -171,14 +173,22 @@ impl EnvmapSequence {
             quantity,
             maps,
             points,
+            setup: format!("{p:?}|{brdf:?}"),
             reference: empty(),
         };
         bed.reference = bed.compute_reference();
         Ok(bed)
     }
 
-    /// The exact references of every pixel and frame (both quantities).
+    /// The exact references of every pixel and frame (both quantities), computed once per process
+    /// and setup (the quadrature over every texel takes seconds; an experiment builds the bed per
+    /// plan and seed).
     pub fn pixel_references(&self) -> Vec<PixelReference> {
+        static COMPUTED: crate::memo::Memo<Vec<PixelReference>> = crate::memo::Memo::new();
+        COMPUTED.get_or_compute(self.setup.clone(), || self.compute_pixel_references())
+    }
+
+    fn compute_pixel_references(&self) -> Vec<PixelReference> {
         let g = self.maps[0].grid();
         let table = TexelTable::new(g.width, g.height);
         (0..self.points.len() * self.frames)
