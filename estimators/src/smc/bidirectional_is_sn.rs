@@ -29,9 +29,12 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         Ok(Box::new(BidirectionalSn(p.common().config("bidirectional_is_sn", None)?)))
     },
     params: ParamSpec::of::<BidirectionalSnParams>(),
-    // Two candidates: the self-normalisation bias shrinks like 1/M, so more would hide it.
+    // Five candidates: the self-normalisation bias shrinks like 1/M, so many would hide it; at two
+    // (bias -56% on `specular`) the per-repetition sums are so skewed (4.5 against the pooled
+    // test's limit 2.95 at 1500 repetitions) that no seed can test it; at five the bias is about
+    // -20% and every seed can.
     checks: Checks {
-        params: &[("candidates", 2.0)],
+        params: &[("candidates", 5.0)],
         exempt: &[Exemption {
             testbed: "envmap-sequence",
             variants: &["*-lns"],

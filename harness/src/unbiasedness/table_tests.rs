@@ -41,7 +41,7 @@ fn verdicts_follow_the_papers_claims() {
 #[test]
 fn exempt_controls_are_expected_to_pass() {
     let mut r = row("biased", "pass", 0.5);
-    r.estimator = "bidirectional_is_sn[candidates=2]".into();
+    r.estimator = "bidirectional_is_sn[candidates=5]".into();
     r.testbed = "envmap-sequence".into();
     r.variant = "mixed-lns".into();
     let registry = crate::registry::Registry::builtin();
