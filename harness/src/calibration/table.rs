@@ -55,17 +55,33 @@ pub struct Row {
     pub firefly_rel_bias: f64,
     /// The fraction of seeds in which it is flagged.
     pub firefly_flag_rate: f64,
-    /// False-flag rate within 1.5x of nominal (None: fewer than 50 tested seeds, or a control).
+    /// False-flag rate consistent with 1.5x of nominal: its Wilson interval meets the band (None:
+    /// fewer than 50 tested seeds, a zero-variance estimator, or a control).
     pub ok_false_flag: Option<bool>,
     /// Reported detectable within 25% of the measured 80% point (None: the pooled test ran in
     /// fewer than 80% of seeds, so the rows are inconclusive and the detectable bias decides no pass).
     pub ok_detectable: Option<bool>,
-    /// A +1% bias flagged in at least 80% of the seeds that pass at 1% (None: no seed passes).
+    /// A +1% bias flagged in at least 80% of the seeds that pass at 1%, to within the Wilson
+    /// interval of the passing seeds (None: no seed passes).
     pub ok_power: Option<bool>,
     /// A control flagged in at least 99% of seeds (None: not a control).
     pub ok_control: Option<bool>,
     /// What the checks found.
     pub note: String,
+}
+
+/// The band the false-flag rate must be consistent with: within 1.5x of [`NOMINAL`].
+pub const SIZE_BAND: (f64, f64) = (NOMINAL / 1.5, NOMINAL * 1.5);
+/// The power at 1% a passing row must have.
+pub const MIN_POWER: f64 = 0.8;
+
+/// Whether `k` flags in `n` seeds are consistent with a rate inside [`SIZE_BAND`]: the 95% Wilson
+/// interval meets the band (with 100 seeds a test of size exactly 5% shows 3 or fewer flags in a
+/// quarter of families, so the point estimate alone would fail sized tests by chance; the pooled
+/// rate over all families, [`claims`], is the sharp check).
+pub fn within_band(k: usize, n: usize) -> bool {
+    let (lo, hi) = wilson(k, n);
+    hi >= SIZE_BAND.0 && lo <= SIZE_BAND.1
 }
 
 /// The 95% Wilson score interval of `k` successes in `n` trials.
@@ -120,14 +136,20 @@ pub fn row(family: &Family, m: &Measured, name: &str) -> Row {
     let tested_fraction = frac(tested.len(), n);
     let flag_rate = frac(s.iter().filter(|o| o.null.verdict == "biased").count(), n);
     let unbiased = family.bias == Bias::Unbiased;
-    let ok_false_flag = (unbiased && tested.len() >= 50).then(|| {
-        let r = frac(ff, tested.len());
-        (NOMINAL / 1.5..=NOMINAL * 1.5).contains(&r)
+    // A zero-variance estimator is compared exactly: no size to measure, any bias is flagged.
+    let deterministic = detectable == 0.0;
+    let ok_false_flag = (unbiased && !deterministic && tested.len() >= 50).then(|| within_band(ff, tested.len()));
+    let ok_detectable = (unbiased && tested_fraction >= 0.8).then(|| {
+        if deterministic {
+            measured_80 == grid[0]
+        } else {
+            measured_80.is_finite() && (detectable / measured_80 - 1.0).abs() <= 0.25
+        }
     });
-    let ok_detectable = (unbiased && tested_fraction >= 0.8)
-        .then(|| measured_80.is_finite() && (detectable / measured_80 - 1.0).abs() <= 0.25);
-    let power_1pct_on_pass = frac(passing.iter().filter(|o| o.flagged[i1]).count(), passing.len());
-    let ok_power = (unbiased && !passing.is_empty()).then_some(power_1pct_on_pass >= 0.8);
+    let on_pass = passing.iter().filter(|o| o.flagged[i1]).count();
+    let power_1pct_on_pass = frac(on_pass, passing.len());
+    // Not shown to be below 80%: the Wilson interval reaches it.
+    let ok_power = (unbiased && !passing.is_empty()).then(|| wilson(on_pass, passing.len()).1 >= MIN_POWER);
     let ok_control = (family.bias == Bias::Biased).then_some(flag_rate >= 0.99);
     let mut note = Vec::new();
     if unbiased && tested_fraction < 0.8 {
@@ -243,15 +265,65 @@ pub fn markdown(rows: &[Row], header: &str) -> String {
     s
 }
 
-/// The claims: one per check over every family it applies to.
+/// The pooled checks over every family they apply to: the false-flag rate over all tested seeds
+/// of unbiased families (point estimate inside [`SIZE_BAND`]) and the power at 1% over all passing
+/// seeds (point estimate at least [`MIN_POWER`]).
+fn pooled_claims(rows: &[Row]) -> Vec<Claim> {
+    let count = |x: f64, n: f64| (x * n).round() as usize;
+    let (mut ff, mut tested, mut flagged, mut passing) = (0, 0, 0, 0);
+    for r in rows.iter().filter(|r| r.claim == "unbiased") {
+        let t = count(r.tested_fraction, r.seeds as f64);
+        if r.ok_false_flag.is_some() {
+            ff += count(r.false_flag_rate, t as f64);
+            tested += t;
+        }
+        let p = count(r.pass_rate, r.seeds as f64);
+        if p > 0 {
+            flagged += count(r.power_1pct_on_pass, p as f64);
+            passing += p;
+        }
+    }
+    let claim = |text: &str, k: usize, n: usize, held: bool, what: &str| {
+        let (lo, hi) = wilson(k, n);
+        Claim {
+            testbed: "all".into(),
+            claim: format!("harness: {text}"),
+            paper_value: None,
+            our_value: (n > 0).then(|| k as f64 / n as f64),
+            held: (n > 0).then_some(held),
+            note: format!("{k} of {n} {what}: {:.1}% [{:.1}, {:.1}]", 100.0 * frac(k, n), 100.0 * lo, 100.0 * hi),
+        }
+    };
+    let rate = frac(ff, tested);
+    vec![
+        claim(
+            "false-flag rate pooled over the unbiased families within 1.5x of the nominal 5%",
+            ff,
+            tested,
+            (SIZE_BAND.0..=SIZE_BAND.1).contains(&rate),
+            "tested seeds flagged",
+        ),
+        claim(
+            "a 1% bias flagged in at least 80% of all passing seeds",
+            flagged,
+            passing,
+            frac(flagged, passing) >= MIN_POWER,
+            "passing seeds flag +1%",
+        ),
+    ]
+}
+
+/// The claims: one per check over every family it applies to, and the pooled checks.
 pub fn claims(rows: &[Row]) -> Vec<Claim> {
     type Check = fn(&Row) -> Option<bool>;
     let checks: [(&str, Check); 4] = [
-        ("false-flag rate within 1.5x of the nominal 5% on every unbiased family whose pooled test runs", |r| {
+        ("false-flag rate consistent with 1.5x of the nominal 5% on every unbiased family whose pooled test runs", |r| {
             r.ok_false_flag
         }),
         ("reported detectable bias within 25% of the measured 80% point on every resolved family", |r| r.ok_detectable),
-        ("a 1% bias flagged in at least 80% of the seeds of every row that passes at 1%", |r| r.ok_power),
+        ("a 1% bias flagged in at least 80% of the seeds of every row that passes at 1% (within its interval)", |r| {
+            r.ok_power
+        }),
         ("every control flagged in at least 99% of seeds", |r| r.ok_control),
     ];
     checks
@@ -278,6 +350,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
                 },
             }
         })
+        .chain(pooled_claims(rows))
         .collect()
 }
 
@@ -290,6 +363,15 @@ mod tests {
         let (lo, hi) = wilson(10, 200);
         assert!((lo - 0.0274).abs() < 5e-4 && (hi - 0.0898).abs() < 5e-4, "{lo} {hi}");
         assert_eq!(wilson(0, 0), (0.0, 1.0));
+    }
+
+    #[test]
+    fn the_size_band_takes_the_interval_into_account() {
+        // 2 of 100: the interval [0.6%, 7.0%] meets [3.3%, 7.5%]; 0 of 400 does not; 30 of 100 does not.
+        assert!(within_band(2, 100));
+        assert!(!within_band(0, 400));
+        assert!(!within_band(30, 100));
+        assert!(within_band(5, 100));
     }
 
     #[test]
