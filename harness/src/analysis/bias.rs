@@ -221,7 +221,13 @@ fn pooled(cell: &CellResult, reference: &Reference, gate: Option<&Gate>, alpha: 
     let mean = d.mean();
     let dev = mean - mean.clamp(-bound_total, bound_total);
     let sd_run = d.variance().sqrt();
-    let sd = gate.map_or(sd_run, |g| if g.rep_sd.is_nan() { sd_run } else { (0.5 * (sd_run * sd_run + g.rep_sd * g.rep_sd)).sqrt() });
+    let sd = gate.map_or(sd_run, |g| {
+        if g.rep_sd.is_nan() {
+            sd_run
+        } else {
+            (0.5 * (sd_run * sd_run + g.rep_sd * g.rep_sd)).sqrt()
+        }
+    });
     let a = sd * sd / r.max(1) as f64;
     let se = (a + var_ref).sqrt();
     let dof = if var_ref > 0.0 && a > 0.0 {

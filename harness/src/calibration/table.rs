@@ -317,9 +317,10 @@ fn pooled_claims(rows: &[Row]) -> Vec<Claim> {
 pub fn claims(rows: &[Row]) -> Vec<Claim> {
     type Check = fn(&Row) -> Option<bool>;
     let checks: [(&str, Check); 4] = [
-        ("false-flag rate consistent with 1.5x of the nominal 5% on every unbiased family whose pooled test runs", |r| {
-            r.ok_false_flag
-        }),
+        (
+            "false-flag rate consistent with 1.5x of the nominal 5% on every unbiased family whose pooled test runs",
+            |r| r.ok_false_flag,
+        ),
         ("reported detectable bias within 25% of the measured 80% point on every resolved family", |r| r.ok_detectable),
         ("a 1% bias flagged in at least 80% of the seeds of every row that passes at 1% (within its interval)", |r| {
             r.ok_power
