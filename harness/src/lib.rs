@@ -61,6 +61,7 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
+mod budget_pilot;
 pub mod calibration;
 pub mod cell;
 pub mod claim_spec;

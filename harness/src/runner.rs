@@ -15,7 +15,7 @@ use estimators::budget::{Budget, BudgetKind};
 use estimators::error::EstimateError;
 use estimators::math::Rgb;
 use estimators::rng::StreamKey;
-use estimators::task::{Costs, Task, FETCH_BUDGET_SAMPLE_CAP};
+use estimators::task::{Costs, Task};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -87,9 +87,7 @@ pub(crate) fn add_costs(a: &mut Costs, b: &Costs) {
 }
 
 /// Repetition index of the pilot stream that calibrates fetch budgets (never a real repetition).
-const PILOT_REP: u64 = u64::MAX;
-/// At most this many sequences (spread evenly over the test bed) run in a fetch-budget pilot.
-const PILOT_SEQUENCES: usize = 64;
+pub(crate) const PILOT_REP: u64 = u64::MAX;
 
 /// One cell's fixed inputs: which pair, which budget, and the sample count a fetch budget became.
 pub(crate) struct CellRun<'a> {
@@ -169,79 +167,6 @@ pub fn sequence_estimates(
     Ok(out.values)
 }
 
-/// The fixed number of samples per estimate that a fetch budget buys (paper 002 compares
-/// estimators at equal fetches per pixel). Stopping each estimate when its fetches run out would
-/// bias it ([`Task::with_samples`]), so a pilot pass on its own stream (repetition [`PILOT_REP`],
-/// up to [`PILOT_SEQUENCES`] sequences spread over the test bed) runs with that stopping rule, and
-/// `n = round(budget x pilot samples / pilot fetches)` over the pilot sequences that fetched at all,
-/// the same for every integral and repetition, as a renderer sets one spp for the whole image. The
-/// reported costs are the fetches the estimates really spent (pixels whose rays miss the medium
-/// spend none, so the image's mean is below the budget).
-fn samples_for_fetch_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<u64> {
-    let b = &plan.beds[bi];
-    let frames = b.bed.sequence_length().max(1);
-    let sequences = b.bed.integrals() / frames;
-    let picks = sequences.min(PILOT_SEQUENCES);
-    let label = b.label();
-    let pilot = CellRun { plan, label: &label, bi, ei, budget, samples: None };
-    let pilots: Vec<Result<Item>> = (0..picks)
-        .into_par_iter()
-        .map(|k| {
-            let mut out = Item::default();
-            run_sequence(&pilot, PILOT_REP, k * sequences / picks * frames, &mut out)?;
-            Ok(out)
-        })
-        .collect();
-    // Sequences that fetch nothing (their rays miss the medium) ran into the sample cap; they say
-    // nothing about what a fetch costs in samples, and every estimate there is free anyway.
-    let mut costs = Costs::default();
-    for p in pilots {
-        let p = p?;
-        if p.costs.fetches > 0 {
-            add_costs(&mut costs, &p.costs);
-        }
-    }
-    let cap = budget.amount.saturating_mul(FETCH_BUDGET_SAMPLE_CAP);
-    if costs.fetches == 0 {
-        return Ok(cap);
-    }
-    let n = (budget.amount as f64 * costs.samples as f64 / costs.fetches as f64).round();
-    Ok((n as u64).clamp(1, cap))
-}
-
-/// The fixed number of samples per estimate that a time budget buys: a pilot on its own stream
-/// (as for fetch budgets) runs the estimator until each pilot estimate's time is up, and
-/// `n = budget x pilot samples / pilot CPU microseconds`. Stopping each real estimate when its time
-/// runs out would make its sample count depend on the values drawn (slow paths and their values go
-/// together); a count fixed in advance does not. The count depends on the machine, so a time budget
-/// is the one setting whose results are not bit-reproducible (`meta.reproducible` says so).
-fn samples_for_time_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<u64> {
-    let b = &plan.beds[bi];
-    let frames = b.bed.sequence_length().max(1);
-    let sequences = b.bed.integrals() / frames;
-    let picks = sequences.min(PILOT_SEQUENCES);
-    let label = b.label();
-    let pilot = CellRun { plan, label: &label, bi, ei, budget, samples: None };
-    let pilots: Vec<Result<(u64, f64)>> = (0..picks)
-        .into_par_iter()
-        .map(|k| {
-            let mut out = Item::default();
-            let t0 = crate::cputime::thread_seconds();
-            run_sequence(&pilot, PILOT_REP, k * sequences / picks * frames, &mut out)?;
-            Ok((out.costs.samples, crate::cputime::thread_seconds() - t0))
-        })
-        .collect();
-    let (mut samples, mut seconds) = (0u64, 0.0f64);
-    for p in pilots {
-        let (n, s) = p?;
-        samples += n;
-        seconds += s;
-    }
-    let micros = (seconds * 1e6).max(1.0);
-    let n = (budget.amount as f64 * samples as f64 / micros).round();
-    Ok((n as u64).clamp(1, crate::limits::MAX_SAMPLES))
-}
-
 /// Repetitions per block. A cell's repetitions are reduced block by block (Welford pushes in
 /// repetition order inside a block, [`Moments::merge`](estimators::stats::Moments::merge) of the
 /// blocks in block order), so the block is the unit a shard (`--shard i/n`) can own: the split is
@@ -279,12 +204,12 @@ pub fn run_blocks(plan: &Plan, bi: usize, ei: usize, budget: Budget, blocks: &[u
 }
 
 /// The sample count a budget becomes before a cell runs: a fetch or time budget is calibrated
-/// by a pilot ([`samples_for_fetch_budget`], [`samples_for_time_budget`]); a sample budget is used
+/// by a pilot ([`crate::budget_pilot`]); a sample budget is used
 /// as it is (`None`).
 pub(crate) fn calibrated_samples(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Option<u64>> {
     Ok(match budget.kind {
-        BudgetKind::Fetches => Some(samples_for_fetch_budget(plan, bi, ei, budget)?),
-        BudgetKind::Micros => Some(samples_for_time_budget(plan, bi, ei, budget)?),
+        BudgetKind::Fetches => Some(crate::budget_pilot::samples_for_fetch_budget(plan, bi, ei, budget)?),
+        BudgetKind::Micros => Some(crate::budget_pilot::samples_for_time_budget(plan, bi, ei, budget)?),
         BudgetKind::Samples => None,
     })
 }
