@@ -24,7 +24,8 @@ pub struct Costs {
     pub fetches: u64,
     /// Cheap approximate-extinction evaluations (control variates), counted apart.
     pub cheap_fetches: u64,
-    /// Rays traced (incident-radiance queries, shadow rays, ...).
+    /// Rays traced: camera and incident-radiance queries, shadow rays, and in a medium every
+    /// free-flight segment of a path (one per scattering vertex left).
     pub rays: u64,
 }
 
@@ -299,6 +300,11 @@ impl MediumProbe<'_> {
     }
     /// Counts one more ray within the current sample (a shadow ray towards a light).
     pub fn shadow_ray(&self) {
+        self.task.count(|c| c.rays += 1);
+    }
+    /// Counts one more free-flight segment of the current path (the ray leaving a scattering
+    /// vertex): a renderer traces it like any other ray, so `rays` counts segments, not paths.
+    pub fn scattered_ray(&self) {
         self.task.count(|c| c.rays += 1);
     }
     /// Real extinction at `p`: one fetch.

@@ -119,6 +119,7 @@ pub fn independent_path<R: Rng + ?Sized>(probe: &MediumProbe<'_>, rng: &mut R) -
                 weight *= a;
                 pos = x;
                 dir = phase.sample(dir, rng).0;
+                probe.scattered_ray();
             }
         }
     }
@@ -244,6 +245,7 @@ pub fn smc_path<S: Scalar, R: Rng + ?Sized>(
                 vertices.push(v);
                 pos = x;
                 dir = w;
+                probe.scattered_ray();
             }
         }
     };

@@ -79,6 +79,7 @@ pub fn trace(
                     Phase::Rayleigh => rayleigh::sample(dir, rng),
                     other => other.sample(dir, rng).0,
                 };
+                probe.scattered_ray();
                 break;
             } else if xi < q_scat + q_tran {
                 e *= (1.0 - r) / q_tran;
