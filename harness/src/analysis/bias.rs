@@ -51,6 +51,9 @@ pub struct Gate {
     pub rep_sd: f64,
     /// Sample skewness per integral and channel.
     pub integral_skew: Vec<[f64; 3]>,
+    /// Sample variance of one repetition's estimate per integral and channel, scaled to the tested
+    /// cell.
+    pub integral_var: Vec<[f64; 3]>,
 }
 
 impl Gate {
@@ -65,6 +68,7 @@ impl Gate {
             rep_skew: skew(&cell.rep_dev),
             rep_sd: cell.rep_dev.variance().sqrt() * scale,
             integral_skew: cell.moments.iter().map(|m| [skew(&m[0]), skew(&m[1]), skew(&m[2])]).collect(),
+            integral_var: cell.moments.iter().map(|m| [0, 1, 2].map(|c| m[c].variance() * scale * scale)).collect(),
         }
     }
 }
@@ -159,18 +163,34 @@ fn holm(cell: &CellResult, reference: &Reference, gate: Option<&Gate>, alpha: f6
         let name = if stored_n.is_some() { "holm_welch" } else { "holm_t" };
         return (name.into(), f64::NAN, f64::NAN, f64::NAN, m);
     }
+    // The integrals of one test bed share their sampling process, and a pixel's sample skewness
+    // from a few hundred repetitions is low exactly when it missed its rare large values (in the
+    // pilot as in the cell). So no integral is tested below the pilot's median skewness over the
+    // image: where the typical integral is too skewed for a t-test, none is tested.
+    let floor = gate.map_or(0.0, |g| {
+        let mut all: Vec<f64> = g.integral_skew.iter().flatten().map(|s| s.abs()).filter(|s| s.is_finite()).collect();
+        all.sort_by(f64::total_cmp);
+        all.get(all.len() / 2).copied().unwrap_or(0.0)
+    });
     for (i, mom) in cell.moments.iter().enumerate() {
         for (c, mc) in mom.iter().enumerate() {
             let (r, rse) = (reference.value[i][c], reference.std_err[i][c]);
             let r_test = if stored_n.is_none() { mc.mean().clamp(r - bound, r + bound) } else { r };
-            let se = mc.std_err();
+            // As in the pooled test: the variance is the mean of the cell's and the gate's, so a
+            // cell that missed a rare large value (small spread, low mean) is not flagged on its own
+            // small standard error.
+            let var_gate = gate.and_then(|g| g.integral_var.get(i)).map(|v| v[c]).filter(|v| v.is_finite());
+            let se = match var_gate {
+                Some(v) if reps > 0 => ((0.5 * (mc.variance() + v)) / reps as f64).sqrt(),
+                _ => mc.std_err(),
+            };
             let se_total = (se * se + rse * rse).sqrt();
             if r != 0.0 {
                 detect
                     .push(detectable_shift_t(se_total, per_test_alpha, POWER, reps.saturating_sub(1) as f64) / r.abs());
             }
             let gate_skew = gate.and_then(|g| g.integral_skew.get(i)).map_or(0.0, |s| s[c].abs());
-            let skew = mc.skewness().abs().max(if gate_skew.is_nan() { 0.0 } else { gate_skew });
+            let skew = mc.skewness().abs().max(if gate_skew.is_nan() { 0.0 } else { gate_skew }).max(floor);
             let t = match stored_n {
                 None if se == 0.0 && mc.mean() == r_test => t_test(0.0, 0.0, f64::INFINITY),
                 None if deterministic => t_test(1.0, 0.0, f64::INFINITY),
