@@ -16,7 +16,6 @@ use estimators::error::EstimateError;
 use estimators::math::Rgb;
 use estimators::rng::StreamKey;
 use estimators::task::{Costs, Task};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

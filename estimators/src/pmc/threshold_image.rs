@@ -35,7 +35,11 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         Ok(Box::new(ThresholdImage { initial: p.initial, threshold: p.threshold }))
     },
     params: ParamSpec::of::<ThresholdImageParams>(),
-    checks: Checks::DEFAULT,
+    // Stopping at a relative standard error of 0.3: at 4 samples per pixel its bias on
+    // `checker-image` is about +3.6% (default) and +1.1% (occluded), 1.5-1.8x what 128 repetitions
+    // detect; at the default 0.1 it is smaller, and at 0.5 and above nearly every pixel stops at
+    // its first two samples, unbiased.
+    checks: Checks { params: &[("threshold", 0.3)], exempt: &[] },
 };
 
 /// Parameters of `threshold_image`.
