@@ -1,6 +1,6 @@
 //! Judging paper claims against a run: slope claims and speed-up claims.
 
-use crate::analysis::{Fit, SlopeRange, TestRow};
+use crate::analysis::{Fit, SlopeRange, SpeedUp, TestRow};
 use crate::output::{Claim, RunReport};
 
 /// The fit of an estimator on a test bed, if the run has one.
@@ -155,12 +155,36 @@ pub fn slope_steeper_than(
 /// speed-up beside it).
 pub fn speedup_claim(report: &RunReport, tb: (&str, &str), estimator: &str, paper: f64, claim: &str) -> Claim {
     let s = report.speedups.iter().find(|s| s.testbed == tb.0 && s.variant == tb.1 && s.estimator == estimator);
+    speedup_verdict(s, tb, (estimator, "the sweep's baseline"), paper, claim)
+}
+
+/// [`speedup_claim`] against a named `baseline` (the pair as the paper states it, which need not
+/// be the sweep's baseline: paper 001's factors are against BRDF sampling).
+pub fn speedup_claim_against(
+    report: &RunReport,
+    tb: (&str, &str),
+    (estimator, baseline): (&str, &str),
+    paper: f64,
+    claim: &str,
+) -> Claim {
+    let all = crate::analysis::speedups(&report.rows, &report.fits, baseline);
+    let s = all.iter().find(|s| s.testbed == tb.0 && s.variant == tb.1 && s.estimator == estimator);
+    speedup_verdict(s, tb, (estimator, baseline), paper, claim)
+}
+
+fn speedup_verdict(
+    s: Option<&SpeedUp>,
+    tb: (&str, &str),
+    (estimator, baseline): (&str, &str),
+    paper: f64,
+    claim: &str,
+) -> Claim {
     match s {
         None => not_measured(
             tb.0,
             claim,
             paper,
-            format!("no speed-up for {estimator} (not available, skipped, or no baseline fit)"),
+            format!("no speed-up for {estimator} against {baseline} (not available, skipped, or no fit)"),
         ),
         Some(s) => Claim {
             testbed: format!("{}/{}", tb.0, tb.1),
@@ -169,7 +193,7 @@ pub fn speedup_claim(report: &RunReport, tb: (&str, &str), estimator: &str, pape
             our_value: Some(s.speedup),
             held: Some(s.speedup >= 0.5 * paper),
             note: format!(
-                "at {} spp: {:.3}x fewer samples, {:.3}x overhead in CPU time (wall clock: {:.3}x overhead, speed-up {:.3}); held if >= half the paper's factor",
+                "against {baseline} at {} spp: {:.3}x fewer samples, {:.3}x overhead in CPU time (wall clock: {:.3}x overhead, speed-up {:.3}); held if >= half the paper's factor",
                 s.budget, s.sample_ratio, s.overhead, s.overhead_wall, s.speedup_wall
             ),
         },
