@@ -37,7 +37,7 @@ pub fn free_flight<R: Rng + ?Sized>(probe: &MediumProbe<'_>, pos: Vec3, dir: Vec
         return Flight::Escaped(probe.environment(dir));
     };
     let majorant = probe.majorant();
-    if !(majorant > 0.0) {
+    if majorant.is_nan() || majorant <= 0.0 {
         // `0 <= sigma_t <= majorant`: nothing to collide with.
         return Flight::Escaped(probe.environment(dir));
     }
