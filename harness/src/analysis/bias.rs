@@ -165,12 +165,14 @@ fn holm(cell: &CellResult, reference: &Reference, gate: Option<&Gate>, alpha: f6
     }
     // The integrals of one test bed share their sampling process, and a pixel's sample skewness
     // from a few hundred repetitions is low exactly when it missed its rare large values (in the
-    // pilot as in the cell). So no integral is tested below the pilot's median skewness over the
-    // image: where the typical integral is too skewed for a t-test, none is tested.
-    let floor = gate.map_or(0.0, |g| {
+    // pilot as in the cell). So when the pilot's median skewness over the image is beyond the
+    // limit by more than two standard errors of a sample skewness (`sqrt(6 / R)`: the median is
+    // then clearly too skewed, not merely noisy, as it is for any estimator at a few
+    // repetitions), no integral is tested.
+    let heavy = gate.is_some_and(|g| {
         let mut all: Vec<f64> = g.integral_skew.iter().flatten().map(|s| s.abs()).filter(|s| s.is_finite()).collect();
         all.sort_by(f64::total_cmp);
-        all.get(all.len() / 2).copied().unwrap_or(0.0)
+        all.get(all.len() / 2).is_some_and(|&median| median > limit + 2.0 * (6.0 / reps.max(1) as f64).sqrt())
     });
     for (i, mom) in cell.moments.iter().enumerate() {
         for (c, mc) in mom.iter().enumerate() {
@@ -190,11 +192,11 @@ fn holm(cell: &CellResult, reference: &Reference, gate: Option<&Gate>, alpha: f6
                     .push(detectable_shift_t(se_total, per_test_alpha, POWER, reps.saturating_sub(1) as f64) / r.abs());
             }
             let gate_skew = gate.and_then(|g| g.integral_skew.get(i)).map_or(0.0, |s| s[c].abs());
-            let skew = mc.skewness().abs().max(if gate_skew.is_nan() { 0.0 } else { gate_skew }).max(floor);
+            let skew = mc.skewness().abs().max(if gate_skew.is_nan() { 0.0 } else { gate_skew });
             let t = match stored_n {
                 None if se == 0.0 && mc.mean() == r_test => t_test(0.0, 0.0, f64::INFINITY),
                 None if deterministic => t_test(1.0, 0.0, f64::INFINITY),
-                _ if se == 0.0 || skew > limit => {
+                _ if heavy || se == 0.0 || skew > limit => {
                     untested += 1;
                     continue;
                 }
