@@ -24,6 +24,26 @@ pub(crate) fn pilot_sequence(k: usize, picks: usize, sequences: usize) -> usize 
     (lo + offset).min(hi.max(lo + 1) - 1)
 }
 
+/// Runs the pilot sequences of a cell under its budget's own stopping rule: each one's costs and
+/// its CPU seconds.
+fn run_pilots(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<Vec<(Item, f64)>> {
+    let b = &plan.beds[bi];
+    let frames = b.bed.sequence_length().max(1);
+    let sequences = b.bed.integrals() / frames;
+    let picks = sequences.min(PILOT_SEQUENCES);
+    let label = b.label();
+    let pilot = CellRun { plan, label: &label, bi, ei, budget, samples: None };
+    (0..picks)
+        .into_par_iter()
+        .map(|k| {
+            let mut out = Item::default();
+            let t0 = crate::cputime::thread_seconds();
+            run_sequence(&pilot, PILOT_REP, pilot_sequence(k, picks, sequences) * frames, &mut out)?;
+            Ok((out, crate::cputime::thread_seconds() - t0))
+        })
+        .collect()
+}
+
 /// The fixed number of samples per estimate that a fetch budget buys (paper 002 compares
 /// estimators at equal fetches per pixel). Stopping each estimate when its fetches run out would
 /// bias it ([`Task::with_samples`]), so a pilot pass on its own stream (repetition [`PILOT_REP`],
@@ -34,25 +54,9 @@ pub(crate) fn pilot_sequence(k: usize, picks: usize, sequences: usize) -> usize 
 /// reported costs are the fetches the estimates really spent (pixels whose rays miss the medium
 /// spend none, so the image's mean is below the budget).
 pub(crate) fn samples_for_fetch_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<u64> {
-    let b = &plan.beds[bi];
-    let frames = b.bed.sequence_length().max(1);
-    let sequences = b.bed.integrals() / frames;
-    let picks = sequences.min(PILOT_SEQUENCES);
-    let label = b.label();
-    let pilot = CellRun { plan, label: &label, bi, ei, budget, samples: None };
-    let pilots: Vec<Result<Item>> = (0..picks)
-        .into_par_iter()
-        .map(|k| {
-            let mut out = Item::default();
-            run_sequence(&pilot, PILOT_REP, pilot_sequence(k, picks, sequences) * frames, &mut out)?;
-            Ok(out)
-        })
-        .collect();
-    // Sequences that fetch nothing (their rays miss the medium) ran into the sample cap; they say
-    // nothing about what a fetch costs in samples, and every estimate there is free anyway.
-    let mut per_sample = Vec::with_capacity(picks);
-    for p in pilots {
-        let p = p?;
+    let pilots = run_pilots(plan, bi, ei, budget)?;
+    let mut per_sample = Vec::with_capacity(pilots.len());
+    for (p, _) in pilots {
         if p.costs.fetches > 0 && p.costs.samples > 0 {
             per_sample.push(p.costs.fetches as f64 / p.costs.samples as f64);
         }
@@ -84,24 +88,10 @@ pub(crate) fn samples_for_mean_cost(budget: f64, per_sample: &[f64]) -> Option<u
 /// together); a count fixed in advance does not. The count depends on the machine, so a time budget
 /// is the one setting whose results are not bit-reproducible (`meta.reproducible` says so).
 pub(crate) fn samples_for_time_budget(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> Result<u64> {
-    let b = &plan.beds[bi];
-    let frames = b.bed.sequence_length().max(1);
-    let sequences = b.bed.integrals() / frames;
-    let picks = sequences.min(PILOT_SEQUENCES);
-    let label = b.label();
-    let pilot = CellRun { plan, label: &label, bi, ei, budget, samples: None };
-    let pilots: Vec<Result<(u64, f64)>> = (0..picks)
-        .into_par_iter()
-        .map(|k| {
-            let mut out = Item::default();
-            let t0 = crate::cputime::thread_seconds();
-            run_sequence(&pilot, PILOT_REP, pilot_sequence(k, picks, sequences) * frames, &mut out)?;
-            Ok((out.costs.samples, crate::cputime::thread_seconds() - t0))
-        })
-        .collect();
-    let mut per_sample = Vec::with_capacity(picks);
-    for p in pilots {
-        let (n, s) = p?;
+    let pilots = run_pilots(plan, bi, ei, budget)?;
+    let mut per_sample = Vec::with_capacity(pilots.len());
+    for (p, s) in pilots {
+        let n = p.costs.samples;
         if n > 0 {
             // A clock tick below a microsecond reads as one.
             per_sample.push((s * 1e6).max(1.0 / n as f64) / n as f64);

@@ -1,5 +1,5 @@
 //! `canonical-1d`: the transmittance of the segment `[0, 1]` through the canonical extinction
-//! profiles of [`super::canonical_profiles`], scaled to a target transmittance (issue 12; paper 002
+//! profiles of [`super::canonical_profiles`], scaled to a target transmittance (paper 002
 //! §3.4 studies the same one-dimensional problem analytically).
 //!
 //! Variants `<profile>-T<t>` for the seven profiles and the target transmittances
@@ -72,7 +72,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "canonical-1d",
     variants: VARIANTS,
     provides: Needs::MEDIUM,
-    summary: "T of [0, 1] through 7 analytic extinction profiles x 5 target T, closed-form references (issue 12)",
+    summary: "T of [0, 1] through 7 analytic extinction profiles x 5 target T, closed-form references",
     build: |variant, params, _| Ok(Box::new(Canonical1d::new(variant, params)?)),
     compute_reference: None,
     params: ParamSpec::of::<Canonical1dParams>(),
