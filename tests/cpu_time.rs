@@ -93,6 +93,7 @@ fn sweep(ids: &[&str], resolution: f64, budgets: Vec<Budget>, reps: usize) -> Sw
         baseline: None,
         claims: Vec::new(),
         bias_tolerance: None,
+        cost_model: Default::default(),
     }
 }
 

@@ -50,6 +50,7 @@ fn fetch_budgets_are_spent_within_ten_percent_at_every_resolution() {
             baseline: None,
             claims: Vec::new(),
             bias_tolerance: None,
+            cost_model: Default::default(),
         };
         let plan = mcbench::plan::Plan::prepare(sweep, &registry).expect("valid sweep");
         let opts = ExecOptions {

@@ -27,6 +27,7 @@ fn sweep(ids: &[&str], reps: usize) -> Sweep {
         baseline: Some("is0_cv0".into()),
         claims: Vec::new(),
         bias_tolerance: None,
+        cost_model: Default::default(),
     }
 }
 

@@ -65,7 +65,7 @@ fn unbiased_cells_pass(a: &Analysis) -> Claim {
     let sweep_p = holm_bonferroni(&p).into_iter().fold(1.0, f64::min);
     Claim {
         testbed: TB.into(),
-        claim: "issue 12: every unbiased cell passes its unbiasedness test (Holm t-tests against the closed form, alpha 1e-3 per cell)".into(),
+        claim: "every unbiased cell passes its unbiasedness test (Holm t-tests against the closed form, alpha 1e-3 per cell)".into(),
         paper_value: Some(0.0),
         our_value: Some(flagged.len() as f64),
         held: Some(flagged.is_empty()),
@@ -77,6 +77,7 @@ fn unbiased_cells_pass(a: &Analysis) -> Claim {
             sig(sweep_p, 3),
             if flagged.is_empty() { "none".into() } else { list(&flagged, 12) }
         ) + mode_note(a),
+        ..Default::default()
     }
 }
 
@@ -107,7 +108,7 @@ fn control_flagged(a: &Analysis) -> Claim {
     let flagged = rm.iter().filter(|r| r.verdict() == Some("biased")).count();
     Claim {
         testbed: TB.into(),
-        claim: "issue 12 / SPEC §6: the biased control (ray marching, step 0.5: two steps) is flagged in every cell where its exact bias is detectable (above the shift the test detects with 80% power)".into(),
+        claim: "SPEC §6: the biased control (ray marching, step 0.5: two steps) is flagged in every cell where its exact bias is detectable (above the shift the test detects with 80% power)".into(),
         paper_value: Some(detectable as f64),
         our_value: Some(caught as f64),
         held: Some(caught == detectable && detectable > 0),
@@ -117,6 +118,7 @@ fn control_flagged(a: &Analysis) -> Claim {
             if surprise.is_empty() { "none".into() } else { list(&surprise, 8) },
             if hidden.is_empty() { "none".into() } else { list(&hidden, 12) }
         ),
+        ..Default::default()
     }
 }
 
@@ -150,7 +152,7 @@ fn variance_agreement(a: &Analysis) -> Vec<Claim> {
     vec![
         Claim {
             testbed: TB.into(),
-            claim: "issue 12 / paper 002 Eq. 16-20: predicted and measured variance of one estimate agree within error bars in every resolved cell".into(),
+            claim: "paper 002 Eq. 16-20: predicted and measured variance of one estimate agree within error bars in every resolved cell".into(),
             paper_value: Some(0.0),
             our_value: Some(disagree.len() as f64),
             held: Some(disagree.is_empty()),
@@ -164,10 +166,11 @@ fn variance_agreement(a: &Analysis) -> Vec<Claim> {
                 sig(a.z_crit, 3),
                 if disagree.is_empty() { "none".into() } else { list(&disagree, 12) }
             ) + mode_note(a),
+            ..Default::default()
         },
         Claim {
             testbed: TB.into(),
-            claim: "issue 12: the worst predicted-vs-measured disagreement over the resolved cells (|z|, critical value as paper value)".into(),
+            claim: "the worst predicted-vs-measured disagreement over the resolved cells (|z|, critical value as paper value)".into(),
             paper_value: Some(a.z_crit),
             our_value: worst.map(|w| w.1.abs()),
             held: worst.map(|w| w.1.abs() <= a.z_crit),
@@ -176,6 +179,7 @@ fn variance_agreement(a: &Analysis) -> Vec<Claim> {
                 worst.map(|(r, z)| format!("{} z = {}", label(r), sig(z, 3))).unwrap_or_else(|| "-".into()),
                 worst_ratio.map(|(r, x)| format!("{} ratio {}", label(r), sig(x, 3))).unwrap_or_else(|| "-".into())
             ),
+            ..Default::default()
         },
     ]
 }
@@ -258,6 +262,7 @@ fn model_claims(a: &Analysis) -> Vec<Claim> {
                 sig(a.z_crit, 3),
                 if differ.is_empty() { "none".into() } else { list(&differ, 10) }
             ),
+            ..Default::default()
         },
         Claim {
             testbed: TB.into(),
@@ -266,6 +271,7 @@ fn model_claims(a: &Analysis) -> Vec<Claim> {
             our_value: Some(worse.len() as f64),
             held: (m > 0).then_some(worse.is_empty()),
             note: format!("cells (of {m}) where the non-terminating variance is significantly higher (z > {}): {}", sig(a.z_crit, 3), if worse.is_empty() { "none".into() } else { list(&worse, 10) }),
+            ..Default::default()
         },
         Claim {
             testbed: TB.into(),
@@ -274,6 +280,7 @@ fn model_claims(a: &Analysis) -> Vec<Claim> {
             our_value: Some(frac(&falls)),
             held: (!falls.is_empty()).then_some(falls.iter().all(|x| *x)),
             note: format!("share of the {} (profile, T) pairs", falls.len()),
+            ..Default::default()
         },
         Claim {
             testbed: TB.into(),
@@ -282,6 +289,7 @@ fn model_claims(a: &Analysis) -> Vec<Claim> {
             our_value: Some(frac(&lower)),
             held: (!lower.is_empty()).then_some(frac(&lower) > 0.5),
             note: format!("share of the {} (profile, T, ratio) cells where the constant main part (explorer mean) lowers the measured variance; held if most", lower.len()),
+            ..Default::default()
         },
     ]
 }

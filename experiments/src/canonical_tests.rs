@@ -140,6 +140,7 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
         baseline: None,
         claims: Vec::new(),
         bias_tolerance: None,
+        cost_model: Default::default(),
     };
     let registry = crate::test_registry();
     let opts = ExecOptions {
@@ -154,9 +155,9 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
     let def = crate::canonical_sweep::DEF.experiment();
     let out = execute(&prepare(sweep, &registry).unwrap(), Some(&def), &opts).unwrap();
     let claim = |start: &str| out.report.paper.iter().find(|c| c.claim.starts_with(start)).unwrap().clone();
-    let unbiased = claim("issue 12: every unbiased cell passes");
+    let unbiased = claim("every unbiased cell passes");
     assert_eq!(unbiased.held, Some(true), "{}", unbiased.note);
-    let control = claim("issue 12 / SPEC §6: the biased control");
+    let control = claim("SPEC §6: the biased control");
     assert_eq!((control.held, control.our_value), (Some(true), Some(2.0)), "{}", control.note);
     let cells = std::fs::read_to_string(out.results_dir.join("cells.csv")).unwrap();
     assert!(cells.contains("delta_tracking.sigma_samp_ratio = 0.5: delta_tracking needs a majorant"), "{cells}");

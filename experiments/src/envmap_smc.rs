@@ -47,7 +47,7 @@ pub fn m_values(mode: Mode) -> &'static [u32] {
 fn verdict(r: &RunReport, variant: &str, estimator: &str, claim: &str, expect_pass: Option<bool>) -> Claim {
     let t = mcbench::claims::decisive_test(&r.tests, variant, estimator, "");
     match t {
-        None => Claim { testbed: format!("envmap-sequence/{variant}"), claim: claim.into(), paper_value: None, our_value: None, held: None, note: format!("{estimator} did not run") },
+        None => Claim { testbed: format!("envmap-sequence/{variant}"), claim: claim.into(), paper_value: None, our_value: None, held: None, note: format!("{estimator} did not run") , ..Default::default() },
         Some(t) => Claim {
             testbed: format!("envmap-sequence/{variant}"),
             claim: claim.into(),
@@ -64,6 +64,7 @@ fn verdict(r: &RunReport, variant: &str, estimator: &str, claim: &str, expect_pa
                 "main sweep, reported only: {} p = {:.3e} over {} reps ({}), detectable relative bias {:.2e}; a dozen repetitions make t-tests anti-conservative for skewed HDR estimates, the dedicated check below decides",
                 t.test, t.p_value, r.meta.reps, t.verdict, t.detectable_rel_bias
             ),
+            ..Default::default()
         },
     }
 }

@@ -91,7 +91,15 @@ fn at_time(points: &[(f64, f64)], t: f64) -> Option<(f64, bool)> {
 }
 
 fn claim(testbed: &str, text: &str, paper: Option<f64>, ours: Option<f64>, held: Option<bool>, note: String) -> Claim {
-    Claim { testbed: testbed.into(), claim: text.into(), paper_value: paper, our_value: ours, held, note }
+    Claim {
+        testbed: testbed.into(),
+        claim: text.into(),
+        paper_value: paper,
+        our_value: ours,
+        held,
+        note,
+        ..Default::default()
+    }
 }
 
 fn series(label: &str, style: usize, points: Vec<(f64, f64)>) -> Series {

@@ -2,7 +2,7 @@
 //! nodes, leaves, cells, bytes of the octree at the largest budget, from the estimators'
 //! diagnostics) written to `structure.csv` and beside the paper's numbers in the `paper` block,
 //! and the check that the stored references are precise enough: every measured RMSE at the
-//! largest budget must be at least 3x the reference's RMS standard error (SPEC §2, issue 4).
+//! largest budget must be at least 3x the reference's RMS standard error (SPEC §2).
 
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
@@ -92,6 +92,7 @@ pub fn post(
             note: format!(
                 "structure report, not a claim: is1_cv2 at {last} spp, criterion {CRITERION}, 16x16 pixels (mean over repetitions; every variant and id in structure.csv)"
             ),
+            ..Default::default()
         });
     }
     report.paper.extend(mcbench::claims::reference_precision(plan, report));

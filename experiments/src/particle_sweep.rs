@@ -47,6 +47,7 @@ fn claims(r: &RunReport) -> Vec<Claim> {
             note: format!(
                 "FoM = 1/(MSE x fetches) at {budget} fetches; best {best:?}; held if the best sigma_samp is below 1"
             ),
+            ..Default::default()
         });
         let (mut worse, mut compared) = (0, 0);
         let mut notes = Vec::new();
@@ -69,6 +70,7 @@ fn claims(r: &RunReport) -> Vec<Claim> {
             our_value: Some(worse as f64),
             held: (compared > 0).then_some(worse == 0),
             note: format!("count of (model, sigma_samp) where adaptive's FoM is below 0.8x the other's ({compared} compared; FoM noise at quick sizes is ~20%): {}", notes.join("; ")),
+            ..Default::default()
         });
     }
     out.push(Claim {
@@ -78,6 +80,7 @@ fn claims(r: &RunReport) -> Vec<Claim> {
         our_value: None,
         held: None,
         note: "refused here (ConfigError, exit 2 if requested): spm_terminating runs only at sigma_samp >= 0.95".into(),
+        ..Default::default()
     });
     out
 }

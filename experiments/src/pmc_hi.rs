@@ -38,6 +38,7 @@ fn p_eff_claim(r: &RunReport, variant: &str, method: &str, paper: f64, claim: &s
                     b.seconds,
                     plain.map_or("n/a".into(), |p| format!("{p:.3}"))
                 ),
+                ..Default::default()
             }
         }
         _ => Claim {
@@ -47,6 +48,7 @@ fn p_eff_claim(r: &RunReport, variant: &str, method: &str, paper: f64, claim: &s
             our_value: None,
             held: None,
             note: format!("{method} or mis did not run"),
+            ..Default::default()
         },
     }
 }

@@ -42,6 +42,7 @@ fn p_eff_claim(r: &RunReport, variant: &str, method: (&str, u64), paper: f64, cl
             our_value: None,
             held: None,
             note: format!("{m} or uniform_image did not run at {budget} spp"),
+            ..Default::default()
         };
     };
     let ratio = a.p_eff.zip(b.p_eff).map(|(x, y)| x / y);
@@ -66,6 +67,7 @@ fn p_eff_claim(r: &RunReport, variant: &str, method: (&str, u64), paper: f64, cl
             2 * budget,
             double.map_or("n/a".into(), |d| format!("{d:.3}")),
         ),
+        ..Default::default()
     }
 }
 
@@ -87,6 +89,7 @@ fn err_claim(r: &RunReport, variant: &str, paper: f64) -> Claim {
                     "Err uniform {:.4} / PMC-IP {:.4}; RMSE {:.4} vs {:.4}; held if >= half the paper's factor",
                     b.p_err, a.p_err, b.rmse, a.rmse
                 ),
+                ..Default::default()
             }
         }
         _ => Claim {
@@ -96,6 +99,7 @@ fn err_claim(r: &RunReport, variant: &str, paper: f64) -> Claim {
             our_value: None,
             held: None,
             note: "pmc_ip or uniform_image did not run at 10 spp".into(),
+            ..Default::default()
         },
     }
 }
@@ -131,6 +135,7 @@ fn unbiased_claim(r: &RunReport, variant: &str, estimator: &str) -> Claim {
             p(test("uniform_image", "pooled_t")),
             r.meta.reps
         ),
+        ..Default::default()
     }
 }
 

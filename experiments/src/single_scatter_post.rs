@@ -100,6 +100,7 @@ pub fn post(
                             row.cheap_fetches,
                             row.rays - row.samples
                         ),
+                        ..Default::default()
                     });
                 }
             }
@@ -124,6 +125,7 @@ pub fn post(
                 } else {
                     format!("flagged: {}", flagged.join("; "))
                 },
+                ..Default::default()
             });
         }
         for t in report.tests.iter().filter(|t| {
@@ -143,6 +145,7 @@ pub fn post(
                     t.detectable_rel_bias,
                     crate::single_scatter::CONTROL
                 ),
+                ..Default::default()
             });
         }
     }

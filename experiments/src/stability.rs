@@ -1,4 +1,4 @@
-//! `stability` (SPEC §10, issue 9 item 3): every numerical stability case of the specification
+//! `stability` (SPEC §10): every numerical stability case of the specification
 //! with its outcome, `correct` (within error bars of an exact or stored reference, or of an
 //! error-free numeric reference) or `refused` (a typed one-line error), never a panic or a NaN.
 //!
@@ -136,6 +136,7 @@ pub fn post(
             our_value: (!o.statistic.is_nan()).then_some(o.statistic),
             held: Some(o.outcome == expected),
             note: format!("{}: {}", o.outcome, one_line(&o.text)),
+            ..Default::default()
         });
         let (tb, variant) = bed.split_once('/').unwrap_or((&bed, ""));
         let statistic = if o.statistic.is_nan() { String::new() } else { format!("{:.9e}", o.statistic) };

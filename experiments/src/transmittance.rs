@@ -43,6 +43,7 @@ fn claims(r: &RunReport) -> Vec<Claim> {
                 our_value: ratio,
                 held: ratio.map(|x| x > 1.0),
                 note: format!("RMSE new {new:?}, Woodcock {wood:?}, ray marching {rm:?}; held if Woodcock's RMSE is larger (paper Errs: marching {paper_rm}, Woodcock {paper_wt}, new {paper_new}; Fig. 10 gives no numbers)"),
+                ..Default::default()
             });
             let beat_rm = new.zip(rm).map(|(n, m)| m / n);
             out.push(Claim {
@@ -52,6 +53,7 @@ fn claims(r: &RunReport) -> Vec<Claim> {
                 our_value: beat_rm,
                 held: beat_rm.map(|x| x > 1.0),
                 note: "ray marching is biased; its RMSE includes the bias".into(),
+                ..Default::default()
             });
         }
     }

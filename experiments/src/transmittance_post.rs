@@ -91,6 +91,7 @@ pub fn post(
             our_value: Some(within as f64),
             held: Some(within == POINTS),
             note: format!("points s = 1..20 whose measured variance lies within 4 SE of Eq. 16 ({RAYS} one-ray estimates each; SE from the sample fourth moment, itself unreliable for heavy tails); worst |z| {worst:.2}; data in fig8_bands.csv"),
+            ..Default::default()
         });
     }
     results.write_csv("fig8_bands.csv", &rows)?;

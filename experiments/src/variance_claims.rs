@@ -93,6 +93,7 @@ pub fn eq16_claims() -> Vec<Claim> {
                 our_value: Some(v),
                 held: Some((v - pred[k].1).abs() <= 4.0 * se),
                 note: format!("T = {:.5}, measured variance {v:.5e} +- {se:.2e} (1 SE, {n} one-ray estimates); std band T +- {:.4}", pred[k].0, pred[k].1.sqrt()),
+                ..Default::default()
             });
         }
     }

@@ -46,6 +46,7 @@ fn rows(
         baseline: None,
         claims: Vec::new(),
         bias_tolerance: None,
+        cost_model: Default::default(),
     };
     let plan = Plan::prepare(sweep, registry).expect("valid sweep");
     let opts = RunOptions { threads: Some(threads), cell_dir: None, observer: &Silent };

@@ -25,9 +25,11 @@
 //! text = "my estimator reaches slope -0.94"
 //!
 //! [[claims]]
-//! kind = "speedup"                     # against the sweep's baseline at the largest budget
+//! kind = "speedup"                     # at the largest budget, judged on its 95% interval
 //! testbed = "gradient-plane/diffuse"
 //! estimator = "my_estimator"
+//! baseline = "is0_cv0"                 # the pair as stated (default: the sweep's baseline)
+//! regime = "renderer"                  # rays and fetches priced by [cost_model] (default "measured")
 //! value = 2.0
 //! text = "twice as efficient as the baseline"
 //!
@@ -38,6 +40,7 @@
 
 use crate::analysis::SlopeRange;
 use crate::claims;
+use crate::cost_model::Regime;
 use crate::output::{Claim, RunReport};
 use serde::{Deserialize, Serialize};
 
@@ -86,6 +89,13 @@ pub enum ClaimSpec {
         value: f64,
         /// The claim in words.
         text: String,
+        /// The estimator it is measured against (default: the sweep's baseline).
+        #[serde(default)]
+        baseline: Option<String>,
+        /// `measured` (CPU time, the default) or `renderer` (counted operations priced by the
+        /// sweep's `[cost_model]`).
+        #[serde(default)]
+        regime: Regime,
     },
     /// The biased control `estimator` is flagged by the unbiasedness tests.
     ControlFlagged {
@@ -108,8 +118,8 @@ impl ClaimSpec {
             ClaimSpec::SlopeBelow { testbed, estimator, value, text, range } => {
                 claims::slope_steeper_than(report, split(testbed), (estimator, *range), *value, text)
             }
-            ClaimSpec::Speedup { testbed, estimator, value, text } => {
-                claims::speedup_claim(report, split(testbed), estimator, *value, text)
+            ClaimSpec::Speedup { testbed, estimator, value, text, baseline, regime } => {
+                claims::speedup_claim(report, split(testbed), (estimator, baseline.as_deref()), *value, text, *regime)
             }
             ClaimSpec::ControlFlagged { estimator } => claims::control_flagged(report, estimator),
         }
@@ -150,5 +160,41 @@ mod tests {
         // Unknown ranges are refused.
         let bad = "kind = 'slope'\nrange = 'left'\ntestbed = 'a/b'\nestimator = 'e'\nvalue = -0.5\ntext = 't'";
         assert!(toml::from_str::<ClaimSpec>(bad).is_err());
+    }
+
+    #[test]
+    fn speedup_claims_are_judged_on_their_interval_in_their_regime() {
+        let report = crate::plot::tests::synthetic_report();
+        let judge = |value: f64, extra: &str| {
+            let text = format!(
+                "kind = 'speedup'\n{extra}testbed = 'gradient-plane/default'\nestimator = 'is1_cv2'\nvalue = {value}\ntext = 't'"
+            );
+            toml::from_str::<ClaimSpec>(&text).unwrap_or_else(|e| panic!("{e}")).judge(&report)
+        };
+        // Our CPU speed-up 11.43 with ln-scale SE 0.1: [9.40, 13.90] against half the paper's factor.
+        let held = judge(10.0, "");
+        assert_eq!(
+            (held.verdict.as_str(), held.held, held.regime.as_str()),
+            ("held", Some(true), "measured"),
+            "{held:?}"
+        );
+        assert_eq!(held.pair, "is1_cv2 vs is0_cv0");
+        let [lo, hi] = held.interval.expect("interval");
+        assert!((lo - 9.396).abs() < 1e-3 && (hi - 13.905).abs() < 1e-3, "{lo} {hi}");
+        let straddles = judge(20.0, "");
+        assert_eq!((straddles.verdict.as_str(), straddles.held), ("inconclusive", None), "{straddles:?}");
+        assert!(straddles.reason.contains("repetitions would decide"), "{}", straddles.reason);
+        assert_eq!(judge(40.0, "").verdict, "not held");
+        // In the renderer regime the same pair is 16x: [13.15, 19.47] clears half of 20.
+        let renderer = judge(20.0, "regime = 'renderer'\n");
+        assert_eq!((renderer.verdict.as_str(), renderer.our_value), ("held", Some(16.0)), "{renderer:?}");
+        assert!(renderer.note.contains("limit 20.000"), "{}", renderer.note);
+        // A pair the run has no speed-up for is not measured, not failed.
+        let missing = judge(2.0, "baseline = 'no_such_estimator'\n");
+        assert_eq!((missing.verdict(), missing.held), ("not measured", None), "{missing:?}");
+        assert!(toml::from_str::<ClaimSpec>(
+            "kind = 'speedup'\nregime = 'gpu'\ntestbed = 'a/b'\nestimator = 'e'\nvalue = 2.0\ntext = 't'"
+        )
+        .is_err());
     }
 }

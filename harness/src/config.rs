@@ -18,6 +18,7 @@
 //! ```
 
 use crate::claim_spec::ClaimSpec;
+pub use crate::cost_model::CostModel;
 use crate::error::{HarnessError, Result};
 use estimators::budget::{Budget, BudgetKind};
 use estimators::error::ConfigError;
@@ -130,6 +131,9 @@ pub struct Sweep {
     /// [`crate::analysis::DEFAULT_TOLERANCE`], 1%).
     #[serde(default)]
     pub bias_tolerance: Option<f64>,
+    /// Unit costs of the `renderer` cost regime ([`CostModel`]; its defaults unless set).
+    #[serde(default)]
+    pub cost_model: CostModel,
 }
 
 impl Sweep {
@@ -181,6 +185,9 @@ pub struct SweepFile {
     pub claims: Option<Vec<ClaimSpec>>,
     /// The relative bias an unbiasedness `pass` must be able to detect (default 0.01).
     pub bias_tolerance: Option<f64>,
+    /// Unit costs of the `renderer` cost regime (a `[cost_model]` table; unset fields keep their
+    /// defaults).
+    pub cost_model: Option<CostModel>,
 }
 
 impl SweepFile {
@@ -213,6 +220,7 @@ impl SweepFile {
                 baseline: None,
                 claims: Vec::new(),
                 bias_tolerance: None,
+                cost_model: CostModel::default(),
             },
         };
         if let Some(name) = self.name {
@@ -245,6 +253,9 @@ impl SweepFile {
         }
         if self.bias_tolerance.is_some() {
             sweep.bias_tolerance = self.bias_tolerance;
+        }
+        if let Some(m) = self.cost_model {
+            sweep.cost_model = m;
         }
         Ok(sweep)
     }
@@ -323,6 +334,7 @@ impl Sweep {
                 return Err(ConfigError::invalid("estimators", n, "listed twice").into());
             }
         }
+        self.cost_model.validate()?;
         if let Some(t) = self.bias_tolerance {
             if !(t > 0.0 && t < 1.0) {
                 return Err(ConfigError::invalid("bias_tolerance", t, "must lie in (0, 1): a relative bias").into());

@@ -61,15 +61,18 @@ pub fn print_summary(r: &crate::output::RunReport, seconds: f64) {
         .paper
         .iter()
         .map(|c| {
-            let held = match c.held {
-                Some(true) => "held",
-                Some(false) => "did NOT hold",
-                None => "not measured",
+            let held = match c.verdict() {
+                "not held" => "did NOT hold",
+                v => v,
             };
             vec![
                 c.claim.clone(),
                 c.paper_value.map(|v| sig(v, 3)).unwrap_or_default(),
-                c.our_value.map(|v| sig(v, 3)).unwrap_or_else(|| "-".into()),
+                match (c.our_value, c.interval) {
+                    (Some(v), Some([lo, hi])) => format!("{} [{}, {}]", sig(v, 3), sig(lo, 3), sig(hi, 3)),
+                    (Some(v), None) => sig(v, 3),
+                    (None, _) => "-".into(),
+                },
                 held.into(),
             ]
         })

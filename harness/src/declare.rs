@@ -59,6 +59,8 @@ pub struct ExperimentFile {
     pub claims: Option<Vec<ClaimSpec>>,
     /// The relative bias an unbiasedness `pass` must detect (default 0.01).
     pub bias_tolerance: Option<f64>,
+    /// Unit costs of the `renderer` cost regime (`[cost_model]`).
+    pub cost_model: Option<crate::cost_model::CostModel>,
     /// Overrides for `--quick`.
     #[serde(default)]
     pub quick: SweepFile,
@@ -86,6 +88,7 @@ impl ExperimentFile {
             estimators: self.estimators.clone(),
             claims: self.claims.clone(),
             bias_tolerance: self.bias_tolerance,
+            cost_model: self.cost_model,
         };
         let base = shared.apply(None, mode)?;
         let mut overrides = match mode {

@@ -145,7 +145,8 @@ pub fn finish(
         }
     }
     let fits = analysis::fits(&rows);
-    let speedups = sweep.baseline.as_deref().map(|b| analysis::speedups(&rows, &fits, b)).unwrap_or_default();
+    let speedups =
+        sweep.baseline.as_deref().map(|b| analysis::speedups(&rows, &fits, b, &sweep.cost_model)).unwrap_or_default();
     let mut notes = Vec::new();
     for b in &plan.beds {
         notes.push(match &b.bed.reference().kind {
@@ -183,6 +184,7 @@ pub fn finish(
             notes,
             run_id: run_id.clone(),
             reproducible,
+            cost_model: sweep.cost_model,
         },
         fits,
         tests,

@@ -70,6 +70,7 @@ pub mod cli;
 pub mod config;
 pub mod conformance;
 pub mod console;
+pub mod cost_model;
 pub mod cputime;
 pub mod declare;
 pub mod error;

@@ -181,6 +181,7 @@ mod tests {
             baseline: None,
             claims: Vec::new(),
             bias_tolerance: None,
+            cost_model: Default::default(),
         };
         let m = Manifest {
             format: shard::FORMAT,

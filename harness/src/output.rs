@@ -59,6 +59,10 @@ pub struct Meta {
     /// calibrated on this machine).
     #[serde(default = "yes")]
     pub reproducible: bool,
+    /// Unit costs of the `renderer` cost regime the speed-ups were priced with (the defaults in
+    /// files written before it).
+    #[serde(default)]
+    pub cost_model: crate::cost_model::CostModel,
 }
 
 fn yes() -> bool {
@@ -66,7 +70,7 @@ fn yes() -> bool {
 }
 
 /// A paper claim beside our measurement (`paper` in summary.json).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Claim {
     /// Test bed the claim was checked on.
     pub testbed: String,
@@ -76,10 +80,43 @@ pub struct Claim {
     pub paper_value: Option<f64>,
     /// Our number.
     pub our_value: Option<f64>,
-    /// Whether it held here (`None`: not measured in this run, see `note`).
+    /// Whether it held here (`None`: not measured in this run, or inconclusive; `verdict` says
+    /// which).
     pub held: Option<bool>,
     /// How it was judged, or why it was not.
     pub note: String,
+    /// `held`, `not held`, `inconclusive` (the interval does not decide) or `not measured`; empty
+    /// in files written before it, where `held` is the verdict ([`Claim::verdict`]).
+    #[serde(default)]
+    pub verdict: String,
+    /// 95% interval of `our_value`, for claims judged on an interval.
+    #[serde(default)]
+    pub interval: Option<[f64; 2]>,
+    /// The compared pair (`method vs baseline`) of a ratio claim.
+    #[serde(default)]
+    pub pair: String,
+    /// The cost regime (`measured` or `renderer`, [`crate::cost_model::Regime`]) of a time-based
+    /// claim.
+    #[serde(default)]
+    pub regime: String,
+    /// Why the verdict is what it is, in one sentence (for an inconclusive claim: what would
+    /// resolve it).
+    #[serde(default)]
+    pub reason: String,
+}
+
+impl Claim {
+    /// The verdict: `verdict` when set, else read from `held`.
+    pub fn verdict(&self) -> &str {
+        if !self.verdict.is_empty() {
+            return &self.verdict;
+        }
+        match self.held {
+            Some(true) => "held",
+            Some(false) => "not held",
+            None => "not measured",
+        }
+    }
 }
 
 /// Everything `summary.json` holds, plus the rows of `summary.csv` (for plots and reports).

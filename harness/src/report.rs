@@ -142,10 +142,22 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
     });
 
     let claims = report.paper.iter().map(|c| {
-        let held = c.held.map(yes_no).unwrap_or_else(|| "not measured".to_string());
-        vec![c.testbed.clone(), c.claim.clone(), opt(c.paper_value), opt(c.our_value), held, c.note.clone()]
+        let interval = c.interval.map(|[lo, hi]| format!("[{}, {}]", sig(lo, 4), sig(hi, 4))).unwrap_or_default();
+        let note = if c.reason.is_empty() { c.note.clone() } else { format!("{}. {}", c.reason, c.note) };
+        vec![
+            c.testbed.clone(),
+            c.claim.clone(),
+            opt(c.paper_value),
+            opt(c.our_value),
+            interval,
+            c.pair.clone(),
+            c.regime.clone(),
+            c.verdict().to_string(),
+            note,
+        ]
     });
-    let header = ["testbed", "claim", "paper value", "our value", "held", "note"];
+    let header =
+        ["testbed", "claim", "paper value", "our value", "95% interval", "pair", "cost regime", "verdict", "note"];
     section(&mut out, "Paper claims", &header, claims.collect(), "No paper claims for this experiment.");
 
     let fits = report.fits.iter().map(|f| {
@@ -192,6 +204,11 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
             sr,
             ov,
             su,
+            format!("[{}, {}]", sig(s.speedup_ci_low, 4), sig(s.speedup_ci_high, 4)),
+            sig(s.overhead_renderer, 4),
+            sig(s.speedup_renderer, 4),
+            sig(s.speedup_ray_limit, 4),
+            sig(s.break_even_ray_ns, 4),
             sig(s.overhead_wall, 4),
             sig(s.speedup_wall, 4),
         ]
@@ -205,6 +222,11 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
         "sample ratio",
         "overhead (CPU)",
         "speed-up (CPU)",
+        "95% CI",
+        "overhead (renderer)",
+        "speed-up (renderer)",
+        "limit (costly rays)",
+        "break-even ray ns",
         "overhead (wall)",
         "speed-up (wall)",
     ];
@@ -264,8 +286,9 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
             report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
         results_table(&mut out, report, testbed, variant, &rows);
         diagnostics_table(&mut out, report, testbed, variant);
-        for kind in PlotKind::ALL {
-            let png = format!("{}.png", plot_stem(testbed, variant, kind));
+        let stems = PlotKind::ALL.iter().map(|k| plot_stem(testbed, variant, *k));
+        for stem in stems.chain([crate::plot::ray_cost::stem(testbed, variant)]) {
+            let png = format!("{stem}.png");
             if let Some(i) = plots.iter().position(|p| p.file_name().is_some_and(|n| n.to_string_lossy() == png)) {
                 used[i] = true;
                 embed(&mut out, &plots[i], plots, &mut used, plots_dir);
@@ -469,6 +492,7 @@ mod tests {
             (r.rmse, r.variance, r.bias, r.seconds, r.efficiency) = (f64::NAN, f64::NAN, f64::INFINITY, 0.0, None);
         }
         report.tests[0].p_value = f64::NAN;
+        report.speedups.clear();
         let plots = write_plots(&report, dir.path()).unwrap();
         assert!(plots.is_empty());
         let path = write_report(&report, &plots, dir.path(), dir.path()).unwrap();

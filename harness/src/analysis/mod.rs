@@ -2,8 +2,10 @@
 //! papers' speed-up computation (paper 000/001).
 
 pub mod bias;
+pub mod speedup;
 
 pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE, POOLED_SHARE};
+pub use speedup::{speedups, SpeedUp};
 
 use crate::metrics::SummaryRow;
 use estimators::stats::{log_log_fit, weighted_linear_fit, SlopeFit};
@@ -196,80 +198,6 @@ pub fn reps_for(d: f64, reps: usize, est_share: f64, tolerance: f64) -> Option<f
     (room > 0.0).then(|| (reps as f64 * s * d * d / room - 1e-9).ceil().max(2.0))
 }
 
-/// The papers' speed-up at the rightmost budget (paper 000 §5, 001 §5): samples the baseline needs
-/// to reach the method's error (from the baseline's fitted slope) over the method's samples, divided
-/// by the method's overhead (its CPU time per estimate over the baseline's; the wall-clock ratio is
-/// reported beside it).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SpeedUp {
-    /// Test bed id.
-    pub testbed: String,
-    /// Variant.
-    pub variant: String,
-    /// Estimator name.
-    pub estimator: String,
-    /// Baseline name.
-    pub baseline: String,
-    /// The rightmost budget.
-    pub budget: u64,
-    /// Baseline samples needed for the method's RMSE over the method's samples.
-    #[serde(deserialize_with = "crate::output::f64_or_nan")]
-    pub sample_ratio: f64,
-    /// Method CPU seconds per estimate over the baseline's at the same budget
-    /// ([`SummaryRow::metric_seconds`]).
-    #[serde(deserialize_with = "crate::output::f64_or_nan")]
-    pub overhead: f64,
-    /// sample_ratio / overhead.
-    #[serde(deserialize_with = "crate::output::f64_or_nan")]
-    pub speedup: f64,
-    /// Method wall-clock seconds per estimate over the baseline's: what `overhead` was before CPU
-    /// time, which depends on how loaded the machine was while each cell ran (NaN in files written
-    /// before it).
-    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
-    pub overhead_wall: f64,
-    /// sample_ratio / overhead_wall (NaN in files written before it).
-    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
-    pub speedup_wall: f64,
-}
-
-/// Speed-ups of every series against `baseline`.
-pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str) -> Vec<SpeedUp> {
-    let mut out = Vec::new();
-    for series in group(rows) {
-        let last = series[series.len() - 1];
-        if last.estimator == baseline {
-            continue;
-        }
-        let same = |r: &&SummaryRow| r.testbed == last.testbed && r.variant == last.variant && r.estimator == baseline;
-        let (Some(fit), Some(base)) = (
-            fits.iter().find(|f| f.testbed == last.testbed && f.variant == last.variant && f.estimator == baseline),
-            rows.iter().filter(same).find(|r| r.budget == last.budget),
-        ) else {
-            continue;
-        };
-        if last.rmse <= 0.0 || fit.slope >= 0.0 {
-            continue;
-        }
-        let needed = ((last.rmse.ln() - fit.intercept) / fit.slope).exp();
-        let sample_ratio = needed / last.budget as f64;
-        let overhead = last.metric_seconds() / base.metric_seconds();
-        let overhead_wall = last.seconds / base.seconds;
-        out.push(SpeedUp {
-            testbed: last.testbed.clone(),
-            variant: last.variant.clone(),
-            estimator: last.estimator.clone(),
-            baseline: baseline.to_string(),
-            budget: last.budget,
-            sample_ratio,
-            overhead,
-            speedup: sample_ratio / overhead,
-            overhead_wall,
-            speedup_wall: sample_ratio / overhead_wall,
-        });
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::bias::tests::{cell_from, exact};
@@ -358,60 +286,5 @@ mod tests {
         let x: Vec<f64> = rows.iter().map(|r| r.budget as f64).collect();
         let y: Vec<f64> = rows.iter().map(|r| r.rmse).collect();
         assert_eq!(f.slope, log_log_fit(&x, &y).unwrap().slope);
-    }
-
-    #[test]
-    fn speedup_uses_the_baseline_fit() {
-        let mk = |est: &str, budget: u64, rmse: f64, seconds: f64| SummaryRow {
-            testbed: "t".into(),
-            variant: "v".into(),
-            estimator: est.into(),
-            budget_kind: "samples".into(),
-            budget,
-            reps: 2,
-            integrals: 1,
-            rmse,
-            mse: rmse * rmse,
-            variance: rmse * rmse,
-            bias: 0.0,
-            bias_se: 0.0,
-            samples: budget as f64,
-            fetches: 0.0,
-            rays: 0.0,
-            seconds,
-            efficiency: None,
-            fom: None,
-            rel_rmse: 0.0,
-            reference_var: 0.0,
-            cheap_fetches: 0.0,
-            seconds_median: seconds,
-            efficiency_mse: None,
-            p_err: 0.0,
-            p_eff: None,
-            estimator_id: String::new(),
-            params: String::new(),
-            testbed_params: String::new(),
-            mse_se: f64::NAN,
-            cpu_seconds: if est == "fast" { 0.75 * seconds } else { seconds },
-            efficiency_wall: None,
-            time_clock: "cpu".into(),
-        };
-        let mut rows = Vec::new();
-        for b in [4u64, 16, 64] {
-            rows.push(mk("base", b, 1.0 / (b as f64).sqrt(), b as f64));
-            rows.push(mk("fast", b, 1.0 / b as f64, 2.0 * b as f64));
-        }
-        let f = fits(&rows);
-        let s = speedups(&rows, &f, "base");
-        // At 64 spp the fast method's RMSE 1/64 needs 4096 baseline samples: 64x; overhead 1.5x
-        // in CPU time, 2x on the wall clock.
-        assert_eq!(s.len(), 1);
-        assert!((s[0].sample_ratio - 64.0).abs() < 1e-6 && (s[0].overhead - 1.5).abs() < 1e-12);
-        assert!((s[0].speedup - 64.0 / 1.5).abs() < 1e-6);
-        assert!((s[0].overhead_wall - 2.0).abs() < 1e-12 && (s[0].speedup_wall - 32.0).abs() < 1e-6);
-        // Rows read from files written before CPU time: the wall clock, as then.
-        rows.iter_mut().for_each(|r| r.cpu_seconds = f64::NAN);
-        let s = speedups(&rows, &f, "base");
-        assert!((s[0].overhead - 2.0).abs() < 1e-12 && (s[0].speedup - 32.0).abs() < 1e-6);
     }
 }

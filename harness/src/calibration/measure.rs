@@ -86,6 +86,7 @@ fn plan_of(f: &Family, reps: usize, seed: u64, mode: Mode, registry: &Registry) 
         baseline: None,
         claims: Vec::new(),
         bias_tolerance: None,
+        cost_model: Default::default(),
     };
     Plan::prepare(sweep, registry)
 }

@@ -292,6 +292,7 @@ fn pooled_claims(rows: &[Row]) -> Vec<Claim> {
             our_value: (n > 0).then(|| k as f64 / n as f64),
             held: (n > 0).then_some(held),
             note: format!("{k} of {n} {what}: {:.1}% [{:.1}, {:.1}]", 100.0 * frac(k, n), 100.0 * lo, 100.0 * hi),
+            ..Default::default()
         }
     };
     let rate = frac(ff, tested);
@@ -349,6 +350,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
                 } else {
                     format!("fails on {} of {}: {}", failed.len(), judged.len(), failed.join(", "))
                 },
+                ..Default::default()
             }
         })
         .chain(pooled_claims(rows))

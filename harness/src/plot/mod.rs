@@ -1,12 +1,14 @@
 //! Log-log plots of a run (SPEC §8): per (test bed, variant), RMSE and efficiency against the
 //! budget and RMSE against time, one series per estimator with its paper label and (RMSE plots)
-//! its fitted convergence slope in the legend. Each plot is written as SVG and PNG, atomically.
+//! its fitted convergence slope in the legend; with speed-ups, the speed-up against the cost of a
+//! ray ([`ray_cost`]). Each plot is written as SVG and PNG, atomically.
 //!
 //! Text uses the DejaVu Sans font bundled in `assets/fonts` (no system fonts are needed).
 
 mod draw;
 pub mod heatmap;
 pub mod maps;
+pub mod ray_cost;
 #[cfg(test)]
 pub(crate) mod tests;
 
@@ -158,6 +160,9 @@ pub fn write_plots(report: &RunReport, dir: &Path) -> Result<Vec<PathBuf>> {
             write_png(&png, &fig)?;
             written.push(png);
         }
+    }
+    for (stem, fig) in ray_cost::figures(report) {
+        written.extend(write_figure(dir, &stem, &fig)?);
     }
     Ok(written)
 }

@@ -80,6 +80,7 @@ pub fn synthetic_report() -> RunReport {
             notes: vec!["exact reference".into()],
             run_id: "r1".into(),
             reproducible: true,
+            cost_model: Default::default(),
         },
         fits,
         tests: vec![test("is0_cv0", 0.42, "pass"), test("is1_cv2", 3.1e-7, "biased")],
@@ -90,6 +91,7 @@ pub fn synthetic_report() -> RunReport {
             our_value: Some(-0.9),
             held: Some(true),
             note: "within the CI".into(),
+            ..Default::default()
         }],
         speedups: vec![SpeedUp {
             testbed: "gradient-plane".into(),
@@ -102,6 +104,16 @@ pub fn synthetic_report() -> RunReport {
             speedup: 11.43,
             overhead_wall: 2.0,
             speedup_wall: 10.0,
+            log_se: 0.1,
+            speedup_ci_low: 11.43 / 0.2f64.exp(),
+            speedup_ci_high: 11.43 * 0.2f64.exp(),
+            overhead_renderer: 1.25,
+            speedup_renderer: 16.0,
+            speedup_ray_limit: 20.0,
+            break_even_ray_ns: 0.0,
+            cpu_seconds: Some((1.75e-6, 1e-6)),
+            rays: Some((64.0, 64.0)),
+            reps: 16,
         }],
         skipped: vec![Skipped {
             testbed: "gradient-plane".into(),
@@ -129,7 +141,10 @@ fn writes_svg_and_png_for_every_plot() {
     assert_eq!(report.fits.len(), 2);
     let dir = tempfile::TempDir::new().unwrap();
     let files = write_plots(&report, dir.path()).unwrap();
-    assert_eq!(files.len(), 6);
+    // Three plots against the budget and the speed-up against the cost of a ray.
+    assert_eq!(files.len(), 8);
+    let curve = std::fs::read_to_string(dir.path().join("gradient-plane_default_speedup_vs_ray_cost.svg")).unwrap();
+    assert!(curve.contains("break-even (1x)") && curve.contains("limit 20.000"), "ray-cost legend missing");
     for kind in PlotKind::ALL {
         let stem = plot_stem("gradient-plane", "default", kind);
         let png = dir.path().join(format!("{stem}.png"));
@@ -159,6 +174,7 @@ fn empty_and_degenerate_reports_do_not_panic() {
     // Single-point series only (a single-budget sweep): no plot against the budget is drawn.
     let mut report = synthetic_report();
     report.rows.truncate(2);
+    report.speedups.clear();
     assert!(write_plots(&report, dir.path()).unwrap().is_empty());
 
     let mut report = synthetic_report();
@@ -170,8 +186,9 @@ fn empty_and_degenerate_reports_do_not_panic() {
     report.fits[0].slope = f64::NAN;
     let files = write_plots(&report, dir.path()).unwrap();
     // RMSE and RMSE-vs-time have a two-point series beside single points and undrawable values
-    // (NaN, zero, infinite, negative); efficiency has at most one point per series.
-    assert_eq!(files.len(), 4, "{files:?}");
+    // (NaN, zero, infinite, negative); efficiency has at most one point per series. The speed-up
+    // against the cost of a ray is drawn from the speed-ups, not the rows.
+    assert_eq!(files.len(), 6, "{files:?}");
 }
 
 #[test]

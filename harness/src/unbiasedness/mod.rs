@@ -96,6 +96,7 @@ pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
                     baseline: None,
                     claims: Vec::new(),
                     bias_tolerance: None,
+                    cost_model: Default::default(),
                 },
             }
         })
@@ -118,6 +119,7 @@ fn first_part(registry: &Registry, mode: Mode) -> Sweep {
             baseline: None,
             claims: Vec::new(),
             bias_tolerance: None,
+            cost_model: Default::default(),
         };
     }
     all.swap_remove(0).sweep

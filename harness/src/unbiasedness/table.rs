@@ -195,6 +195,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
             our_value: (!r.p_value.is_nan()).then_some(r.p_value),
             held: r.agrees,
             note: format!("{} {}: {}", r.test, r.verdict, r.note),
+            ..Default::default()
         })
         .collect();
     let mut controls: Vec<&str> = Vec::new();
@@ -221,6 +222,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
             } else {
                 format!("NOT flagged (inconclusive or passing) on: {}", missed.join(", "))
             },
+            ..Default::default()
         });
     }
     let unbiased: Vec<&Row> = rows.iter().filter(|r| r.paper_bias == "unbiased" && r.verdict != "not-run").collect();
@@ -250,6 +252,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
             failed.len(),
             if failed.is_empty() { String::new() } else { format!(" ({})", failed.join("; ")) }
         ),
+        ..Default::default()
     });
     out
 }

@@ -115,6 +115,7 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
         baseline: None,
         claims: Vec::new(),
         bias_tolerance: None,
+        cost_model: Default::default(),
     };
     let plan = Plan::prepare(
         sweep,

@@ -1,0 +1,236 @@
+//! The papers' speed-up (paper 000 §5, 001 §5) with its 95% interval, in both cost regimes
+//! ([`crate::cost_model`]), and as a function of the cost of a ray.
+
+use super::{group, Fit};
+use crate::cost_model::{CostModel, RayCostCurve, Regime};
+use crate::metrics::SummaryRow;
+use serde::{Deserialize, Serialize};
+
+/// The normal quantile of a two-sided 95% interval.
+const Z95: f64 = 1.959_963_984_540_054;
+
+/// The papers' speed-up at the rightmost budget: samples the baseline needs to reach the method's
+/// error (from the baseline's fitted slope) over the method's samples, divided by the method's
+/// overhead (its seconds per estimate over the baseline's at that budget).
+///
+/// Its interval is a delta-method one on the log scale over the noise of the two errors (each
+/// budget's `mse_se`) and of the baseline's slope; the seconds per estimate are means over every
+/// estimate of a cell and are taken as exact. The overhead is reported in CPU time (`measured`),
+/// on the wall clock (load-dependent, for comparison) and with counted operations priced by the
+/// sweep's [`CostModel`] (`renderer`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpeedUp {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// Baseline name.
+    pub baseline: String,
+    /// The rightmost budget.
+    pub budget: u64,
+    /// Baseline samples needed for the method's RMSE over the method's samples.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
+    pub sample_ratio: f64,
+    /// Method CPU seconds per estimate over the baseline's at the same budget
+    /// ([`SummaryRow::metric_seconds`]).
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
+    pub overhead: f64,
+    /// sample_ratio / overhead.
+    #[serde(deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup: f64,
+    /// Method wall-clock seconds per estimate over the baseline's: what `overhead` was before CPU
+    /// time, which depends on how loaded the machine was while each cell ran (NaN in files written
+    /// before it).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub overhead_wall: f64,
+    /// sample_ratio / overhead_wall (NaN in files written before it).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup_wall: f64,
+    /// Standard error of ln(`sample_ratio`) (delta method); NaN without `mse_se` (files written
+    /// before it, or before this column).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub log_se: f64,
+    /// 95% interval of `speedup`, low end.
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup_ci_low: f64,
+    /// 95% interval of `speedup`, high end.
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup_ci_high: f64,
+    /// The overhead with counted operations priced by the cost model (`renderer` regime).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub overhead_renderer: f64,
+    /// sample_ratio / overhead_renderer.
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup_renderer: f64,
+    /// The speed-up as rays get costly: sample_ratio x baseline rays / method rays (NaN when the
+    /// method traces none).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup_ray_limit: f64,
+    /// The ray cost (ns, other costs as measured) at which the speed-up crosses 1: 0 when it is
+    /// above 1 at every ray cost, NaN when it crosses at none.
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub break_even_ray_ns: f64,
+    /// (method, baseline) CPU seconds per estimate at the budget.
+    #[serde(default)]
+    pub cpu_seconds: Option<(f64, f64)>,
+    /// (method, baseline) rays per estimate at the budget.
+    #[serde(default)]
+    pub rays: Option<(f64, f64)>,
+    /// Repetitions of the method's cell (what `log_se` was measured at).
+    #[serde(default)]
+    pub reps: usize,
+}
+
+impl SpeedUp {
+    /// The speed-up in `regime`.
+    pub fn in_regime(&self, regime: Regime) -> f64 {
+        match regime {
+            Regime::Measured => self.speedup,
+            Regime::Renderer => self.speedup_renderer,
+        }
+    }
+
+    /// The 95% interval of the speed-up in `regime` (NaN ends without `log_se`).
+    pub fn interval(&self, regime: Regime) -> (f64, f64) {
+        let s = self.in_regime(regime);
+        let w = (Z95 * self.log_se).exp();
+        (s / w, s * w)
+    }
+
+    /// The speed-up as a function of the cost of a ray (None in files written before it).
+    pub fn curve(&self) -> Option<RayCostCurve> {
+        let (t, r) = (self.cpu_seconds?, self.rays?);
+        Some(RayCostCurve { sample_ratio: self.sample_ratio, method: (t.0, r.0), baseline: (t.1, r.1) })
+    }
+}
+
+/// The variance of a log RMSE from a row's `mse_se` (delta method: d ln sqrt(m) = dm / 2m).
+fn log_rmse_var(r: &SummaryRow) -> f64 {
+    (r.mse_se / (2.0 * r.mse)).powi(2)
+}
+
+/// Speed-ups of every series against `baseline`, with unit costs from `model`.
+pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str, model: &CostModel) -> Vec<SpeedUp> {
+    let mut out = Vec::new();
+    for series in group(rows) {
+        let last = series[series.len() - 1];
+        if last.estimator == baseline {
+            continue;
+        }
+        let same = |r: &&SummaryRow| r.testbed == last.testbed && r.variant == last.variant && r.estimator == baseline;
+        let (Some(fit), Some(base)) = (
+            fits.iter().find(|f| f.testbed == last.testbed && f.variant == last.variant && f.estimator == baseline),
+            rows.iter().filter(same).find(|r| r.budget == last.budget),
+        ) else {
+            continue;
+        };
+        if last.rmse <= 0.0 || fit.slope >= 0.0 {
+            continue;
+        }
+        let needed = ((last.rmse.ln() - fit.intercept) / fit.slope).exp();
+        let sample_ratio = needed / last.budget as f64;
+        // ln needed = (ln rmse_m - a) / b: the method's error and the fitted baseline at this
+        // budget (its own point's variance, an upper bound for the fit there) enter as 1/b, the
+        // slope as ln(sample ratio) / b.
+        let slope_var = ((fit.slope_ci_high - fit.slope_ci_low) / (2.0 * Z95)).powi(2);
+        let log_se = ((log_rmse_var(last) + log_rmse_var(base)) / fit.slope.powi(2)
+            + (sample_ratio.ln() / fit.slope).powi(2) * slope_var)
+            .sqrt();
+        let overhead = model.seconds(Regime::Measured, last) / model.seconds(Regime::Measured, base);
+        let overhead_renderer = model.seconds(Regime::Renderer, last) / model.seconds(Regime::Renderer, base);
+        let overhead_wall = last.seconds / base.seconds;
+        let speedup = sample_ratio / overhead;
+        let w = (Z95 * log_se).exp();
+        let curve = RayCostCurve {
+            sample_ratio,
+            method: (last.metric_seconds(), last.rays),
+            baseline: (base.metric_seconds(), base.rays),
+        };
+        out.push(SpeedUp {
+            testbed: last.testbed.clone(),
+            variant: last.variant.clone(),
+            estimator: last.estimator.clone(),
+            baseline: baseline.to_string(),
+            budget: last.budget,
+            sample_ratio,
+            overhead,
+            speedup,
+            overhead_wall,
+            speedup_wall: sample_ratio / overhead_wall,
+            log_se,
+            speedup_ci_low: speedup / w,
+            speedup_ci_high: speedup * w,
+            overhead_renderer,
+            speedup_renderer: sample_ratio / overhead_renderer,
+            speedup_ray_limit: curve.limit(),
+            break_even_ray_ns: curve.reaching(1.0).ns(),
+            cpu_seconds: Some(curve.method.0).zip(Some(curve.baseline.0)),
+            rays: Some((last.rays, base.rays)),
+            reps: last.reps,
+        });
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::fits;
+    use super::*;
+
+    #[test]
+    fn speedup_uses_the_baseline_fit() {
+        let mk = |est: &str, budget: u64, rmse: f64, seconds: f64| SummaryRow {
+            testbed: "t".into(),
+            variant: "v".into(),
+            estimator: est.into(),
+            budget_kind: "samples".into(),
+            budget,
+            reps: 2,
+            integrals: 1,
+            rmse,
+            mse: rmse * rmse,
+            variance: rmse * rmse,
+            bias: 0.0,
+            bias_se: 0.0,
+            samples: budget as f64,
+            fetches: 0.0,
+            rays: 0.0,
+            seconds,
+            efficiency: None,
+            fom: None,
+            rel_rmse: 0.0,
+            reference_var: 0.0,
+            cheap_fetches: 0.0,
+            seconds_median: seconds,
+            efficiency_mse: None,
+            p_err: 0.0,
+            p_eff: None,
+            estimator_id: String::new(),
+            params: String::new(),
+            testbed_params: String::new(),
+            mse_se: f64::NAN,
+            cpu_seconds: if est == "fast" { 0.75 * seconds } else { seconds },
+            efficiency_wall: None,
+            time_clock: "cpu".into(),
+        };
+        let mut rows = Vec::new();
+        for b in [4u64, 16, 64] {
+            rows.push(mk("base", b, 1.0 / (b as f64).sqrt(), b as f64));
+            rows.push(mk("fast", b, 1.0 / b as f64, 2.0 * b as f64));
+        }
+        let f = fits(&rows);
+        let s = speedups(&rows, &f, "base", &CostModel::default());
+        // At 64 spp the fast method's RMSE 1/64 needs 4096 baseline samples: 64x; overhead 1.5x
+        // in CPU time, 2x on the wall clock.
+        assert_eq!(s.len(), 1);
+        assert!((s[0].sample_ratio - 64.0).abs() < 1e-6 && (s[0].overhead - 1.5).abs() < 1e-12);
+        assert!((s[0].speedup - 64.0 / 1.5).abs() < 1e-6);
+        assert!((s[0].overhead_wall - 2.0).abs() < 1e-12 && (s[0].speedup_wall - 32.0).abs() < 1e-6);
+        // Rows read from files written before CPU time: the wall clock, as then.
+        rows.iter_mut().for_each(|r| r.cpu_seconds = f64::NAN);
+        let s = speedups(&rows, &f, "base", &CostModel::default());
+        assert!((s[0].overhead - 2.0).abs() < 1e-12 && (s[0].speedup - 32.0).abs() < 1e-6);
+    }
+}
