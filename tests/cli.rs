@@ -54,6 +54,8 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
             "nope",
         ),
         ("bad_kind.toml", "name='x'\nbudget_kind='parsecs'\n".to_string(), "parsecs"),
+        ("bad_cost.toml", format!("{SMALL}\n[cost_model]\nray_ns = -1.0\n"), "cost_model.ray_ns"),
+        ("typo_cost.toml", format!("{SMALL}\n[cost_model]\nray = 90.0\n"), "ray"),
         ("notes.txt", "name = 'x'".to_string(), ".toml or .json"),
     ];
     for (name, text, needle) in cases {
@@ -82,7 +84,7 @@ fn tree(root: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Vec<u8>> 
     out
 }
 
-/// Issue 9 item 4: bad invocations against a folder that already holds a finished run exit 2 with
+/// Bad invocations against a folder that already holds a finished run exit 2 with
 /// one line naming the flag or field, and leave every byte of `results/` and `plots/` as it was.
 #[test]
 fn bad_invocations_leave_existing_results_unchanged() {
@@ -163,7 +165,7 @@ fn reference_command_stores_the_exact_reference() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("error bound"));
 }
 
-/// SPEC §8 / issue 9 item 5: a run killed (SIGKILL) mid-way and run again with the same seed reuses
+/// SPEC §8: a run killed (SIGKILL) mid-way and run again with the same seed reuses
 /// the cells it had finished, leaves no corrupt file, and ends with the same summary as a run that
 /// was never interrupted (timing columns aside).
 #[test]

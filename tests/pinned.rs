@@ -1,4 +1,4 @@
-//! Value stability (issue 9 item 6): the first estimate of every registered estimator, on the
+//! Value stability: the first estimate of every registered estimator, on the
 //! first of a list of small test beds it supports, for a fixed seed, pinned bit for bit in
 //! `tests/pinned_estimates.json`. An accidental change to an estimator, a sampler, a test bed or
 //! the random streams fails here; an intended one is re-pinned with

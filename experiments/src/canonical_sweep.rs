@@ -1,4 +1,4 @@
-//! `canonical-sweep` (issue 12): every transmittance estimator on `canonical-1d` — seven analytic
+//! `canonical-sweep`: every transmittance estimator on `canonical-1d` — seven analytic
 //! extinction profiles x target transmittance {0.01, 0.1, 0.5, 0.9, 0.99} x sampling density
 //! ratio `sigma_samp / max sigma_t` in {0.25, 0.5, 0.75, 1, 1.5, 2, 4, 8} — with the measured
 //! variance beside paper 002's Eq. 16-20 prediction in every cell. The public harness of Georgiev

@@ -1,4 +1,4 @@
-//! The heat maps of `canonical-sweep` (issue 12): per profile, variance x cost of every estimator
+//! The heat maps of `canonical-sweep`: per profile, variance x cost of every estimator
 //! over (target T, sigma_samp ratio) and the measured-over-predicted variance in every cell
 //! (colour: z, the distance in error bars); and the best estimator per cell for every profile.
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Peer comparison (issue 10 item 5): Mitsuba 3's `volpath` on mcbench's `gradient-box` (SPEC 3.2).
+"""Peer comparison: Mitsuba 3's `volpath` on mcbench's `gradient-box` (SPEC 3.2).
 
 Not built or run by cargo. Setup (outside the repository):
     python3 -m venv /work/venv-mitsuba && /work/venv-mitsuba/bin/pip install mitsuba

@@ -1,4 +1,4 @@
-//! The registry of samplers and their chi-square goodness-of-fit checks (SPEC §6, issue 9 item 2):
+//! The registry of samplers and their chi-square goodness-of-fit checks (SPEC §6):
 //! one entry per sampler module (the direction and distance samplers of this folder, the Phong
 //! BRDF mixture and the phase functions), each check drawing with a fixed seed and binning against
 //! the sampler's reported density with the helpers of [`super::testing`].
