@@ -9,7 +9,7 @@
 //! ours in the `paper` block ([`crate::single_scatter_post`]).
 
 use crate::ExperimentDef;
-use mcbench::claims;
+use mcbench::claims::{self, RatioMetric, RatioSpec};
 use mcbench::output::{Claim, RunReport};
 
 /// Every id the experiment runs, in the order of paper 002 Fig. 12.
@@ -54,8 +54,26 @@ pub fn ranking(r: &RunReport, tb: &str, budget: u64) -> Vec<(&'static str, f64)>
     v
 }
 
-fn rank_of(order: &[(&str, f64)], id: &str) -> Option<usize> {
-    order.iter().position(|(i, _)| *i == id).map(|p| p + 1)
+/// A ratio claim between two methods on `testbed` (single-scatter variant) at `budget`.
+fn judged(
+    r: &RunReport,
+    (tb, budget): (&str, u64),
+    (a, b): (&str, &str),
+    below: bool,
+    claim: String,
+    note: &str,
+) -> Claim {
+    let spec = RatioSpec {
+        tb: (tb, "single-scatter"),
+        estimator: a,
+        baseline: b,
+        budget,
+        metric: RatioMetric::Rmse,
+        threshold: 1.0,
+        above: !below,
+        paper: None,
+    };
+    claims::ratio_claim(r, &spec, &claim, note)
 }
 
 fn claims(r: &RunReport) -> Vec<Claim> {
@@ -68,82 +86,74 @@ fn claims(r: &RunReport) -> Vec<Claim> {
             }
             let unbiased: Vec<(&str, f64)> = all.iter().copied().filter(|(id, _)| *id != "ray_marching").collect();
             let listed = all.iter().map(|(id, e)| format!("{id} {e:.3e}")).collect::<Vec<_>>().join(" < ");
-            let testbed = format!("{tb}/single-scatter");
-            let mis = rank_of(&unbiased, "mis");
-            let others = unbiased.iter().filter(|(id, _)| *id != "mis").map(|x| x.1).fold(f64::INFINITY, f64::min);
-            let mis_ratio = rmse(r, tb, "mis", budget).map(|m| m / others);
-            out.push(Claim {
-                testbed: testbed.clone(),
-                claim: format!("paper 002 Fig. 12: at ~{budget} fetches per pixel MIS (source + scattering-driven) has the lowest error of the unbiased methods (rank, 1 = best)"),
-                paper_value: Some(1.0),
-                our_value: mis.map(|m| m as f64),
-                held: mis.map(|m| m == 1),
-                note: format!(
-                    "RMSE of MIS / best other unbiased {}; RMSE, best first: {listed}",
-                    mis_ratio.map_or("-".into(), |x| format!("{x:.3}"))
-                ),
-                ..Default::default()
-            });
-            let (src, sct) = (rank_of(&unbiased, "source_driven"), rank_of(&unbiased, "scattering_driven"));
-            let worse = src.zip(sct).map(|(a, b)| a.max(b));
-            out.push(Claim {
-                testbed: testbed.clone(),
-                claim: format!("paper 002 Fig. 12: at ~{budget} fetches scattering- and source-driven sampling come next (both within the best 3 of the unbiased methods; worse rank of the two)"),
-                paper_value: Some(3.0),
-                our_value: worse.map(|w| w as f64),
-                held: worse.map(|w| w <= 3),
-                note: format!(
-                    "ranks among the {} unbiased: source-driven {}, scattering-driven {}",
-                    unbiased.len(),
-                    src.map_or("-".into(), |r| r.to_string()),
-                    sct.map_or("-".into(), |r| r.to_string())
-                ),
-                ..Default::default()
-            });
+            let at = (tb, budget);
+            // Orderings are judged between the method and the competitor the point estimates put
+            // next to it, on the interval of their RMSE ratio.
+            if let Some((best_other, _)) = unbiased.iter().find(|(id, _)| *id != "mis") {
+                out.push(judged(
+                    r,
+                    at,
+                    ("mis", best_other),
+                    true,
+                    format!("paper 002 Fig. 12: at ~{budget} fetches per pixel MIS (source + scattering-driven) has the lowest error of the unbiased methods (RMSE ratio MIS / best other unbiased, below 1)"),
+                    &format!("RMSE, best first: {listed}"),
+                ));
+            }
+            let pair = ["source_driven", "scattering_driven"];
+            let worse = pair.iter().filter_map(|id| all.iter().find(|x| x.0 == *id)).max_by(|a, b| a.1.total_cmp(&b.1));
+            let rest: Vec<&(&str, f64)> = unbiased.iter().filter(|(id, _)| !pair.contains(id)).collect();
+            if let (Some((w, _)), Some((second, _))) = (worse, rest.get(1)) {
+                out.push(judged(
+                    r,
+                    at,
+                    (w, second),
+                    true,
+                    format!("paper 002 Fig. 12: at ~{budget} fetches scattering- and source-driven sampling come next (both within the best 3 of the unbiased methods: RMSE ratio of the worse of the two / the second best other method, below 1)"),
+                    "",
+                ));
+            }
             let new = ["source_driven", "scattering_driven", "mis"]
                 .iter()
-                .filter_map(|id| rmse(r, tb, id, budget))
-                .fold(f64::INFINITY, f64::min);
+                .filter_map(|id| rmse(r, tb, id, budget).map(|e| (*id, e)))
+                .min_by(|a, b| a.1.total_cmp(&b.1));
             for (marcher, what) in
                 [("ray_marching", "jittered offsets"), (NOISE_FREE, "offsets 1/2, noise free as the paper's")]
             {
-                let ratio = rmse(r, tb, marcher, budget).map(|m| m / new).filter(|x| x.is_finite());
-                out.push(Claim {
-                    testbed: testbed.clone(),
-                    claim: format!("paper 002 Fig. 12: at ~{budget} fetches the new methods (best of source-driven, scattering-driven, MIS) have lower error than ray marching, {marcher} ({what}; RMSE ratio marching / best new)"),
-                    paper_value: (budget == 300).then_some(104.0 / 52.0),
-                    our_value: ratio,
-                    held: ratio.map(|x| x > 1.0),
-                    note: "one primary ray spends the budget; its RMSE includes its bias; the paper's ratio is from its ~300-fetch row".into(),
-                    ..Default::default()
-                });
+                let Some((best_new, _)) = new else { continue };
+                let mut c = judged(
+                    r,
+                    at,
+                    (marcher, best_new),
+                    false,
+                    format!("paper 002 Fig. 12: at ~{budget} fetches the new methods (best of source-driven, scattering-driven, MIS) have lower error than ray marching, {marcher} ({what}; RMSE ratio marching / best new, above 1)"),
+                    "one primary ray spends the budget; its RMSE includes its bias; the paper's ratio is from its ~300-fetch row",
+                );
+                c.paper_value = (budget == 300).then_some(104.0 / 52.0);
+                out.push(c);
             }
-            let wood = rank_of(&all, "delta_tracking");
-            out.push(Claim {
-                testbed: testbed.clone(),
-                claim: format!("paper 002 Fig. 12: at ~{budget} fetches Woodcock (delta) tracking has the highest error of all methods (rank of {})", all.len()),
-                paper_value: Some(all.len() as f64),
-                our_value: wood.map(|w| w as f64),
-                held: wood.map(|w| w == all.len()),
-                note: "paper at ~300: ray marching 104, Woodcock 128, attenuation-driven 114, SIR 72, source-driven 54, scattering-driven 52 (MIS's number is lost in the text extraction; the text calls MIS the winner)".into(),
-                ..Default::default()
-            });
+            let worst_other = all.iter().filter(|(id, _)| *id != "delta_tracking").max_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((w, _)) = worst_other {
+                out.push(judged(
+                    r,
+                    at,
+                    ("delta_tracking", w),
+                    false,
+                    format!("paper 002 Fig. 12: at ~{budget} fetches Woodcock (delta) tracking has the highest error of all methods (RMSE ratio Woodcock / the worst other, above 1)"),
+                    "paper at ~300: ray marching 104, Woodcock 128, attenuation-driven 114, SIR 72, source-driven 54, scattering-driven 52 (MIS's number is lost in the text extraction; the text calls MIS the winner)",
+                ));
+            }
         }
     }
-    if let (Some(w), Some(s)) =
-        (rmse(r, "eq21-medium", "delta_tracking", 300), rmse(r, "eq21-medium", "scattering_driven", 300))
-    {
-        out.push(Claim {
-            testbed: "eq21-medium/single-scatter".into(),
-            claim: "paper 002 Fig. 12 (~300 fetches): Err ratio Woodcock / scattering-driven".into(),
-            paper_value: Some(128.0 / 52.0),
-            our_value: Some(w / s),
-            held: Some(w / s > 1.0),
-            note: "held if Woodcock's RMSE is the larger (the factor depends on the scene's light and image scale)"
-                .into(),
-            ..Default::default()
-        });
-    }
+    let mut c = judged(
+        r,
+        ("eq21-medium", 300),
+        ("delta_tracking", "scattering_driven"),
+        false,
+        "paper 002 Fig. 12 (~300 fetches): Err ratio Woodcock / scattering-driven".into(),
+        "held if Woodcock's RMSE is the larger (the factor depends on the scene's light and image scale)",
+    );
+    c.paper_value = Some(128.0 / 52.0);
+    out.push(c);
     out.push(claims::control_flagged(r, CONTROL));
     out
 }

@@ -34,12 +34,23 @@
 //! text = "twice as efficient as the baseline"
 //!
 //! [[claims]]
+//! kind = "ratio"                       # metric(estimator) / metric(baseline) at a budget
+//! testbed = "eq21-medium/transmittance"
+//! estimator = "delta_tracking"
+//! baseline = "residual_ratio_tracking"
+//! budget = 10
+//! metric = "rmse"                      # rmse (default) | mse | fom | efficiency_mse
+//! side = "above"                       # its 95% interval lies above `threshold` (default 1)
+//! value = 6.8                          # the paper's ratio (optional)
+//! text = "Woodcock tracking has the larger error"
+//!
+//! [[claims]]
 //! kind = "control_flagged"             # the unbiasedness test flags a biased control
 //! estimator = "clamped_is0_cv0"
 //! ```
 
 use crate::analysis::SlopeRange;
-use crate::claims;
+use crate::claims::{self, RatioMetric, RatioSpec};
 use crate::cost_model::Regime;
 use crate::output::{Claim, RunReport};
 use serde::{Deserialize, Serialize};
@@ -97,11 +108,53 @@ pub enum ClaimSpec {
         #[serde(default)]
         regime: Regime,
     },
+    /// `metric(estimator) / metric(baseline)` at `budget` lies above (or below) `threshold`,
+    /// judged on its 95% interval ([`claims::ratio_claim`]): an ordering ("lower error than") at
+    /// threshold 1, or a factor.
+    Ratio {
+        /// `id/variant`.
+        testbed: String,
+        /// The numerator's estimator.
+        estimator: String,
+        /// The denominator's estimator.
+        baseline: String,
+        /// The budget both are compared at.
+        budget: u64,
+        /// `rmse` (default), `mse`, `fom` or `efficiency_mse`.
+        #[serde(default)]
+        metric: RatioMetric,
+        /// The level the ratio is claimed to clear (default 1).
+        #[serde(default = "one")]
+        threshold: f64,
+        /// `above` (default) or `below` the threshold.
+        #[serde(default)]
+        side: Side,
+        /// The paper's ratio, when it gives one.
+        #[serde(default)]
+        value: Option<f64>,
+        /// The claim in words.
+        text: String,
+    },
     /// The biased control `estimator` is flagged by the unbiasedness tests.
     ControlFlagged {
         /// Estimator name.
         estimator: String,
     },
+}
+
+/// Which side of its threshold a ratio claim puts the ratio.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// Above the threshold.
+    #[default]
+    Above,
+    /// Below the threshold.
+    Below,
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 fn split(testbed: &str) -> (&str, &str) {
@@ -120,6 +173,19 @@ impl ClaimSpec {
             }
             ClaimSpec::Speedup { testbed, estimator, value, text, baseline, regime } => {
                 claims::speedup_claim(report, split(testbed), (estimator, baseline.as_deref()), *value, text, *regime)
+            }
+            ClaimSpec::Ratio { testbed, estimator, baseline, budget, metric, threshold, side, value, text } => {
+                let spec = RatioSpec {
+                    tb: split(testbed),
+                    estimator,
+                    baseline,
+                    budget: *budget,
+                    metric: *metric,
+                    threshold: *threshold,
+                    above: *side == Side::Above,
+                    paper: *value,
+                };
+                claims::ratio_claim(report, &spec, text, "")
             }
             ClaimSpec::ControlFlagged { estimator } => claims::control_flagged(report, estimator),
         }

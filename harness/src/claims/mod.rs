@@ -1,4 +1,8 @@
-//! Judging paper claims against a run: slope claims and speed-up claims.
+//! Judging paper claims against a run: slope claims, speed-up claims and ratio claims ([`ratio`]).
+
+pub mod ratio;
+
+pub use ratio::{ratio_claim, Ratio, RatioMetric, RatioSpec};
 
 use crate::analysis::{Fit, SlopeRange, SpeedUp, TestRow};
 use crate::cost_model::Regime;

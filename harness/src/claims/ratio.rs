@@ -1,0 +1,239 @@
+//! Ratio and ordering claims between two cells at one budget, judged on a 95% interval: "A has
+//! lower error than B", "A's figure of merit is k times B's", "A ranks first".
+//!
+//! Each cell's MSE carries its standard error `mse_se` (the spread of the per-repetition squared
+//! errors), so the log of a ratio of MSE-based metrics has the delta-method standard error
+//! `sqrt((se_a / mse_a)^2 + (se_b / mse_b)^2)` for independent cells (halved for an RMSE ratio).
+//! Costs per estimate (fetches, CPU seconds) are means over every estimate of a cell and are taken
+//! as exact. A claim holds when the interval clears its threshold, does not when it lies on the
+//! other side, and is `inconclusive`, with the repetitions that would decide, when it straddles.
+
+use crate::metrics::SummaryRow;
+use crate::output::{Claim, RunReport};
+use serde::{Deserialize, Serialize};
+
+/// The normal quantile of a two-sided 95% interval.
+const Z95: f64 = 1.959_963_984_540_054;
+
+/// The quantity a ratio claim compares.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RatioMetric {
+    /// Root mean square error (paper 002's Err).
+    #[default]
+    Rmse,
+    /// Mean square error.
+    Mse,
+    /// Figure of merit 1 / (MSE x fetches).
+    Fom,
+    /// Efficiency 1 / (MSE x CPU seconds).
+    EfficiencyMse,
+}
+
+impl RatioMetric {
+    /// The metric's name in notes.
+    pub fn name(self) -> &'static str {
+        match self {
+            RatioMetric::Rmse => "RMSE",
+            RatioMetric::Mse => "MSE",
+            RatioMetric::Fom => "FoM",
+            RatioMetric::EfficiencyMse => "efficiency 1/(MSE x CPU s)",
+        }
+    }
+
+    fn value(self, r: &SummaryRow) -> Option<f64> {
+        let v = match self {
+            RatioMetric::Rmse => Some(r.rmse),
+            RatioMetric::Mse => Some(r.mse),
+            RatioMetric::Fom => r.fom,
+            RatioMetric::EfficiencyMse => r.efficiency_mse,
+        };
+        v.filter(|v| v.is_finite() && *v > 0.0)
+    }
+
+    /// The power of the MSE the metric scales with (an RMSE is its square root).
+    fn mse_power(self) -> f64 {
+        match self {
+            RatioMetric::Rmse => 0.5,
+            _ => 1.0,
+        }
+    }
+}
+
+/// A ratio `a / b` of one metric between two cells, with the log-scale standard error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ratio {
+    /// The ratio.
+    pub value: f64,
+    /// Standard error of its logarithm (NaN without `mse_se` on both cells).
+    pub log_se: f64,
+    /// The smaller repetition count of the two cells.
+    pub reps: usize,
+}
+
+impl Ratio {
+    /// Of `metric` between rows `a` and `b`.
+    pub fn of(metric: RatioMetric, a: &SummaryRow, b: &SummaryRow) -> Option<Ratio> {
+        let value = metric.value(a)? / metric.value(b)?;
+        let rel = |r: &SummaryRow| r.mse_se / r.mse;
+        let log_se = metric.mse_power() * (rel(a).powi(2) + rel(b).powi(2)).sqrt();
+        Some(Ratio { value, log_se, reps: a.reps.min(b.reps) })
+    }
+
+    /// The 95% interval.
+    pub fn interval(&self) -> (f64, f64) {
+        let w = (Z95 * self.log_se).exp();
+        (self.value / w, self.value * w)
+    }
+
+    /// `above`: whether the ratio lies above `threshold` (else below): `held`, `not held` or
+    /// `inconclusive`, with the reason.
+    pub fn verdict(&self, threshold: f64, above: bool) -> (&'static str, Option<bool>, String) {
+        let (lo, hi) = self.interval();
+        let side = if above { "above" } else { "below" };
+        if !(lo.is_finite() && hi.is_finite()) {
+            return ("inconclusive", None, "no interval: the cells carry no error spread (mse_se)".into());
+        }
+        let (yes, no) = if above { (lo > threshold, hi < threshold) } else { (hi < threshold, lo > threshold) };
+        if yes {
+            ("held", Some(true), format!("the 95% interval lies {side} {threshold}"))
+        } else if no {
+            ("not held", Some(false), format!("the 95% interval lies on the other side of {threshold}"))
+        } else {
+            let need = (self.reps as f64 * (Z95 * self.log_se / (self.value / threshold).ln().abs()).powi(2)).ceil();
+            let more = if need.is_finite() {
+                format!("about {need} repetitions would decide it")
+            } else {
+                "no repetition count decides it (the ratio sits at the threshold)".into()
+            };
+            ("inconclusive", None, format!("the 95% interval straddles {threshold}; {more}"))
+        }
+    }
+}
+
+/// The row of `estimator` on `tb` at `budget`.
+pub fn row<'a>(report: &'a RunReport, tb: (&str, &str), estimator: &str, budget: u64) -> Option<&'a SummaryRow> {
+    report
+        .rows
+        .iter()
+        .find(|r| r.testbed == tb.0 && r.variant == tb.1 && r.estimator == estimator && r.budget == budget)
+}
+
+/// What a ratio claim compares and how it is judged.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RatioSpec<'a> {
+    /// (test bed, variant).
+    pub tb: (&'a str, &'a str),
+    /// The numerator's estimator.
+    pub estimator: &'a str,
+    /// The denominator's estimator.
+    pub baseline: &'a str,
+    /// The budget both are compared at.
+    pub budget: u64,
+    /// The metric.
+    pub metric: RatioMetric,
+    /// The threshold the ratio is claimed to clear (1 for an ordering).
+    pub threshold: f64,
+    /// Claimed above the threshold (else below).
+    pub above: bool,
+    /// The paper's ratio, when it gives one.
+    pub paper: Option<f64>,
+}
+
+/// A claim that `metric(estimator) / metric(baseline)` lies above (or below) `threshold` at
+/// `budget`, judged on its 95% interval; `note` is appended to the generated one.
+pub fn ratio_claim(report: &RunReport, spec: &RatioSpec<'_>, claim: &str, note: &str) -> Claim {
+    let RatioSpec { tb, estimator, baseline, budget, metric, threshold, above, paper } = spec.clone();
+    let base = Claim {
+        testbed: format!("{}/{}", tb.0, tb.1),
+        claim: claim.into(),
+        paper_value: paper,
+        pair: format!("{estimator} vs {baseline}"),
+        ..Default::default()
+    };
+    let (Some(a), Some(b)) = (row(report, tb, estimator, budget), row(report, tb, baseline, budget)) else {
+        return Claim {
+            verdict: "not measured".into(),
+            note: format!("no {} cell for {estimator} or {baseline} at {budget}", metric.name()),
+            ..base
+        };
+    };
+    let Some(r) = Ratio::of(metric, a, b) else {
+        return Claim {
+            verdict: "not measured".into(),
+            note: format!("{} not defined for {estimator} or {baseline} at {budget}", metric.name()),
+            ..base
+        };
+    };
+    let (verdict, held, reason) = r.verdict(threshold, above);
+    let (lo, hi) = r.interval();
+    Claim {
+        our_value: Some(r.value),
+        held,
+        note: format!(
+            "{} {estimator} / {baseline} at {budget} {}: {:.4} [{lo:.4}, {hi:.4}] ({} repetitions); {note}",
+            metric.name(),
+            a.budget_kind,
+            r.value,
+            r.reps
+        ),
+        verdict: verdict.into(),
+        interval: Some([lo, hi]),
+        reason,
+        ..base
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rows(report: &mut RunReport, mse: (f64, f64), se: (f64, f64)) {
+        let template = report.rows[0].clone();
+        report.rows.clear();
+        for (name, m, s) in [("a", mse.0, se.0), ("b", mse.1, se.1)] {
+            let mut r = template.clone();
+            (r.estimator, r.budget, r.mse, r.rmse, r.mse_se, r.reps) = (name.into(), 64, m, m.sqrt(), s, 16);
+            r.fom = Some(1.0 / (m * 10.0));
+            report.rows.push(r);
+        }
+    }
+
+    fn spec(metric: RatioMetric, above: bool) -> RatioSpec<'static> {
+        RatioSpec {
+            tb: ("gradient-plane", "default"),
+            estimator: "a",
+            baseline: "b",
+            budget: 64,
+            metric,
+            threshold: 1.0,
+            above,
+            paper: Some(2.0),
+        }
+    }
+
+    #[test]
+    fn ratios_are_judged_on_their_interval() {
+        let mut report = crate::plot::tests::synthetic_report();
+        // MSE 4 vs 1 with 5% relative errors: RMSE ratio 2, log SE 0.5 x sqrt(2) x 0.05.
+        rows(&mut report, (4.0, 1.0), (0.2, 0.05));
+        let c = ratio_claim(&report, &spec(RatioMetric::Rmse, true), "a has the larger error", "");
+        assert_eq!((c.verdict.as_str(), c.held, c.pair.as_str()), ("held", Some(true), "a vs b"), "{c:?}");
+        let [lo, hi] = c.interval.expect("interval");
+        let w = (Z95 * 0.5 * 2f64.sqrt() * 0.05).exp();
+        assert!((lo - 2.0 / w).abs() < 1e-12 && (hi - 2.0 * w).abs() < 1e-12);
+        // The FoM ratio is the inverse MSE ratio: 1/4, below 1.
+        let f = ratio_claim(&report, &spec(RatioMetric::Fom, false), "a has the lower FoM", "");
+        assert_eq!((f.verdict.as_str(), f.our_value), ("held", Some(0.25)), "{f:?}");
+        assert_eq!(ratio_claim(&report, &spec(RatioMetric::Fom, true), "", "").verdict, "not held");
+        // Noisy cells straddle 1: inconclusive, with the repetitions that would decide.
+        rows(&mut report, (1.1, 1.0), (0.3, 0.3));
+        let i = ratio_claim(&report, &spec(RatioMetric::Mse, true), "", "");
+        assert_eq!((i.verdict.as_str(), i.held), ("inconclusive", None), "{i:?}");
+        assert!(i.reason.contains("repetitions would decide"), "{}", i.reason);
+        // A missing cell is not measured.
+        let mut s = spec(RatioMetric::Mse, true);
+        s.budget = 4;
+        assert_eq!(ratio_claim(&report, &s, "", "").verdict(), "not measured");
+    }
+}
