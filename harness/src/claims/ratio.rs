@@ -3,7 +3,8 @@
 //!
 //! Each cell's MSE carries its standard error `mse_se` (the spread of the per-repetition squared
 //! errors), so the log of a ratio of MSE-based metrics has the delta-method standard error
-//! `sqrt((se_a / mse_a)^2 + (se_b / mse_b)^2)` for independent cells (halved for an RMSE ratio).
+//! `sqrt((se_a / mse_a)^2 + (se_b / mse_b)^2)` for independent cells (halved for an RMSE ratio;
+//! [`RatioMetric::PEff`] says what stands in for the error of `Err`).
 //! Costs per estimate (fetches, CPU seconds) are means over every estimate of a cell and are taken
 //! as exact. A claim holds when the interval clears its threshold, does not when it lies on the
 //! other side, and is `inconclusive`, with the repetitions that would decide, when it straddles.
@@ -28,6 +29,10 @@ pub enum RatioMetric {
     Fom,
     /// Efficiency 1 / (MSE x CPU seconds).
     EfficiencyMse,
+    /// Paper 003's perceptual efficiency `P-Eff = 1 / (T Err)`. Its interval uses the relative
+    /// standard error of the MSE for that of `Err` (a tvi-weighted MSE: the two coincide where the
+    /// weights are even, and the weighting of a bright image changes the spread little).
+    PEff,
 }
 
 impl RatioMetric {
@@ -38,6 +43,7 @@ impl RatioMetric {
             RatioMetric::Mse => "MSE",
             RatioMetric::Fom => "FoM",
             RatioMetric::EfficiencyMse => "efficiency 1/(MSE x CPU s)",
+            RatioMetric::PEff => "P-Eff",
         }
     }
 
@@ -47,6 +53,7 @@ impl RatioMetric {
             RatioMetric::Mse => Some(r.mse),
             RatioMetric::Fom => r.fom,
             RatioMetric::EfficiencyMse => r.efficiency_mse,
+            RatioMetric::PEff => r.p_eff,
         };
         v.filter(|v| v.is_finite() && *v > 0.0)
     }
