@@ -6,15 +6,25 @@ use crate::cost_model::{CostModel, RayCostCurve, Regime};
 use crate::metrics::SummaryRow;
 use serde::{Deserialize, Serialize};
 
-/// The normal quantile of a two-sided 95% interval.
+use estimators::stats::hypothesis::t_quantile;
+
+/// The normal quantile of a two-sided 95% interval (the slope's interval width to a standard
+/// error).
 const Z95: f64 = 1.959_963_984_540_054;
+
+/// The quantile of the speed-up's two-sided 95% interval: Student's t with one less degree of
+/// freedom than the method's repetitions, since the errors' spreads are estimated from them.
+fn quantile(reps: usize) -> f64 {
+    t_quantile(0.975, reps as f64 - 1.0)
+}
 
 /// The papers' speed-up at the rightmost budget: samples the baseline needs to reach the method's
 /// error (from the baseline's fitted slope) over the method's samples, divided by the method's
 /// overhead (its seconds per estimate over the baseline's at that budget).
 ///
 /// Its interval is a delta-method one on the log scale over the noise of the two errors (each
-/// budget's `mse_se`) and of the baseline's slope; the seconds per estimate are means over every
+/// budget's `mse_se`) and of the baseline's slope, with a Student's t quantile at one less degree
+/// of freedom than the method's repetitions; the seconds per estimate are means over every
 /// estimate of a cell and are taken as exact. The overhead is reported in CPU time (`measured`),
 /// on the wall clock (load-dependent, for comparison) and with counted operations priced by the
 /// sweep's [`CostModel`] (`renderer`).
@@ -95,7 +105,7 @@ impl SpeedUp {
     /// The 95% interval of the speed-up in `regime` (NaN ends without `log_se`).
     pub fn interval(&self, regime: Regime) -> (f64, f64) {
         let s = self.in_regime(regime);
-        let w = (Z95 * self.log_se).exp();
+        let w = (quantile(self.reps) * self.log_se).exp();
         (s / w, s * w)
     }
 
@@ -142,7 +152,7 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str, model: &CostM
         let overhead_renderer = model.seconds(Regime::Renderer, last) / model.seconds(Regime::Renderer, base);
         let overhead_wall = last.seconds / base.seconds;
         let speedup = sample_ratio / overhead;
-        let w = (Z95 * log_se).exp();
+        let w = (quantile(last.reps) * log_se).exp();
         let curve = RayCostCurve {
             sample_ratio,
             method: (last.metric_seconds(), last.rays),

@@ -6,15 +6,18 @@
 //! `sqrt((se_a / mse_a)^2 + (se_b / mse_b)^2)` for independent cells (halved for an RMSE ratio;
 //! [`RatioMetric::PEff`] says what stands in for the error of `Err`).
 //! Costs per estimate (fetches, CPU seconds) are means over every estimate of a cell and are taken
-//! as exact. A claim holds when the interval clears its threshold, does not when it lies on the
+//! as exact. Intervals use Student's t with one less degree of freedom than the smaller cell's
+//! repetitions, since each `mse_se` is itself estimated from them. A claim holds when the interval clears its threshold, does not when it lies on the
 //! other side, and is `inconclusive`, with the repetitions that would decide, when it straddles.
 
 use crate::metrics::SummaryRow;
 use crate::output::{Claim, RunReport};
 use serde::{Deserialize, Serialize};
 
-/// The normal quantile of a two-sided 95% interval.
-const Z95: f64 = 1.959_963_984_540_054;
+use estimators::stats::hypothesis::t_quantile;
+
+/// The two-sided level of the intervals.
+pub const LEVEL: f64 = 0.95;
 
 /// The quantity a ratio claim compares.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -87,9 +90,19 @@ impl Ratio {
         Some(Ratio { value, log_se, reps: a.reps.min(b.reps) })
     }
 
+    /// The quantile of a two-sided interval at `level`.
+    fn quantile(&self, level: f64) -> f64 {
+        t_quantile(0.5 + 0.5 * level, self.reps as f64 - 1.0)
+    }
+
     /// The 95% interval.
     pub fn interval(&self) -> (f64, f64) {
-        let w = (Z95 * self.log_se).exp();
+        self.interval_at(LEVEL)
+    }
+
+    /// The interval at a two-sided `level` (e.g. a Bonferroni-adjusted one for a family).
+    pub fn interval_at(&self, level: f64) -> (f64, f64) {
+        let w = (self.quantile(level) * self.log_se).exp();
         (self.value / w, self.value * w)
     }
 
@@ -107,7 +120,8 @@ impl Ratio {
         } else if no {
             ("not held", Some(false), format!("the 95% interval lies on the other side of {threshold}"))
         } else {
-            let need = (self.reps as f64 * (Z95 * self.log_se / (self.value / threshold).ln().abs()).powi(2)).ceil();
+            let z = t_quantile(0.5 + 0.5 * LEVEL, f64::INFINITY);
+            let need = (self.reps as f64 * (z * self.log_se / (self.value / threshold).ln().abs()).powi(2)).ceil();
             let more = if need.is_finite() {
                 format!("about {need} repetitions would decide it")
             } else {
@@ -227,7 +241,7 @@ mod tests {
         let c = ratio_claim(&report, &spec(RatioMetric::Rmse, true), "a has the larger error", "");
         assert_eq!((c.verdict.as_str(), c.held, c.pair.as_str()), ("held", Some(true), "a vs b"), "{c:?}");
         let [lo, hi] = c.interval.expect("interval");
-        let w = (Z95 * 0.5 * 2f64.sqrt() * 0.05).exp();
+        let w = (t_quantile(0.975, 15.0) * 0.5 * 2f64.sqrt() * 0.05).exp();
         assert!((lo - 2.0 / w).abs() < 1e-12 && (hi - 2.0 * w).abs() < 1e-12);
         // The FoM ratio is the inverse MSE ratio: 1/4, below 1.
         let f = ratio_claim(&report, &spec(RatioMetric::Fom, false), "a has the lower FoM", "");
