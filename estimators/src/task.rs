@@ -27,6 +27,10 @@ pub struct Costs {
     /// Rays traced: camera and incident-radiance queries, shadow rays, and in a medium every
     /// free-flight segment of a path (one per scattering vertex left).
     pub rays: u64,
+    /// The shadow (visibility) rays among `rays`: any-hit queries, which a renderer traces more
+    /// cheaply than closest-hit ones (0 in cells stored before they were counted apart).
+    #[serde(default)]
+    pub shadow_rays: u64,
 }
 
 /// Under a fetch budget, an estimate also stops after `budget x FETCH_BUDGET_SAMPLE_CAP` samples
@@ -258,7 +262,10 @@ impl EnvProbe<'_> {
     }
     /// Visibility of `wi` from the shading point: one shadow ray.
     pub fn visible(&self, wi: Vec3) -> bool {
-        self.task.count(|c| c.rays += 1);
+        self.task.count(|c| {
+            c.rays += 1;
+            c.shadow_rays += 1;
+        });
         self.scene.visible(self.pixel, wi)
     }
     /// A direction from this frame's environment-map sampler (density proportional to the
@@ -300,7 +307,10 @@ impl MediumProbe<'_> {
     }
     /// Counts one more ray within the current sample (a shadow ray towards a light).
     pub fn shadow_ray(&self) {
-        self.task.count(|c| c.rays += 1);
+        self.task.count(|c| {
+            c.rays += 1;
+            c.shadow_rays += 1;
+        });
     }
     /// Counts one more free-flight segment of the current path (the ray leaving a scattering
     /// vertex): a renderer traces it like any other ray, so `rays` counts segments, not paths.

@@ -14,7 +14,8 @@
 //!
 //! ```toml
 //! [cost_model]
-//! ray_ns = 268.0          # one traced segment: camera, free-flight or shadow ray (default 91)
+//! ray_ns = 268.0          # one closest-hit segment: camera or free flight (default 91)
+//! shadow_ray_ns = 59.0    # one shadow (any-hit) ray (default 41)
 //! fetch_ns = 39.0         # one medium extinction lookup (default 4.6)
 //! cheap_fetch_ns = 4.6    # one lookup of the approximate (cheap) extinction (default 4.6)
 //! ```
@@ -26,15 +27,19 @@ use serde::{Deserialize, Serialize};
 /// Unit costs of counted operations, in nanoseconds of one CPU thread.
 ///
 /// The defaults are Mitsuba 3.9 (`llvm_ad_rgb`, one thread, AMD EPYC) on its Cornell box: 91 ns
-/// for a closest-hit ray with its hit record, 4.6 ns for a trilinear lookup in a 64³ grid volume;
+/// for a closest-hit ray with its hit record, 41 ns for a shadow ray, 4.6 ns for a trilinear
+/// lookup in a 64³ grid volume;
 /// the cheap approximate extinction is priced as a fetch (`docs/cost_model_source.md`, measured by
 /// `scripts/peer/ray_cost.sh`). Heavier scenes cost more: 268 ns per ray at 10⁶ triangles, 39 ns
 /// per fetch from a 256³ grid.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CostModel {
-    /// One traced segment (`rays` counts camera, free-flight and shadow segments).
+    /// One traced segment that finds its closest hit (`rays` less `shadow_rays`: camera,
+    /// incident-radiance and free-flight segments).
     pub ray_ns: f64,
+    /// One shadow (any-hit visibility) ray (`shadow_rays`).
+    pub shadow_ray_ns: f64,
     /// One medium extinction lookup (`fetches`).
     pub fetch_ns: f64,
     /// One lookup of the cheap approximate extinction (`cheap_fetches`).
@@ -43,12 +48,19 @@ pub struct CostModel {
 
 /// Default unit cost of a traced ray, ns (see [`CostModel`]).
 pub const RENDERER_RAY_NS: f64 = 91.0;
+/// Default unit cost of a shadow ray, ns (see [`CostModel`]).
+pub const RENDERER_SHADOW_RAY_NS: f64 = 41.0;
 /// Default unit cost of an extinction lookup, ns (see [`CostModel`]).
 pub const RENDERER_FETCH_NS: f64 = 4.6;
 
 impl Default for CostModel {
     fn default() -> Self {
-        CostModel { ray_ns: RENDERER_RAY_NS, fetch_ns: RENDERER_FETCH_NS, cheap_fetch_ns: RENDERER_FETCH_NS }
+        CostModel {
+            ray_ns: RENDERER_RAY_NS,
+            shadow_ray_ns: RENDERER_SHADOW_RAY_NS,
+            fetch_ns: RENDERER_FETCH_NS,
+            cheap_fetch_ns: RENDERER_FETCH_NS,
+        }
     }
 }
 
@@ -93,7 +105,11 @@ impl CostModel {
 
     /// The priced seconds per estimate of the counted operations (no CPU time).
     pub fn priced_seconds(&self, row: &SummaryRow) -> f64 {
-        1e-9 * (self.ray_ns * row.rays + self.fetch_ns * row.fetches + self.cheap_fetch_ns * row.cheap_fetches)
+        let shadow = row.shadow_rays.min(row.rays);
+        1e-9 * (self.ray_ns * (row.rays - shadow)
+            + self.shadow_ray_ns * shadow
+            + self.fetch_ns * row.fetches
+            + self.cheap_fetch_ns * row.cheap_fetches)
     }
 
     /// Seconds per estimate of `row` in `regime`.
@@ -248,6 +264,17 @@ mod tests {
         let heavy = RayCostCurve { sample_ratio: 2.0, method: (1e-6, 40.0), baseline: (1e-6, 10.0) };
         assert!(matches!(heavy.reaching(1.0), Reach::Below(ns) if (heavy.at(ns) - 1.0).abs() < 1e-9));
         assert!((heavy.limit() - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_renderer_regime_prices_each_count_at_its_unit_cost() {
+        let mut row = crate::plot::tests::synthetic_report().rows[0].clone();
+        (row.cpu_seconds, row.rays, row.shadow_rays, row.fetches, row.cheap_fetches) = (1e-6, 10.0, 4.0, 100.0, 50.0);
+        let m = CostModel { ray_ns: 100.0, shadow_ray_ns: 40.0, fetch_ns: 5.0, cheap_fetch_ns: 1.0 };
+        // 6 closest-hit rays, 4 shadow rays, 100 fetches, 50 cheap ones: 600 + 160 + 500 + 50 ns.
+        assert!((m.priced_seconds(&row) - 1.31e-6).abs() < 1e-18);
+        assert_eq!(m.seconds(Regime::Measured, &row), 1e-6);
+        assert!((m.seconds(Regime::Renderer, &row) - 2.31e-6).abs() < 1e-18);
     }
 
     #[test]

@@ -100,6 +100,10 @@ pub struct SummaryRow {
     /// before this column, whose time-based metrics all used wall-clock seconds).
     #[serde(default)]
     pub time_clock: String,
+    /// Shadow (visibility) rays per estimate, a subset of `rays` (0 in files written before they
+    /// were counted apart, and where a scene reports its rays as one count).
+    #[serde(default)]
+    pub shadow_rays: f64,
 }
 
 impl SummaryRow {
@@ -198,6 +202,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         cpu_seconds,
         efficiency_wall: inverse(variance * seconds),
         time_clock: if cpu { "cpu" } else { "wall" }.to_string(),
+        shadow_rays: per(cell.costs.shadow_rays),
     }
 }
 

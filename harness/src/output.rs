@@ -250,6 +250,7 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "cpu_seconds",
     "efficiency_wall",
     "time_clock",
+    "shadow_rays",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).

@@ -224,6 +224,7 @@ mod tests {
             cpu_seconds: if est == "fast" { 0.75 * seconds } else { seconds },
             efficiency_wall: None,
             time_clock: "cpu".into(),
+            shadow_rays: 0.0,
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {
