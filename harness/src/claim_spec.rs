@@ -212,12 +212,21 @@ mod tests {
         let whole = spec("", "slope").judge(&report);
         assert_eq!((whole.held, whole.our_value), (Some(false), Some(-0.8)), "{whole:?}");
         assert!(whole.note.contains("whole-range fit") && whole.note.contains("right-end slope -0.930"), "{whole:?}");
+        assert_eq!(whole.interval, Some([-0.85, -0.75]));
         let right = spec("range = 'right'\n", "slope").judge(&report);
         assert_eq!((right.held, right.our_value), (Some(true), Some(-0.93)), "{right:?}");
         assert!(right.note.contains("right-end fit"), "{right:?}");
-        // slope_below -0.94: the right end's interval reaches above it, the whole range's is far above.
-        assert_eq!(spec("range = 'right'\n", "slope_below").judge(&report).held, Some(false));
-        assert_eq!(spec("range = \"whole\"\n", "slope_below").judge(&report).held, Some(false));
+        // slope_below -0.94: the right end's interval holds it (inconclusive), the whole range's
+        // lies above it (not held).
+        let straddles = spec("range = 'right'\n", "slope_below").judge(&report);
+        assert_eq!((straddles.held, straddles.verdict()), (None, "inconclusive"), "{straddles:?}");
+        assert_eq!(spec("range = \"whole\"\n", "slope_below").judge(&report).verdict(), "not held");
+        // An interval wider than the tolerance holds the slope but cannot confirm it.
+        let f = report.fits.iter_mut().find(|f| f.estimator == "is1_cv2").expect("fit");
+        (f.slope_right_ci_low, f.slope_right_ci_high) = (-1.1, -0.8);
+        let wide = spec("range = 'right'\n", "slope").judge(&report);
+        assert_eq!((wide.held, wide.verdict()), (None, "inconclusive"), "{wide:?}");
+        assert!(wide.reason.contains("wider than"), "{}", wide.reason);
         // No right-end slope (too few budgets): not measured, not failed.
         let f = report.fits.iter_mut().find(|f| f.estimator == "is1_cv2").expect("fit");
         f.slope_right = f64::NAN;
