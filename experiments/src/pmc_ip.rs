@@ -5,7 +5,8 @@
 //! and the threshold-stopping control of paper 003 §2 that the unbiasedness test must flag.
 
 use crate::{pmc_ip_post, ExperimentDef};
-use mcbench::claims;
+use mcbench::claims::{self, RatioMetric, RatioSpec};
+use mcbench::cost_model::Regime;
 use mcbench::metrics::SummaryRow;
 use mcbench::output::{Claim, RunReport};
 
@@ -28,80 +29,62 @@ pub fn row<'a>(r: &'a RunReport, variant: &str, estimator: &str, budget: u64) ->
 }
 
 /// "PMC-IP improves P-Eff over uniform sampling by `paper` x": our P-Eff ratio of `method` at
-/// `budget` over `uniform_image` at `budget`; held when at least half the paper's factor (the
-/// scenes, sizes and machines differ), the Err ratio, time ratio and plain efficiency ratio in the
-/// note (times are CPU times; the wall-clock time ratio is beside them).
+/// `budget` over `uniform_image` at `budget`, judged on its 95% interval against half the paper's
+/// factor (the scenes, sizes and machines differ); the Err ratio, time ratio and plain efficiency
+/// ratio in the note (times are CPU times; the wall-clock time ratio is beside them).
 fn p_eff_claim(r: &RunReport, variant: &str, method: (&str, u64), paper: f64, claim: &str) -> Claim {
     let (m, budget) = method;
-    let testbed = format!("checker-image/{variant}");
-    let (Some(a), Some(b)) = (row(r, variant, m, budget), row(r, variant, "uniform_image", budget)) else {
-        return Claim {
-            testbed,
-            claim: claim.into(),
-            paper_value: Some(paper),
-            our_value: None,
-            held: None,
-            note: format!("{m} or uniform_image did not run at {budget} spp"),
-            ..Default::default()
-        };
+    let note = match (row(r, variant, m, budget), row(r, variant, "uniform_image", budget)) {
+        (Some(a), Some(b)) => {
+            let plain = a.efficiency_mse.zip(b.efficiency_mse).map(|(x, y)| format!("{:.3}", x / y));
+            let double =
+                row(r, variant, "uniform_image", 2 * budget).and_then(|d| a.p_eff.zip(d.p_eff).map(|(x, y)| x / y));
+            format!(
+                "Err {:.4} vs uniform {:.4} (ratio {:.3}), CPU image time {:.3} s vs {:.3} s (ratio {:.3}; wall clock {:.3}); plain efficiency 1/(MSE x s) ratio {}; P-Eff ratio against uniform at {} spp {}; threshold half the paper's factor",
+                a.p_err,
+                b.p_err,
+                b.p_err / a.p_err,
+                a.metric_seconds() * a.integrals as f64,
+                b.metric_seconds() * b.integrals as f64,
+                a.metric_seconds() / b.metric_seconds(),
+                a.seconds / b.seconds,
+                plain.unwrap_or_else(|| "n/a".into()),
+                2 * budget,
+                double.map_or("n/a".into(), |d| format!("{d:.3}")),
+            )
+        }
+        _ => String::new(),
     };
-    let ratio = a.p_eff.zip(b.p_eff).map(|(x, y)| x / y);
-    let plain = a.efficiency_mse.zip(b.efficiency_mse).map(|(x, y)| format!("{:.3}", x / y));
-    let double = row(r, variant, "uniform_image", 2 * budget).and_then(|d| a.p_eff.zip(d.p_eff).map(|(x, y)| x / y));
-    Claim {
-        testbed,
-        claim: claim.into(),
-        paper_value: Some(paper),
-        our_value: ratio,
-        held: ratio.map(|x| x >= 0.5 * paper),
-        note: format!(
-            "at {budget} spp: Err {:.4} vs uniform {:.4} (ratio {:.3}), CPU image time {:.3} s vs {:.3} s (ratio {:.3}; wall clock {:.3}); plain efficiency 1/(MSE x s) ratio {}; P-Eff ratio against uniform at {} spp {}; held if >= half the paper's factor",
-            a.p_err,
-            b.p_err,
-            b.p_err / a.p_err,
-            a.metric_seconds() * a.integrals as f64,
-            b.metric_seconds() * b.integrals as f64,
-            a.metric_seconds() / b.metric_seconds(),
-            a.seconds / b.seconds,
-            plain.unwrap_or_else(|| "n/a".into()),
-            2 * budget,
-            double.map_or("n/a".into(), |d| format!("{d:.3}")),
-        ),
-        ..Default::default()
-    }
+    let spec = RatioSpec {
+        tb: ("checker-image", variant),
+        estimator: m,
+        baseline: "uniform_image",
+        budget,
+        metric: RatioMetric::PEff,
+        threshold: 0.5 * paper,
+        above: true,
+        paper: Some(paper),
+    };
+    let mut c = claims::ratio_claim(r, &spec, claim, &note);
+    c.regime = Regime::Measured.name().into();
+    c
 }
 
-/// "PMC-IP reduces Err by `paper` x at equal samples" (paper 003 §4.4: 5.4 for the Buddha);
-/// held when at least half the paper's factor.
+/// "PMC-IP reduces Err by `paper` x at equal samples" (paper 003 §4.4: 5.4 for the Buddha): the Err
+/// ratio uniform / PMC-IP at 10 spp, judged on its 95% interval against half the paper's factor.
 fn err_claim(r: &RunReport, variant: &str, paper: f64) -> Claim {
-    let testbed = format!("checker-image/{variant}");
+    let spec = RatioSpec {
+        tb: ("checker-image", variant),
+        estimator: "uniform_image",
+        baseline: "pmc_ip",
+        budget: 10,
+        metric: RatioMetric::PErr,
+        threshold: 0.5 * paper,
+        above: true,
+        paper: Some(paper),
+    };
     let claim = "paper 003 §4.4 (Buddha): PMC-IP 2+4+4 lowers the perceptual error Err 5.4x below uniform 10 spp";
-    match (row(r, variant, "pmc_ip", 10), row(r, variant, "uniform_image", 10)) {
-        (Some(a), Some(b)) => {
-            let ratio = b.p_err / a.p_err;
-            Claim {
-                testbed,
-                claim: claim.into(),
-                paper_value: Some(paper),
-                our_value: Some(ratio),
-                held: Some(ratio >= 0.5 * paper),
-                note: format!(
-                    "Err uniform {:.4} / PMC-IP {:.4}; RMSE {:.4} vs {:.4}; held if >= half the paper's factor",
-                    b.p_err, a.p_err, b.rmse, a.rmse
-                ),
-                ..Default::default()
-            }
-        }
-        _ => Claim {
-            testbed,
-            claim: claim.into(),
-            paper_value: Some(paper),
-            our_value: None,
-            held: None,
-            note: "pmc_ip or uniform_image did not run at 10 spp".into(),
-            ..Default::default()
-        },
-    }
+    claims::ratio_claim(r, &spec, claim, "Err uniform / PMC-IP; threshold half the paper's factor")
 }
 
 /// "PMC-IP is unbiased" (paper 003 §4.2): held when the per-pixel Holm-Welch test against the

@@ -39,7 +39,7 @@
 //! estimator = "delta_tracking"
 //! baseline = "residual_ratio_tracking"
 //! budget = 10
-//! metric = "rmse"                      # rmse (default) | mse | fom | efficiency_mse | p_eff
+//! metric = "rmse"                      # rmse (default) | mse | fom | efficiency_mse | p_eff | p_err
 //! side = "above"                       # its 95% interval lies above `threshold` (default 1)
 //! value = 6.8                          # the paper's ratio (optional)
 //! text = "Woodcock tracking has the larger error"
@@ -120,7 +120,7 @@ pub enum ClaimSpec {
         baseline: String,
         /// The budget both are compared at.
         budget: u64,
-        /// `rmse` (default), `mse`, `fom`, `efficiency_mse` or `p_eff`.
+        /// `rmse` (default), `mse`, `fom`, `efficiency_mse`, `p_eff` or `p_err`.
         #[serde(default)]
         metric: RatioMetric,
         /// The level the ratio is claimed to clear (default 1).

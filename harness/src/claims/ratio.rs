@@ -36,6 +36,9 @@ pub enum RatioMetric {
     /// standard error of the MSE for that of `Err` (a tvi-weighted MSE: the two coincide where the
     /// weights are even, and the weighting of a bright image changes the spread little).
     PEff,
+    /// Paper 003's perceptual error `Err` (mean over integrals of MSE / tvi), with the MSE's
+    /// relative standard error standing in for its own as for [`RatioMetric::PEff`].
+    PErr,
 }
 
 impl RatioMetric {
@@ -47,6 +50,7 @@ impl RatioMetric {
             RatioMetric::Fom => "FoM",
             RatioMetric::EfficiencyMse => "efficiency 1/(MSE x CPU s)",
             RatioMetric::PEff => "P-Eff",
+            RatioMetric::PErr => "Err",
         }
     }
 
@@ -57,6 +61,7 @@ impl RatioMetric {
             RatioMetric::Fom => r.fom,
             RatioMetric::EfficiencyMse => r.efficiency_mse,
             RatioMetric::PEff => r.p_eff,
+            RatioMetric::PErr => Some(r.p_err),
         };
         v.filter(|v| v.is_finite() && *v > 0.0)
     }
