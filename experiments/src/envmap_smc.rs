@@ -26,7 +26,7 @@ pub const N: u64 = 16;
 
 /// Definition.
 pub static DEF: ExperimentDef =
-    ExperimentDef { toml: include_str!("envmap_smc.toml"), claims, post: Some(envmap_smc_post::post) };
+    ExperimentDef { toml: include_str!("envmap_smc.toml"), claims: Some(claims), post: Some(envmap_smc_post::post) };
 
 /// The P values of the moves / bridges sweep (a) for a mode.
 pub fn p_values(mode: Mode) -> &'static [u32] {

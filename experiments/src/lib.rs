@@ -43,8 +43,9 @@ use mcbench::registry::{Experiment, PostFn, Registry};
 pub struct ExperimentDef {
     /// The experiment file.
     pub toml: &'static str,
-    /// The paper's claims judged on a finished run.
-    pub claims: fn(&RunReport) -> Vec<Claim>,
+    /// The paper's claims that need code (the rest are `[[claims]]` tables of the file), judged
+    /// on a finished run.
+    pub claims: Option<fn(&RunReport) -> Vec<Claim>>,
     /// Optional analysis beyond the summary rows, run after the claims with the cells of the run:
     /// it may add claims and write extra result files and plots (returned for the report).
     pub post: Option<PostFn>,
@@ -53,7 +54,7 @@ pub struct ExperimentDef {
 impl ExperimentDef {
     /// The harness's experiment (the embedded file is checked by a test of this crate).
     pub fn experiment(&self) -> Experiment {
-        mcbench::declare::experiment(self.toml, Some(self.claims), self.post)
+        mcbench::declare::experiment(self.toml, self.claims, self.post)
             .unwrap_or_else(|e| panic!("an experiment file of the suite does not parse: {e}"))
     }
 

@@ -15,8 +15,11 @@ pub const SIGMAS: [f64; 7] = [0.4, 0.5, 0.6, 0.7, 0.8, 1.0, 2.0];
 pub const IDS: &[&str] = &["spm_terminating", "spm_nonterminating", "spm_adaptive", "delta_tracking"];
 
 /// Definition.
-pub static DEF: ExperimentDef =
-    ExperimentDef { toml: include_str!("particle_sweep.toml"), claims, post: Some(crate::particle_sweep_post::post) };
+pub static DEF: ExperimentDef = ExperimentDef {
+    toml: include_str!("particle_sweep.toml"),
+    claims: Some(claims),
+    post: Some(crate::particle_sweep_post::post),
+};
 
 fn name(id: &str, s: f64) -> String {
     format!("{id}[sigma_samp={s}]")

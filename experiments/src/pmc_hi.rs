@@ -12,7 +12,7 @@ pub const IDS: &[&str] = &["mis", "pmc_hi", "pmc_hi_feedback", "clamped_is0_cv0"
 
 /// Definition.
 pub static DEF: ExperimentDef =
-    ExperimentDef { toml: include_str!("pmc_hi.toml"), claims, post: Some(crate::pmc_hi_post::post) };
+    ExperimentDef { toml: include_str!("pmc_hi.toml"), claims: Some(claims), post: Some(crate::pmc_hi_post::post) };
 
 /// "PMC-HI improves P-Eff over MIS by `paper` x at equal samples" on one variant, at the largest
 /// budget: held when the 95% interval of our factor lies at or above half the paper's (scenes,

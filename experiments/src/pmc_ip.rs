@@ -18,7 +18,7 @@ pub const PMC_IP_4: &str = "pmc_ip[initial=4]";
 
 /// Definition.
 pub static DEF: ExperimentDef =
-    ExperimentDef { toml: include_str!("pmc_ip.toml"), claims, post: Some(pmc_ip_post::post) };
+    ExperimentDef { toml: include_str!("pmc_ip.toml"), claims: Some(claims), post: Some(pmc_ip_post::post) };
 
 /// The image side the stored `checker-image` references are made for.
 pub const RESOLUTION: f64 = 48.0;

@@ -27,8 +27,11 @@ pub const IDS: &[&str] = &[
 pub const PAPER_BUDGETS: [u64; 2] = [50, 300];
 
 /// Definition.
-pub static DEF: ExperimentDef =
-    ExperimentDef { toml: include_str!("single_scatter.toml"), claims, post: Some(crate::single_scatter_post::post) };
+pub static DEF: ExperimentDef = ExperimentDef {
+    toml: include_str!("single_scatter.toml"),
+    claims: Some(claims),
+    post: Some(crate::single_scatter_post::post),
+};
 
 /// The paper's "noise free but biased" marcher: one ray spending the budget, offsets fixed at 1/2.
 pub const NOISE_FREE: &str = "ray_marching[jitter=0]";

@@ -14,8 +14,11 @@ pub const IDS: &[&str] =
     &["ray_marching", "delta_tracking", "ratio_tracking", "residual_ratio_tracking", "double_particle"];
 
 /// Definition.
-pub static DEF: ExperimentDef =
-    ExperimentDef { toml: include_str!("transmittance.toml"), claims, post: Some(crate::transmittance_post::post) };
+pub static DEF: ExperimentDef = ExperimentDef {
+    toml: include_str!("transmittance.toml"),
+    claims: Some(claims),
+    post: Some(crate::transmittance_post::post),
+};
 
 fn claims(_: &RunReport) -> Vec<Claim> {
     crate::variance_claims::eq16_claims()

@@ -25,6 +25,26 @@
 //! text = "my estimator reaches slope -0.94"
 //!
 //! [[claims]]
+//! kind = "diagnostic"                  # an estimator diagnostic's mean at a budget
+//! testbed = "gradient-plane/default"
+//! estimator = "is1_cv2"
+//! budget = 1024
+//! name = "cells"
+//! value = 256.0
+//! tolerance = 0.1                      # relative
+//! text = "256 cells at 1024 spp"
+//!
+//! [[claims]]
+//! kind = "diagnostic"                  # an estimator diagnostic's mean at a budget
+//! testbed = "gradient-plane/default"
+//! estimator = "is1_cv2"
+//! budget = 1024
+//! name = "cells"
+//! value = 256.0
+//! tolerance = 0.1                      # relative
+//! text = "256 cells at 1024 spp"
+//!
+//! [[claims]]
 //! kind = "speedup"                     # at the largest budget, judged on its 95% interval
 //! testbed = "gradient-plane/diffuse"
 //! estimator = "my_estimator"
@@ -60,7 +80,8 @@ use serde::{Deserialize, Serialize};
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ClaimSpec {
     /// The convergence slope of `estimator` on `testbed` is `value`: held when its 95% interval
-    /// holds it.
+    /// holds it within ±[`claims::SLOPE_TOLERANCE`], not held when it misses it, inconclusive when
+    /// it holds it but is wider.
     Slope {
         /// `id/variant`.
         testbed: String,
@@ -75,7 +96,8 @@ pub enum ClaimSpec {
         #[serde(default)]
         range: SlopeRange,
     },
-    /// `estimator` converges faster than slope `value`: held when its interval lies below.
+    /// `estimator` converges faster than slope `value`: held when its interval lies below, not
+    /// held when above, inconclusive when it holds `value`.
     SlopeBelow {
         /// `id/variant`.
         testbed: String,
@@ -83,6 +105,9 @@ pub enum ClaimSpec {
         estimator: String,
         /// The slope it beats.
         value: f64,
+        /// The paper's own slope, shown beside ours (the claim's value when absent).
+        #[serde(default)]
+        paper: Option<f64>,
         /// The claim in words.
         text: String,
         /// `whole` (default) or `right`, as for `slope`.
@@ -135,6 +160,24 @@ pub enum ClaimSpec {
         /// The claim in words.
         text: String,
     },
+    /// The mean per estimate of a diagnostic `name` of `estimator` at `budget` is `value` within a
+    /// relative `tolerance` (e.g. a cache's cell count).
+    Diagnostic {
+        /// `id/variant`.
+        testbed: String,
+        /// Estimator name.
+        estimator: String,
+        /// The budget.
+        budget: u64,
+        /// The diagnostic's name.
+        name: String,
+        /// The paper's number.
+        value: f64,
+        /// Relative tolerance.
+        tolerance: f64,
+        /// The claim in words.
+        text: String,
+    },
     /// The biased control `estimator` is flagged by the unbiasedness tests.
     ControlFlagged {
         /// Estimator name.
@@ -168,8 +211,16 @@ impl ClaimSpec {
             ClaimSpec::Slope { testbed, estimator, value, text, range } => {
                 claims::slope_matches_over(report, split(testbed), (estimator, *range), *value, text)
             }
-            ClaimSpec::SlopeBelow { testbed, estimator, value, text, range } => {
-                claims::slope_steeper_than(report, split(testbed), (estimator, *range), *value, text)
+            ClaimSpec::SlopeBelow { testbed, estimator, value, paper, text, range } => {
+                let mut c = claims::slope_steeper_than(report, split(testbed), (estimator, *range), *value, text);
+                if let Some(p) = paper {
+                    c.reason = format!("{}; the paper's slope is {p}", c.reason);
+                    c.paper_value = Some(*p);
+                }
+                c
+            }
+            ClaimSpec::Diagnostic { testbed, estimator, budget, name, value, tolerance, text } => {
+                claims::diagnostic_claim(report, split(testbed), (estimator, *budget, name), *value, *tolerance, text)
             }
             ClaimSpec::Speedup { testbed, estimator, value, text, baseline, regime } => {
                 claims::speedup_claim(report, split(testbed), (estimator, baseline.as_deref()), *value, text, *regime)
