@@ -105,7 +105,7 @@ mod tests {
     #[test]
     fn every_experiment_file_parses() {
         for d in super::EXPERIMENTS {
-            let e = mcbench::declare::experiment(d.toml, Some(d.claims), d.post).expect("parses");
+            let e = mcbench::declare::experiment(d.toml, d.claims, d.post).expect("parses");
             assert!(!e.name.is_empty());
         }
     }
