@@ -251,7 +251,7 @@ pub fn speedup_claim(
     let model = &report.meta.cost_model;
     let reach = s.curve().map(|c| {
         format!(
-            "speed-up {:.3} at 1 ns rays, {:.3} at 10 µs, limit {:.3}; break-even (1x) {}; the paper's {paper}x {}",
+            "speed-up {:.3} at 1 ns rays, {:.3} at 10 µs, limit {:.3} as rays get costly; above 1x {}; at or above the paper's {paper}x {}",
             c.at(1.0),
             c.at(1e4),
             c.limit(),
