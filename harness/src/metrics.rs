@@ -104,6 +104,11 @@ pub struct SummaryRow {
     /// were counted apart, and where a scene reports its rays as one count).
     #[serde(default)]
     pub shadow_rays: f64,
+    /// 1 / (variance x seconds per estimate in the `renderer` cost regime): CPU seconds plus the
+    /// counted rays and fetches at the sweep's unit costs ([`crate::cost_model`]; timing; empty in
+    /// files written before it).
+    #[serde(default)]
+    pub efficiency_renderer: Option<f64>,
 }
 
 impl SummaryRow {
@@ -122,7 +127,7 @@ impl SummaryRow {
 pub const TIMING_COLUMNS: &[&str] =
     &["seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff", "cpu_seconds", "efficiency_wall"];
 
-fn inverse(x: f64) -> Option<f64> {
+pub(crate) fn inverse(x: f64) -> Option<f64> {
     (x > 0.0 && x.is_finite()).then(|| 1.0 / x)
 }
 
@@ -203,6 +208,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         efficiency_wall: inverse(variance * seconds),
         time_clock: if cpu { "cpu" } else { "wall" }.to_string(),
         shadow_rays: per(cell.costs.shadow_rays),
+        efficiency_renderer: None,
     }
 }
 

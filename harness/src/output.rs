@@ -251,6 +251,7 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "efficiency_wall",
     "time_clock",
     "shadow_rays",
+    "efficiency_renderer",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).

@@ -73,14 +73,16 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The summary row of a cell of this plan (SPEC §8), with the estimator's id and both
-    /// parameter sets.
+    /// The summary row of a cell of this plan (SPEC §8), with the estimator's id, both parameter
+    /// sets and the efficiency in the sweep's `renderer` cost regime.
     pub fn summary_row(&self, bi: usize, ei: usize, cell: &crate::cell::CellResult) -> crate::metrics::SummaryRow {
         let (b, e) = (&self.beds[bi], &self.estimators[ei]);
         let mut row = crate::metrics::summarize(cell, b.bed.reference());
         row.estimator_id = e.spec.id.clone();
         row.params = e.params_json.clone();
         row.testbed_params = b.params_json.clone();
+        let renderer = self.sweep.cost_model.seconds(crate::cost_model::Regime::Renderer, &row);
+        row.efficiency_renderer = crate::metrics::inverse(row.variance * renderer);
         row
     }
 

@@ -225,6 +225,7 @@ mod tests {
             efficiency_wall: None,
             time_clock: "cpu".into(),
             shadow_rays: 0.0,
+            efficiency_renderer: None,
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {

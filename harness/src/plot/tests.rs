@@ -39,6 +39,7 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         efficiency_wall: Some(1.0 / (variance * seconds)),
         time_clock: "cpu".into(),
         shadow_rays: 0.0,
+        efficiency_renderer: None,
     }
 }
 
