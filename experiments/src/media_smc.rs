@@ -14,8 +14,5 @@ pub const IDS: &[&str] = &["is0_cv0", "is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1"
 pub const VARIANTS: &[&str] = &["albedo-1", "albedo-0.8", "albedo-0.5"];
 
 /// Definition.
-pub static DEF: ExperimentDef = ExperimentDef {
-    toml: include_str!("media_smc.toml"),
-    claims: None,
-    post: Some(crate::media_smc_post::post),
-};
+pub static DEF: ExperimentDef =
+    ExperimentDef { toml: include_str!("media_smc.toml"), claims: None, post: Some(crate::media_smc_post::post) };
