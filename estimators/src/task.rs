@@ -31,6 +31,11 @@ pub struct Costs {
     /// cheaply than closest-hit ones (0 in cells stored before they were counted apart).
     #[serde(default)]
     pub shadow_rays: u64,
+    /// The free-flight segments among `rays`: in a medium, the ray leaving each scattering vertex
+    /// (0 in cells stored before they were counted apart). The rest of `rays` less
+    /// `shadow_rays` are primary rays (camera and incident-radiance queries).
+    #[serde(default)]
+    pub free_flights: u64,
 }
 
 /// Under a fetch budget, an estimate also stops after `budget x FETCH_BUDGET_SAMPLE_CAP` samples
@@ -315,7 +320,10 @@ impl MediumProbe<'_> {
     /// Counts one more free-flight segment of the current path (the ray leaving a scattering
     /// vertex): a renderer traces it like any other ray, so `rays` counts segments, not paths.
     pub fn scattered_ray(&self) {
-        self.task.count(|c| c.rays += 1);
+        self.task.count(|c| {
+            c.rays += 1;
+            c.free_flights += 1;
+        });
     }
     /// Real extinction at `p`: one fetch.
     pub fn sigma_t(&self, p: Vec3) -> f64 {

@@ -109,6 +109,10 @@ pub struct SummaryRow {
     /// files written before it).
     #[serde(default)]
     pub efficiency_renderer: Option<f64>,
+    /// Free-flight segments per estimate, a subset of `rays` (0 in files written before they were
+    /// counted apart); `rays - shadow_rays - free_flights` are primary rays.
+    #[serde(default)]
+    pub free_flights: f64,
 }
 
 impl SummaryRow {
@@ -209,6 +213,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         time_clock: if cpu { "cpu" } else { "wall" }.to_string(),
         shadow_rays: per(cell.costs.shadow_rays),
         efficiency_renderer: None,
+        free_flights: per(cell.costs.free_flights),
     }
 }
 

@@ -252,6 +252,7 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "time_clock",
     "shadow_rays",
     "efficiency_renderer",
+    "free_flights",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).

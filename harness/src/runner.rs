@@ -84,6 +84,7 @@ pub(crate) fn add_costs(a: &mut Costs, b: &Costs) {
     a.cheap_fetches += b.cheap_fetches;
     a.rays += b.rays;
     a.shadow_rays += b.shadow_rays;
+    a.free_flights += b.free_flights;
 }
 
 /// Repetition index of the pilot stream that calibrates fetch budgets (never a real repetition).

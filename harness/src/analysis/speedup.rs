@@ -226,6 +226,7 @@ mod tests {
             time_clock: "cpu".into(),
             shadow_rays: 0.0,
             efficiency_renderer: None,
+            free_flights: 0.0,
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {
