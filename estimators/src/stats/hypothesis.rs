@@ -92,6 +92,15 @@ pub fn t_quantile(p: f64, dof: f64) -> f64 {
     StudentsT::new(0.0, 1.0, dof).map(|t| t.inverse_cdf(p)).unwrap_or(f64::NAN)
 }
 
+/// The lower `p` quantile of the chi-square distribution with `dof` degrees of freedom; `NaN`
+/// outside `0 < p < 1` or for `dof <= 0`.
+pub fn chi_square_quantile(p: f64, dof: f64) -> f64 {
+    if !(p > 0.0 && p < 1.0) || dof.is_nan() || dof <= 0.0 {
+        return f64::NAN;
+    }
+    statrs::distribution::ChiSquared::new(dof).map(|c| c.inverse_cdf(p)).unwrap_or(f64::NAN)
+}
+
 /// Smallest absolute shift that a two-sided t-test at level `alpha` with `dof` degrees of freedom
 /// detects with probability `power`, given its standard error:
 /// `(t_{1-alpha/2, dof} + t_{power, dof}) * std_err` (the noncentral t approximated by a shifted

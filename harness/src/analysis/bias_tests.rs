@@ -210,3 +210,28 @@ fn no_integral_is_tested_below_the_pilots_median_skewness() {
     let rows = unbiasedness(&cell_from(&rare(256), &reference), &reference, Bias::Unbiased, Some(&gate), 0.01);
     assert!(rows[0].p_value.is_nan() && rows[0].untested == 48, "{:?}", rows[0]);
 }
+
+#[test]
+fn a_pass_needs_the_tolerance_at_the_upper_bound_of_the_spread() {
+    let reference = exact(&[[1.0; 3]; 16]);
+    let cell = cell_from(&normal_reps(5, 16, 256, 1.0, 0.05), &reference);
+    let gate = Gate::from_cell(&cell_from(&normal_reps(6, 16, 256, 1.0, 0.05), &reference), "pilot", 1.0);
+    let d = decision(&unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), DEFAULT_TOLERANCE)).clone();
+    // A tolerance just above the reported detectable bias is not enough: the spread is estimated
+    // from 2 x 255 degrees of freedom, whose upper 95% bound is about 6% above the estimate.
+    let just_above = d.detectable_rel_bias * 1.01;
+    let at = decision(&unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), just_above)).verdict.clone();
+    assert_eq!(at, "inconclusive");
+    let with_margin = d.detectable_rel_bias * 1.1;
+    let at = decision(&unbiasedness(&cell, &reference, Bias::Unbiased, Some(&gate), with_margin)).verdict.clone();
+    assert_eq!(at, "pass");
+}
+
+#[test]
+fn the_detectable_bias_is_that_of_an_estimator_off_by_a_factor() {
+    // A shift D detected at the unbiased spread is a factor (1 + b) with b = D / (1 - D), since
+    // the spread scales with the estimate.
+    assert!((super::multiplicative(0.2) - 0.25).abs() < 1e-15);
+    assert!((super::multiplicative(0.01) - 0.01 / 0.99).abs() < 1e-15);
+    assert_eq!(super::multiplicative(1.0), f64::INFINITY);
+}
