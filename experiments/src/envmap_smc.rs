@@ -10,11 +10,12 @@
 //! (c) §7: the share of pixels resampled per frame (paper: 36% with one distribution and 5 moves,
 //!     18% with 5 bridges).
 //!
-//! Plus `smc_adaptive` (beyond the paper) and the biased control `bidirectional_is_sn`. The
-//! per-frame analysis, plots and the claims that need cells are in [`crate::envmap_smc_post`].
+//! Plus `smc_adaptive` (beyond the paper) and the biased control `bidirectional_is_sn` at 5
+//! candidates, whose flagging is claimed by the dedicated unbiasedness check
+//! ([`crate::envmap_unbiasedness`]). The per-frame analysis, plots and the claims that need cells
+//! are in [`crate::envmap_smc_post`].
 
 use crate::{envmap_smc_post, ExperimentDef};
-use mcbench::claims;
 use mcbench::config::Mode;
 use mcbench::output::{Claim, RunReport};
 
@@ -95,6 +96,8 @@ fn claims(r: &RunReport) -> Vec<Claim> {
             None,
         ));
     }
-    out.push(claims::control_flagged(r, "bidirectional_is_sn"));
+    // The control's claim is the dedicated check's (thousands of repetitions on L_r, where the
+    // self-normalised estimate is biased: flagged in 100 of 100 calibration seeds); at this sweep's
+    // repetitions its bias on a 10x10 image is not resolved, and on L_ns it is unbiased.
     out
 }

@@ -25,7 +25,7 @@ fn cases() -> Vec<(&'static str, Params)> {
         ("smc_bridge", Params::new().with("bridges", 3.0).with("candidates", 32.0)),
         ("smc_path", Params::new().with("bridges", 3.0).with("candidates", 32.0)),
         ("smc_adaptive", Params::new().with("candidates", 32.0)),
-        ("bidirectional_is_sn", Params::new().with("candidates", 2.0)),
+        ("bidirectional_is_sn", Params::new().with("candidates", 5.0)),
     ]
 }
 

@@ -144,6 +144,6 @@ fn claims(r: &RunReport) -> Vec<Claim> {
     for variant in ["occluded", "default"] {
         out.push(unbiased_claim(r, variant, "pmc_ip"));
     }
-    out.push(claims::control_flagged(r, "threshold_image"));
+    out.push(claims::control_flagged(r, "threshold_image[threshold=0.3]"));
     out
 }
