@@ -1,4 +1,4 @@
-//! The claims of `canonical-sweep`, judged on its cells: the acceptance (every unbiased
+//! The claims of `canonical-sweep`, judged on its cells: its acceptance criteria (every unbiased
 //! cell passes its test; the biased control is flagged wherever its exact bias is detectable;
 //! predicted and measured variance agree within error bars in every resolved cell, and the worst
 //! disagreement) and paper 002 §3.4's statements on the models (Eq. 17, 19, 20, the constant
