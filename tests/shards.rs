@@ -37,8 +37,20 @@ fn deterministic_json(path: &Path) -> serde_json::Value {
             serde_json::Value::Object(m) => {
                 m.retain(|k, _| {
                     !TIMING_COLUMNS.contains(&k.as_str())
-                        && !["wall_seconds", "overhead", "speedup", "overhead_wall", "speedup_wall", "run_id"]
-                            .contains(&k.as_str())
+                        && ![
+                            "wall_seconds",
+                            "overhead",
+                            "speedup",
+                            "overhead_wall",
+                            "speedup_wall",
+                            "run_id",
+                            "speedup_ci_low",
+                            "speedup_ci_high",
+                            "overhead_renderer",
+                            "speedup_renderer",
+                            "break_even_ray_ns",
+                        ]
+                        .contains(&k.as_str())
                 });
                 m.values_mut().for_each(strip);
             }

@@ -128,8 +128,16 @@ impl SummaryRow {
 }
 
 /// Column names whose values depend on the wall clock (excluded from determinism checks).
-pub const TIMING_COLUMNS: &[&str] =
-    &["seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff", "cpu_seconds", "efficiency_wall"];
+pub const TIMING_COLUMNS: &[&str] = &[
+    "seconds",
+    "efficiency",
+    "seconds_median",
+    "efficiency_mse",
+    "p_eff",
+    "cpu_seconds",
+    "efficiency_wall",
+    "efficiency_renderer",
+];
 
 pub(crate) fn inverse(x: f64) -> Option<f64> {
     (x > 0.0 && x.is_finite()).then(|| 1.0 / x)
