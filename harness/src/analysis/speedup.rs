@@ -102,13 +102,6 @@ impl SpeedUp {
         }
     }
 
-    /// The 95% interval of the speed-up in `regime` (NaN ends without `log_se`).
-    pub fn interval(&self, regime: Regime) -> (f64, f64) {
-        let s = self.in_regime(regime);
-        let w = (quantile(self.reps) * self.log_se).exp();
-        (s / w, s * w)
-    }
-
     /// The speed-up as a function of the cost of a ray (None in files written before it).
     pub fn curve(&self) -> Option<RayCostCurve> {
         let (t, r) = (self.cpu_seconds?, self.rays?);

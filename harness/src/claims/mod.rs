@@ -231,23 +231,12 @@ pub fn speedup_claim(
         return Claim { regime: regime.name().into(), ..not_measured(tb.0, &text, paper, why) };
     };
     let value = s.in_regime(regime);
-    let (lo, hi) = s.interval(regime);
+    // The speed-up's interval is that of a ratio with its log-scale error: the same verdict rule.
+    let ratio = Ratio { value, log_se: s.log_se, reps: s.reps };
+    let (lo, hi) = ratio.interval();
     let target = SPEEDUP_SHARE * paper;
-    let (verdict, held, reason) = if !(lo.is_finite() && hi.is_finite()) {
-        ("inconclusive", None, "no interval: the cells carry no error spread (mse_se)".to_string())
-    } else if lo >= target {
-        ("held", Some(true), format!("the interval lies at or above {target:.4}, half the paper's factor"))
-    } else if hi < target {
-        ("not held", Some(false), format!("the interval lies below {target:.4}, half the paper's factor"))
-    } else {
-        let need = (s.reps as f64 * (1.96 * s.log_se / (value / target).ln().abs()).powi(2)).ceil();
-        let more = if need.is_finite() {
-            format!("about {need} repetitions would decide it")
-        } else {
-            "no repetition count decides it (the speed-up sits at the threshold)".to_string()
-        };
-        ("inconclusive", None, format!("the interval straddles {target:.4}, half the paper's factor; {more}"))
-    };
+    let (verdict, held, why) = ratio.verdict(target, true);
+    let reason = format!("{why} (half the paper's factor)");
     let model = &report.meta.cost_model;
     let reach = s.curve().map(|c| {
         format!(

@@ -10,6 +10,7 @@
 //! repetitions, since each `mse_se` is itself estimated from them. A claim holds when the interval clears its threshold, does not when it lies on the
 //! other side, and is `inconclusive`, with the repetitions that would decide, when it straddles.
 
+use crate::cost_model::Regime;
 use crate::metrics::SummaryRow;
 use crate::output::{Claim, RunReport};
 use serde::{Deserialize, Serialize};
@@ -64,6 +65,11 @@ impl RatioMetric {
             RatioMetric::PErr => Some(r.p_err),
         };
         v.filter(|v| v.is_finite() && *v > 0.0)
+    }
+
+    /// The cost regime of a time-based metric (the CPU seconds it divides by).
+    fn regime(self) -> Option<Regime> {
+        matches!(self, RatioMetric::EfficiencyMse | RatioMetric::PEff).then_some(Regime::Measured)
     }
 
     /// The power of the MSE the metric scales with (an RMSE is its square root).
@@ -175,6 +181,7 @@ pub fn ratio_claim(report: &RunReport, spec: &RatioSpec<'_>, claim: &str, note: 
         claim: claim.into(),
         paper_value: paper,
         pair: format!("{estimator} vs {baseline}"),
+        regime: metric.regime().map_or(String::new(), |r| r.name().into()),
         ..Default::default()
     };
     let (Some(a), Some(b)) = (row(report, tb, estimator, budget), row(report, tb, baseline, budget)) else {
