@@ -45,6 +45,49 @@ fn an_unregistered_sampler_name_fails_the_suite() {
     );
 }
 
+/// An estimator that carries state through a sequence (PMC-IP allocates an image's samples across
+/// its pixels) but declares its integrals independent fails the suite: the declaration, which
+/// gives the unbiasedness tests more power, is checked.
+#[test]
+fn a_false_independence_declaration_fails_the_suite() {
+    use estimators::estimator::Estimator;
+    struct Claims(Box<dyn Estimator>);
+    impl Estimator for Claims {
+        fn estimate(
+            &self,
+            task: &estimators::task::Task<'_>,
+            rng: &mut estimators::rng::StreamRng,
+        ) -> Result<estimators::math::Rgb, estimators::error::EstimateError> {
+            self.0.estimate(task, rng)
+        }
+        fn estimate_sequence(
+            &self,
+            tasks: &[estimators::task::Task<'_>],
+            rng: &mut estimators::rng::StreamRng,
+        ) -> Result<Vec<estimators::math::Rgb>, estimators::error::EstimateError> {
+            self.0.estimate_sequence(tasks, rng)
+        }
+        fn integrals_independent(&self) -> bool {
+            true
+        }
+        fn supports(&self, bed: &dyn estimators::testbed::TestBed) -> Result<(), String> {
+            self.0.supports(bed)
+        }
+    }
+    let real = registry::estimator("pmc_ip").expect("registered");
+    let entry = registry::EstimatorEntry {
+        build: |p| Ok(Box::new(Claims((registry::estimator("pmc_ip").expect("registered").build)(p)?))),
+        samplers: &[],
+        ..*real
+    };
+    let failures = Conformance::new(registry()).expect("builds").check(&entry);
+    assert!(
+        failures.iter().any(|f| f.check == "independence"),
+        "{:?}",
+        failures.iter().map(|f| format!("{}: {}", f.check, f.detail)).collect::<Vec<_>>()
+    );
+}
+
 /// The registry of the `mcbench` binary, reading the repository's stored references.
 fn registry() -> &'static mcbench::Registry {
     static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();

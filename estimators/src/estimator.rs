@@ -65,6 +65,16 @@ pub trait Estimator: Send + Sync {
         tasks.iter().map(|t| self.estimate(t, rng)).collect()
     }
 
+    /// Whether the estimates of one sequence's integrals are independent of each other: no state
+    /// (an adaptive structure, a sample allocation, particles) carried from one task to the next,
+    /// as with the default [`Estimator::estimate_sequence`]. The unbiasedness tests then count
+    /// each integral's test as an independent chance of finding a bias spread over the image
+    /// (integrals of different sequences always are: each sequence has its own stream). The
+    /// default, `false`, treats a sequence as one chance, which is never wrong, only less powerful.
+    fn integrals_independent(&self) -> bool {
+        false
+    }
+
     /// Whether this configured estimator can run on `bed` beyond the static needs of its registry
     /// entry; `Err(reason)` makes the harness skip the pair and report the reason.
     fn supports(&self, _bed: &dyn TestBed) -> Result<(), String> {

@@ -17,7 +17,11 @@
 //!    harness's own test ([`crate::analysis::unbiasedness`], deciding test as in the claims; about
 //!    8000 estimates per bed) must
 //!    not flag it. The same check must flag the known-biased control `clamped_is0_cv0`
-//!    (`tests/conformance.rs` asserts that), so it has teeth.
+//!    (`tests/conformance.rs` asserts that), so it has teeth;
+//! 6. **independence** (estimators that declare
+//!    [`estimators::estimator::Estimator::integrals_independent`]): on the first bed with sequences
+//!    longer than one integral, the sequence estimated at once equals its tasks estimated one by
+//!    one from the same stream (no state carried from task to task).
 
 use crate::analysis::{unbiasedness, Gate, TestRow};
 use crate::cell::CellResult;
@@ -42,7 +46,7 @@ use std::sync::OnceLock;
 pub struct Failure {
     /// Estimator id.
     pub estimator: String,
-    /// Which check (`build`, `finite`, `determinism`, `samplers`, `unbiasedness`).
+    /// Which check (`build`, `finite`, `determinism`, `independence`, `samplers`, `unbiasedness`).
     pub check: &'static str,
     /// What went wrong (one line).
     pub detail: String,
@@ -167,7 +171,7 @@ pub fn small_budget_unbiasedness(entry: &EstimatorEntry, est: &dyn Estimator, be
     let reps = (8000 / n).max(8) as u64;
     let tested = small_budget_cell(entry, est, bed, 0..reps)?;
     let pilot = small_budget_cell(entry, est, bed, reps..2 * reps)?;
-    let gate = Gate::from_cell(&pilot, "pilot", 1.0);
+    let gate = Gate::from_cell(&pilot, "pilot", 1.0).with_group(Gate::group_of(est, bed));
     let rows = unbiasedness(&tested, bed.reference(), entry.bias, Some(&gate), crate::analysis::DEFAULT_TOLERANCE);
     decisive_test(&rows, bed.variant(), entry.id, "").cloned()
 }
@@ -200,6 +204,30 @@ fn small_budget_cell(
     let per_rep: Vec<Vec<[f64; 3]>> = per_rep.into_iter().collect::<Result<_, _>>().ok()?;
     debug_assert_eq!(per_rep.len(), count);
     Some(guarded::cell_of(bed, entry.id, Budget::samples(4).ok()?, 9, &per_rep))
+}
+
+/// The first bed with sequences longer than one integral that `est` runs on: whether its sequence
+/// estimate differs from its tasks' estimates one by one (what `integrals_independent` promises).
+fn independence<'a>(
+    est: &dyn Estimator,
+    beds: impl Iterator<Item = &'a (String, Box<dyn TestBed>)>,
+    entry: &EstimatorEntry,
+) -> Option<String> {
+    let (label, bed) = beds
+        .filter(|(_, b)| b.sequence_length() > 1)
+        .find(|(_, b)| matches!(runs_on(entry, est, b.as_ref()), Ok(true)))?;
+    let budget = Budget::samples(4).ok()?;
+    let key = StreamKey { seed: 9, testbed: label, estimator: entry.id, budget: 4, rep: 0, integral: 0 };
+    let tasks: Vec<estimators::task::Task<'_>> =
+        (0..bed.sequence_length()).map(|i| estimators::task::Task::new(bed.as_ref(), i, budget)).collect();
+    let at_once = est.estimate_sequence(&tasks, &mut key.rng()).ok()?;
+    let mut rng = key.rng();
+    let one_by_one: Vec<_> = tasks.iter().map(|t| est.estimate(t, &mut rng)).collect::<Result<_, _>>().ok()?;
+    (at_once != one_by_one).then(|| {
+        format!(
+            "{label}: declares its integrals independent, but its sequence estimate differs from its tasks' one by one"
+        )
+    })
 }
 
 fn conformance_on(entry: &EstimatorEntry, stability: &Beds, unbiased: &Beds) -> Vec<Failure> {
@@ -236,6 +264,13 @@ fn conformance_on(entry: &EstimatorEntry, stability: &Beds, unbiased: &Beds) -> 
                     }
                 }
             }
+        }
+    }
+    // 6. Independent integrals, where the estimator declares them: a sequence estimated at once
+    // equals its tasks estimated one by one in order from the same stream.
+    if est.integrals_independent() {
+        if let Some(e) = independence(est.as_ref(), stability.iter().chain(unbiased), entry) {
+            out.push(fail("independence", e));
         }
     }
     // 4. Samplers.

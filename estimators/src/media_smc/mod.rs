@@ -135,6 +135,10 @@ impl Estimator for MediaSmc {
             tasks.iter().map(|t| self.estimate(t, rng)).collect()
         }
     }
+    /// With one structure per pixel (`shared = 0`) each pixel is estimated on its own.
+    fn integrals_independent(&self) -> bool {
+        !self.shared
+    }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         supports_radiance(bed)
     }
@@ -192,6 +196,9 @@ impl Estimator for SurfaceOrMedium {
     }
     fn estimate_sequence(&self, tasks: &[Task<'_>], rng: &mut StreamRng) -> Result<Vec<Rgb>, EstimateError> {
         self.pick(tasks.first()).estimate_sequence(tasks, rng)
+    }
+    fn integrals_independent(&self) -> bool {
+        self.surface.integrals_independent() && self.medium.integrals_independent()
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         match (bed.hemisphere(), bed.medium()) {

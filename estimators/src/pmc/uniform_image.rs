@@ -47,4 +47,8 @@ impl Estimator for UniformImage {
         }
         Ok(if n > 0 { sum / n as f64 } else { Rgb::ZERO })
     }
+    /// Each pixel is estimated on its own by the default `estimate_sequence`.
+    fn integrals_independent(&self) -> bool {
+        true
+    }
 }

@@ -198,6 +198,47 @@ pub fn detectable_shift(std_err: f64, alpha: f64, power: f64) -> f64 {
     (z_alpha + z_power) * std_err
 }
 
+/// Smallest shift `s` at which at least one of several independent two-sided t-tests, each at
+/// level `alpha` with `dof` degrees of freedom, rejects with probability `power`, when test `i`'s
+/// statistic has noncentrality `s * strength[i]` (its signal per unit shift over its standard
+/// error). Each test's power is `F_t(s q_i - t_{1-alpha/2})` (the noncentral t approximated by a
+/// shifted central one and the opposite tail ignored, as for [`detectable_shift_t`]), and the
+/// tests' powers combine as `1 - prod(1 - P_i)`. With one test it is `detectable_shift_t` with
+/// unit standard error over `strength[0]`. For dependent tests the combined power is smaller: pass
+/// only the strongest test then, whose power bounds it from below whatever the dependence.
+///
+/// Returns `NaN` without a positive finite strength or outside `0 < alpha, power < 1`.
+pub fn detectable_shift_any(strength: &[f64], alpha: f64, power: f64, dof: f64) -> f64 {
+    let in_unit = |x: f64| x > 0.0 && x < 1.0;
+    let q: Vec<f64> = strength.iter().copied().filter(|q| q.is_finite() && *q > 0.0).collect();
+    if !in_unit(alpha) || !in_unit(power) || q.is_empty() || dof.is_nan() || dof <= 0.0 {
+        return f64::NAN;
+    }
+    let crit = t_quantile(1.0 - alpha / 2.0, dof);
+    let cdf = |x: f64| {
+        if dof > NORMAL_LIMIT_DOF {
+            0.5 * erfc(-x / std::f64::consts::SQRT_2)
+        } else {
+            StudentsT::new(0.0, 1.0, dof).map(|t| t.cdf(x)).unwrap_or(f64::NAN)
+        }
+    };
+    // log(1 - combined power): the sum of each test's log miss probability, decreasing in s.
+    let log_miss = |s: f64| q.iter().map(|&qi| (-cdf(s * qi - crit)).ln_1p()).sum::<f64>();
+    let target = (-power).ln_1p();
+    // The strongest test alone reaches the power at `hi`; a shift that no test sees leaves `lo`.
+    let q_max = q.iter().copied().fold(0.0, f64::max);
+    let (mut lo, mut hi) = (0.0, (crit + t_quantile(power, dof)) / q_max);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if log_miss(mid) > target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
 /// The largest sample skewness at which a one-sample t-test of `n` observations keeps its two-sided
 /// tail at `alpha` within a factor 2 of nominal, by the first Edgeworth term of the studentised
 /// mean: one tail moves by about `phi(z) |G1| (2 z^2 + 1) / (6 sqrt(n))` against
@@ -233,6 +274,26 @@ mod tests {
         let neg = one_sample_t(1.0, 0.5, 11, 2.0);
         assert_eq!(neg.statistic, -2.0);
         assert_eq!(neg.p_value, out.p_value);
+    }
+
+    #[test]
+    fn detectable_shift_any_reduces_to_one_test_and_gains_from_many() {
+        let one = detectable_shift_any(&[2.0], 1e-3, 0.8, 30.0);
+        assert!(close(one, detectable_shift_t(0.5, 1e-3, 0.8, 30.0), 1e-9), "{one}");
+        // Many equal independent tests at a Bonferroni level: each weak, together they resolve a
+        // shift smaller than one of them alone at that level.
+        let m = 1000;
+        let alone = detectable_shift_any(&[1.0], 1e-3 / m as f64, 0.8, 1e9);
+        let all = detectable_shift_any(&vec![1.0; m], 1e-3 / m as f64, 0.8, 1e9);
+        assert!(all < 0.6 * alone, "{all} vs {alone}");
+        // The combined power at the returned shift is the asked one.
+        let normal = Normal::new(0.0, 1.0).unwrap();
+        let crit = -normal.inverse_cdf(1e-3 / m as f64 / 2.0);
+        let miss = (1.0 - normal.cdf(all - crit)).powi(m as i32);
+        assert!(close(1.0 - miss, 0.8, 1e-6), "{}", 1.0 - miss);
+        // Tests that see nothing do not count; none at all gives NaN.
+        assert_eq!(detectable_shift_any(&[2.0, 0.0, f64::NAN], 1e-3, 0.8, 30.0), one);
+        assert!(detectable_shift_any(&[], 1e-3, 0.8, 30.0).is_nan());
     }
 
     #[test]

@@ -15,8 +15,8 @@ pub mod regression;
 
 pub use chi_square::{chi_square_gof, histogram, ChiSquare, StatsError, MIN_EXPECTED_COUNT};
 pub use hypothesis::{
-    detectable_shift, detectable_shift_t, holm_bonferroni, one_sample_t, sidak_alpha, t_quantile, t_test,
-    t_test_skewness_limit, welch, z_test, TestOutcome,
+    detectable_shift, detectable_shift_any, detectable_shift_t, holm_bonferroni, one_sample_t, sidak_alpha, t_quantile,
+    t_test, t_test_skewness_limit, welch, z_test, TestOutcome,
 };
 pub use moments::{Moments, NeumaierSum};
 pub use regression::{linear_fit, log_log_fit, weighted_linear_fit, SlopeFit};

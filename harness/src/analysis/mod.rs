@@ -2,6 +2,8 @@
 //! papers' speed-up computation (paper 000/001).
 
 pub mod bias;
+mod holm;
+mod pooled;
 pub mod speedup;
 
 pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE, POOLED_SHARE};

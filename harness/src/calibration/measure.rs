@@ -124,6 +124,7 @@ pub fn measure(
     let id = plan.estimators[0].name.clone();
     let budget = plan.sweep.budgets[0];
     let ref_sum: f64 = reference.value.iter().flat_map(|v| v.0).map(f64::abs).sum();
+    let group = Gate::group_of(plan.estimators[0].estimator.as_ref(), bed);
     let seeds: Vec<Result<SeedOutcome>> = (0..seeds)
         .into_par_iter()
         .map(|k| {
@@ -134,7 +135,7 @@ pub fn measure(
                 guarded::cell_of(bed, &id, budget, seed, &t)
             };
             let decide = |f: &dyn Fn([f64; 3]) -> [f64; 3]| {
-                let gate = Gate::from_cell(&cell(&pilot, f), "pilot", 1.0);
+                let gate = Gate::from_cell(&cell(&pilot, f), "pilot", 1.0).with_group(group);
                 let rows = unbiasedness(&cell(&tested, f), reference, family.bias, Some(&gate), tolerance);
                 let ran = rows.iter().any(|t| t.test == "pooled_t" && !t.p_value.is_nan());
                 (rows.into_iter().find(|t| t.test == "combined").unwrap_or_default(), ran)

@@ -60,6 +60,9 @@ impl Estimator for Scaled {
         Ok(self.inner.estimate_sequence(tasks, rng)?.into_iter().map(|v| Rgb(self.apply(v.0))).collect())
     }
 
+    fn integrals_independent(&self) -> bool {
+        self.inner.integrals_independent()
+    }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         self.inner.supports(bed)
     }
@@ -102,6 +105,9 @@ impl Estimator for FireflyRejection {
         Ok(self.inner.estimate_sequence(tasks, rng)?.into_iter().map(|v| Rgb(self.apply(v.0))).collect())
     }
 
+    fn integrals_independent(&self) -> bool {
+        self.inner.integrals_independent()
+    }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         self.inner.supports(bed)
     }

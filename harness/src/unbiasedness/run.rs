@@ -33,7 +33,8 @@ fn rows_of(plan: &Plan, run: &RunResults, pilot: &RunResults, report: &mut RunRe
     for ((bi, ei, cell), (_, _, pilot_cell)) in run.cells.iter().zip(&pilot.cells) {
         let bed = plan.beds[*bi].bed.as_ref();
         let bias = plan.estimators[*ei].entry.bias;
-        let gate = crate::analysis::Gate::from_cell(pilot_cell, "pilot", 1.0);
+        let group = crate::analysis::Gate::group_of(plan.estimators[*ei].estimator.as_ref(), bed);
+        let gate = crate::analysis::Gate::from_cell(pilot_cell, "pilot", 1.0).with_group(group);
         let mut tests = crate::analysis::unbiasedness(cell, bed.reference(), bias, Some(&gate), plan.sweep.tolerance());
         if let estimators::testbed::ReferenceKind::Stored { command, .. } = &bed.reference().kind {
             if made_by(command, &plan.estimators[*ei].spec.id) {
