@@ -133,7 +133,12 @@ mod tests {
                         assert!(names.iter().any(|n| n == e), "{} ({}): {e} is not run", file.name, mode.name());
                     }
                     if let Some(t) = c.testbed() {
-                        assert!(beds.iter().any(|b| b == t), "{} ({}): test bed {t} is not run", file.name, mode.name());
+                        assert!(
+                            beds.iter().any(|b| b == t),
+                            "{} ({}): test bed {t} is not run",
+                            file.name,
+                            mode.name()
+                        );
                     }
                     judged += 1;
                 }

@@ -439,7 +439,17 @@ impl ClaimSpec {
                 }
                 c
             }
-            ClaimSpec::RatioOfRatios { testbed, numerator, denominator, budget, metric, threshold, side, value, text } => {
+            ClaimSpec::RatioOfRatios {
+                testbed,
+                numerator,
+                denominator,
+                budget,
+                metric,
+                threshold,
+                side,
+                value,
+                text,
+            } => {
                 let family = Family { tb: split(testbed), budget: *budget, metric: *metric, paper: *value };
                 let n = [numerator[0].as_str(), numerator[1].as_str()];
                 let d = [denominator[0].as_str(), denominator[1].as_str()];

@@ -95,7 +95,12 @@ pub fn refused(base: Claim, name: &str) -> Claim {
 }
 
 /// The rows of `names` on `tb` at `budget`, or the first name without one.
-fn rows<'a>(report: &'a RunReport, tb: (&str, &str), names: &[&'a str], budget: u64) -> Result<Vec<&'a SummaryRow>, String> {
+fn rows<'a>(
+    report: &'a RunReport,
+    tb: (&str, &str),
+    names: &[&'a str],
+    budget: u64,
+) -> Result<Vec<&'a SummaryRow>, String> {
     names.iter().map(|n| row(report, tb, n, budget).ok_or_else(|| n.to_string())).collect()
 }
 
@@ -152,14 +157,18 @@ pub fn ordering_claim(
     let (es, os) = match (rows(report, family.tb, estimators, budget), rows(report, family.tb, others, budget)) {
         (Ok(e), Ok(o)) => (e, o),
         (Err(n), _) | (_, Err(n)) => {
-            return missing(base, format!("no cell for {n} at budget {budget}: the ordering cannot be judged without it"))
+            return missing(
+                base,
+                format!("no cell for {n} at budget {budget}: the ordering cannot be judged without it"),
+            )
         }
     };
     let mut pairs: Vec<(String, Ratio)> = Vec::new();
     for a in &es {
         for b in &os {
             let Some(r) = Ratio::of(family.metric, a, b) else {
-                let why = format!("{} not defined for {} or {} at {budget}", family.metric.name(), a.estimator, b.estimator);
+                let why =
+                    format!("{} not defined for {} or {} at {budget}", family.metric.name(), a.estimator, b.estimator);
                 return missing(base, why);
             };
             pairs.push((format!("{} vs {}", a.estimator, b.estimator), r));
@@ -182,7 +191,10 @@ pub fn ordering_claim(
             ("not held", Some(false), format!("{}: the interval lies on the other side of 1 ({adj})", pairs[i].0))
         }
         Decision::Open(open) => {
-            let need = open.iter().filter_map(|&i| repetitions_to_decide((pairs[i].1.value, pairs[i].1.reps), ends[i], 1.0)).fold(0.0, f64::max);
+            let need = open
+                .iter()
+                .filter_map(|&i| repetitions_to_decide((pairs[i].1.value, pairs[i].1.reps), ends[i], 1.0))
+                .fold(0.0, f64::max);
             let names: Vec<&str> = open.iter().map(|&i| pairs[i].0.as_str()).collect();
             let more = if need > 0.0 {
                 format!("about {need} repetitions would decide it")
@@ -192,11 +204,8 @@ pub fn ordering_claim(
             ("inconclusive", None, format!("the intervals of {} straddle 1 ({adj}); {more}", names.join(", ")))
         }
     };
-    let listed: Vec<String> = pairs
-        .iter()
-        .zip(&ends)
-        .map(|((p, r), (lo, hi))| format!("{p}: {:.4} [{lo:.4}, {hi:.4}]", r.value))
-        .collect();
+    let listed: Vec<String> =
+        pairs.iter().zip(&ends).map(|((p, r), (lo, hi))| format!("{p}: {:.4} [{lo:.4}, {hi:.4}]", r.value)).collect();
     let (lo, hi) = ends[bind];
     Claim {
         our_value: Some(pairs[bind].1.value),
@@ -264,7 +273,9 @@ pub fn optimum_claim(
     let adj = format!("level {level:.4}, Bonferroni over {} inside x {} outside pairs", ins.len(), outs.len());
     let (a, b) = (&ins[bi].estimator, &outs[bo].estimator);
     let (verdict, held, reason) = match (decide(&in_wins, lowest), decide(&out_wins, lowest)) {
-        (Decision::Held, _) => ("held", Some(true), format!("the best inside, {a}, beats every outside candidate ({adj})")),
+        (Decision::Held, _) => {
+            ("held", Some(true), format!("the best inside, {a}, beats every outside candidate ({adj})"))
+        }
         (_, Decision::Held) => {
             ("not held", Some(false), format!("the best outside, {b}, beats every inside candidate ({adj})"))
         }
@@ -312,10 +323,7 @@ pub fn ratio_of_ratios_claim(
     claim: &str,
 ) -> Claim {
     let mut base = family.base(claim);
-    base.pair = format!(
-        "({} vs {}) vs ({} vs {})",
-        numerator[0], numerator[1], denominator[0], denominator[1]
-    );
+    base.pair = format!("({} vs {}) vs ({} vs {})", numerator[0], numerator[1], denominator[0], denominator[1]);
     for [a, b] in [numerator, denominator] {
         if a == b {
             return refused(base, a);
@@ -325,9 +333,9 @@ pub fn ratio_of_ratios_claim(
         return missing(base, format!("no rows on {}/{}", family.tb.0, family.tb.1));
     };
     let ratio = |[a, b]: [&str; 2]| -> Result<Ratio, String> {
-        let (ra, rb) = rows(report, family.tb, &[a, b], budget).map(|v| (v[0], v[1])).map_err(|n| {
-            format!("no cell for {n} at budget {budget}")
-        })?;
+        let (ra, rb) = rows(report, family.tb, &[a, b], budget)
+            .map(|v| (v[0], v[1]))
+            .map_err(|n| format!("no cell for {n} at budget {budget}"))?;
         Ratio::of(family.metric, ra, rb).ok_or_else(|| format!("{} not defined for {a} or {b}", family.metric.name()))
     };
     let (n, d) = match (ratio(numerator), ratio(denominator)) {
@@ -502,7 +510,8 @@ mod tests {
             assert!(c.reason.contains("refused"), "{c:?}");
         }
         let empty: ClaimSpec =
-            toml::from_str("kind = 'ordering'\ntestbed = 'a/b'\ntext = 't'\nestimators = ['a']\nothers = []\n").expect("parses");
+            toml::from_str("kind = 'ordering'\ntestbed = 'a/b'\ntext = 't'\nestimators = ['a']\nothers = []\n")
+                .expect("parses");
         assert!(empty.check().is_err());
     }
 
