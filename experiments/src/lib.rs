@@ -109,4 +109,41 @@ mod tests {
             assert!(!e.name.is_empty());
         }
     }
+
+    /// Every claim of every experiment file, in both modes, names test beds and estimators the
+    /// experiment runs (a claim about a cell that never runs would only ever be inconclusive), and
+    /// none compares an estimator with itself.
+    #[test]
+    fn every_claim_names_what_its_experiment_runs() {
+        use mcbench::config::Mode;
+        let mut judged = 0;
+        for d in super::EXPERIMENTS {
+            let file = mcbench::declare::ExperimentFile::parse(d.toml).expect("parses");
+            for mode in [Mode::Quick, Mode::Full] {
+                let sweep = file.sweep(mode).expect("sweep");
+                let names: Vec<String> = sweep.estimators.iter().map(|e| e.name()).collect();
+                let beds: Vec<String> = sweep
+                    .testbeds
+                    .iter()
+                    .map(|t| format!("{}/{}", t.id, t.variant.as_deref().unwrap_or_default()))
+                    .collect();
+                for c in &sweep.claims {
+                    c.check().unwrap_or_else(|e| panic!("{}: {e}", file.name));
+                    for e in c.estimators() {
+                        assert!(names.iter().any(|n| n == e), "{} ({}): {e} is not run", file.name, mode.name());
+                    }
+                    if let Some(t) = c.testbed() {
+                        assert!(
+                            beds.iter().any(|b| b == t),
+                            "{} ({}): test bed {t} is not run",
+                            file.name,
+                            mode.name()
+                        );
+                    }
+                    judged += 1;
+                }
+            }
+        }
+        assert!(judged > 0);
+    }
 }

@@ -3,6 +3,8 @@
 //! `spm_adaptive` for sigma_samp in {0.4, 0.5, 0.6, 0.7, 0.8, 1, 2}, plus delta tracking, at equal
 //! fetch budgets (Fig. 7: 500 fetches per pixel). The terminating model is only run where it is
 //! valid on both media (sigma_samp >= 0.95: r <= 2/(a+1) with a = 0.9); elsewhere it is refused.
+//! The FoM optimum claims are data (`optimum`, in `particle_sweep.toml`); the never-worse family
+//! claim is here.
 
 use crate::ExperimentDef;
 use mcbench::claims::ratio::{self, Ratio, RatioMetric};
@@ -41,7 +43,6 @@ fn claims(r: &RunReport) -> Vec<Claim> {
     let budget = r.rows.iter().map(|x| x.budget).max().unwrap_or(500);
     let mut out = Vec::new();
     for tb in ["eq21-medium", "perlin-medium"] {
-        out.push(optimum_claim(r, tb, budget));
         out.push(never_worse_claim(r, tb, budget));
     }
     out.push(Claim {
@@ -54,62 +55,6 @@ fn claims(r: &RunReport) -> Vec<Claim> {
         ..Default::default()
     });
     out
-}
-
-/// "FoM peaks below sigma_samp = 1": the best sigma_samp below the maximum extinction against the
-/// best at or above it (sigma_samp 1 and 2), judged on the interval of their FoM ratio at a
-/// Bonferroni level over the candidates below 1 (the best is picked from them, so its interval
-/// must hold for every one of them).
-fn optimum_claim(r: &RunReport, tb: &str, budget: u64) -> Claim {
-    let (paper, text) = if tb == "eq21-medium" {
-        (0.8, "Fig. 6: FoM peaks near sigma_samp = 0.8, below the maximum extinction 1")
-    } else {
-        (0.5, "Fig. 7: the optimal sigma_samp (~0.5) is below the maximum extinction 1")
-    };
-    let fom = |s: f64| row(r, tb, &name("spm_adaptive", s), budget).and_then(|x| x.fom).map(|f| (s, f));
-    let best_of = |v: Vec<(f64, f64)>| v.into_iter().max_by(|a, b| a.1.total_cmp(&b.1));
-    let below: Vec<(f64, f64)> = SIGMAS.iter().filter(|s| **s < 1.0).filter_map(|s| fom(*s)).collect();
-    let k = below.len().max(1);
-    let (lo_best, hi_best) =
-        (best_of(below), best_of(SIGMAS.iter().filter(|s| **s >= 1.0).filter_map(|s| fom(*s)).collect()));
-    let mut c = Claim {
-        testbed: format!("{tb}/multiple"),
-        claim: format!("paper 002 {text} (adaptive model)"),
-        paper_value: Some(paper),
-        ..Default::default()
-    };
-    let ratio = lo_best.zip(hi_best).and_then(|((s, _), (t, _))| {
-        fom_ratio(r, tb, (&name("spm_adaptive", s), &name("spm_adaptive", t)), budget).map(|q| (s, t, q))
-    });
-    let Some((s, t, q)) = ratio else {
-        c.verdict = "not measured".into();
-        c.note = format!("no adaptive FoM at {budget} fetches on both sides of sigma_samp 1");
-        return c;
-    };
-    let level = 1.0 - (1.0 - ratio::LEVEL) / k as f64;
-    let (lo, hi) = q.interval_at(level);
-    let (verdict, held, reason) = if lo > 1.0 {
-        ("held", Some(true), format!("the best FoM below 1 beats the best at or above 1: the interval lies above 1 (level {level:.4}, Bonferroni over {k} candidates)"))
-    } else if hi < 1.0 {
-        (
-            "not held",
-            Some(false),
-            format!("the best FoM at or above 1 is higher: the interval lies below 1 (level {level:.4})"),
-        )
-    } else {
-        ("inconclusive", None, format!("the interval straddles 1 (level {level:.4}, Bonferroni over {k} candidates); more repetitions would narrow it as 1/sqrt(repetitions)"))
-    };
-    c.our_value = Some(s);
-    c.interval = Some([lo, hi]);
-    c.held = held;
-    c.verdict = verdict.into();
-    c.reason = reason;
-    c.pair = format!("{} vs {}", name("spm_adaptive", s), name("spm_adaptive", t));
-    c.note = format!(
-        "FoM = 1/(MSE x fetches) at {budget} fetches; our value is the best sigma_samp below 1; FoM ratio best-below ({s}) / best-at-or-above ({t}) {:.3} [{lo:.3}, {hi:.3}] ({} repetitions)",
-        q.value, q.reps
-    );
-    c
 }
 
 /// "The adaptive version is never worse than the terminating and non-terminating ones": every

@@ -35,16 +35,6 @@
 //! text = "256 cells at 1024 spp"
 //!
 //! [[claims]]
-//! kind = "diagnostic"                  # an estimator diagnostic's mean at a budget
-//! testbed = "gradient-plane/default"
-//! estimator = "is1_cv2"
-//! budget = 1024
-//! name = "cells"
-//! value = 256.0
-//! tolerance = 0.1                      # relative
-//! text = "256 cells at 1024 spp"
-//!
-//! [[claims]]
 //! kind = "speedup"                     # at the largest budget, judged on its 95% interval
 //! testbed = "gradient-plane/diffuse"
 //! estimator = "my_estimator"
@@ -58,19 +48,49 @@
 //! testbed = "eq21-medium/transmittance"
 //! estimator = "delta_tracking"
 //! baseline = "residual_ratio_tracking"
-//! budget = 10
+//! budget = 10                          # default: the largest budget of the test bed
 //! metric = "rmse"                      # rmse (default) | mse | fom | efficiency_mse | p_eff | p_err
 //! side = "above"                       # its 95% interval lies above `threshold` (default 1)
 //! value = 6.8                          # the paper's ratio (optional)
 //! text = "Woodcock tracking has the larger error"
 //!
 //! [[claims]]
+//! kind = "ordering"                    # each of `estimators` beats each of `others`
+//! testbed = "eq21-medium/single-scatter"
+//! estimators = ["mis"]
+//! others = ["delta_tracking", "source_driven", "scattering_driven"]
+//! budget = 300                         # default: the largest budget of the test bed
+//! metric = "rmse"
+//! order = "lowest"                     # lowest (default) | highest: of the metric itself
+//! text = "MIS has the lowest error"    # judged at a Bonferroni level over the pairs
+//!
+//! [[claims]]
+//! kind = "optimum"                     # the best of the candidates is one of `inside`
+//! testbed = "eq21-medium/multiple"
+//! inside = ["spm_adaptive[sigma_samp=0.5]", "spm_adaptive[sigma_samp=0.8]"]
+//! outside = ["spm_adaptive[sigma_samp=1]", "spm_adaptive[sigma_samp=2]"]
+//! metric = "fom"                       # best: lowest for errors, highest for fom and efficiencies
+//! value = 0.8                          # the paper's optimum (optional, shown in the note)
+//! text = "FoM peaks below sigma_samp = 1"
+//!
+//! [[claims]]
+//! kind = "ratio_of_ratios"             # (m(n0) / m(n1)) / (m(d0) / m(d1)) against `threshold`
+//! testbed = "envmap-sequence/mixed-lns"
+//! numerator = ["smc[moves=1]", "smc[moves=10]"]
+//! denominator = ["smc_bridge[bridges=1]", "smc_bridge[bridges=10]"]
+//! side = "below"
+//! text = "more moves reduce the error less than more bridges"
+//!
+//! [[claims]]
 //! kind = "control_flagged"             # the unbiasedness test flags a biased control
 //! estimator = "clamped_is0_cv0"
 //! ```
+//!
+//! A claim never compares an estimator with itself: [`ClaimSpec::check`] refuses such a claim when
+//! its file is read, and [`ClaimSpec::judge`] refuses it too (verdict `not measured`).
 
 use crate::analysis::SlopeRange;
-use crate::claims::{self, RatioMetric, RatioSpec};
+use crate::claims::{self, Family, RatioMetric, RatioSpec};
 use crate::cost_model::Regime;
 use crate::output::{Claim, RunReport};
 use serde::{Deserialize, Serialize};
@@ -143,8 +163,9 @@ pub enum ClaimSpec {
         estimator: String,
         /// The denominator's estimator.
         baseline: String,
-        /// The budget both are compared at.
-        budget: u64,
+        /// The budget both are compared at (default: the largest budget of the test bed).
+        #[serde(default)]
+        budget: Option<u64>,
         /// `rmse` (default), `mse`, `fom`, `efficiency_mse`, `p_eff` or `p_err`.
         #[serde(default)]
         metric: RatioMetric,
@@ -155,6 +176,85 @@ pub enum ClaimSpec {
         #[serde(default)]
         side: Side,
         /// The paper's ratio, when it gives one.
+        #[serde(default)]
+        value: Option<f64>,
+        /// The claim in words.
+        text: String,
+    },
+    /// Each of `estimators` has the lowest (or highest, `order`) `metric` against each of
+    /// `others` at `budget` ([`claims::ordering_claim`]): judged on the ratio intervals of every
+    /// pair at a Bonferroni level over the pairs; held when all lie on the claimed side of 1, not
+    /// held when one lies on the other side, inconclusive otherwise.
+    Ordering {
+        /// `id/variant`.
+        testbed: String,
+        /// The estimators claimed to rank first (as a group).
+        estimators: Vec<String>,
+        /// The estimators they are claimed to beat.
+        others: Vec<String>,
+        /// The budget (default: the largest budget of the test bed).
+        #[serde(default)]
+        budget: Option<u64>,
+        /// The metric, as for `ratio`.
+        #[serde(default)]
+        metric: RatioMetric,
+        /// `lowest` (default) or `highest` value of the metric.
+        #[serde(default)]
+        order: Order,
+        /// The paper's ratio, when it gives one.
+        #[serde(default)]
+        value: Option<f64>,
+        /// The claim in words.
+        text: String,
+    },
+    /// The best of `inside` and `outside` (a parameter sweep) is one of `inside` (the stated
+    /// range) ([`claims::optimum_claim`]): the best inside against the best outside, both picked
+    /// from the data, so every interval is at a Bonferroni level over the inside x outside pairs.
+    Optimum {
+        /// `id/variant`.
+        testbed: String,
+        /// The candidates in the stated range.
+        inside: Vec<String>,
+        /// The candidates outside it.
+        outside: Vec<String>,
+        /// The budget (default: the largest budget of the test bed).
+        #[serde(default)]
+        budget: Option<u64>,
+        /// The metric, as for `ratio`.
+        #[serde(default)]
+        metric: RatioMetric,
+        /// What is best: `lowest` or `highest` (default: lowest for errors, highest for `fom`,
+        /// `efficiency_mse` and `p_eff`).
+        #[serde(default)]
+        best: Option<Order>,
+        /// The paper's number (e.g. its optimal parameter), shown in the note.
+        #[serde(default)]
+        value: Option<f64>,
+        /// The claim in words.
+        text: String,
+    },
+    /// `(metric(n0) / metric(n1)) / (metric(d0) / metric(d1))` lies above (or below) `threshold`
+    /// ([`claims::ratio_of_ratios_claim`]): e.g. one change reduces the error less than another.
+    RatioOfRatios {
+        /// `id/variant`.
+        testbed: String,
+        /// The numerator's pair `[n0, n1]`.
+        numerator: [String; 2],
+        /// The denominator's pair `[d0, d1]`.
+        denominator: [String; 2],
+        /// The budget (default: the largest budget of the test bed).
+        #[serde(default)]
+        budget: Option<u64>,
+        /// The metric, as for `ratio`.
+        #[serde(default)]
+        metric: RatioMetric,
+        /// The level the ratio is claimed to clear (default 1).
+        #[serde(default = "one")]
+        threshold: f64,
+        /// `above` (default) or `below` the threshold.
+        #[serde(default)]
+        side: Side,
+        /// The paper's number, when it gives one.
         #[serde(default)]
         value: Option<f64>,
         /// The claim in words.
@@ -196,8 +296,23 @@ pub enum Side {
     Below,
 }
 
+/// Which end of a metric an ordering or optimum claim is about.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Order {
+    /// The smallest value.
+    #[default]
+    Lowest,
+    /// The largest value.
+    Highest,
+}
+
 fn one() -> f64 {
     1.0
+}
+
+fn names(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
 }
 
 fn split(testbed: &str) -> (&str, &str) {
@@ -205,6 +320,65 @@ fn split(testbed: &str) -> (&str, &str) {
 }
 
 impl ClaimSpec {
+    /// The `id/variant` the claim is about (none for `control_flagged`).
+    pub fn testbed(&self) -> Option<&str> {
+        match self {
+            ClaimSpec::Slope { testbed, .. }
+            | ClaimSpec::SlopeBelow { testbed, .. }
+            | ClaimSpec::Speedup { testbed, .. }
+            | ClaimSpec::Ratio { testbed, .. }
+            | ClaimSpec::Ordering { testbed, .. }
+            | ClaimSpec::Optimum { testbed, .. }
+            | ClaimSpec::RatioOfRatios { testbed, .. }
+            | ClaimSpec::Diagnostic { testbed, .. } => Some(testbed),
+            ClaimSpec::ControlFlagged { .. } => None,
+        }
+    }
+
+    /// Every estimator the claim names.
+    pub fn estimators(&self) -> Vec<&str> {
+        match self {
+            ClaimSpec::Slope { estimator, .. }
+            | ClaimSpec::SlopeBelow { estimator, .. }
+            | ClaimSpec::Diagnostic { estimator, .. }
+            | ClaimSpec::ControlFlagged { estimator } => vec![estimator],
+            ClaimSpec::Speedup { estimator, baseline, .. } => {
+                std::iter::once(estimator.as_str()).chain(baseline.as_deref()).collect()
+            }
+            ClaimSpec::Ratio { estimator, baseline, .. } => vec![estimator, baseline],
+            ClaimSpec::Ordering { estimators: a, others: b, .. } | ClaimSpec::Optimum { inside: a, outside: b, .. } => {
+                a.iter().chain(b).map(String::as_str).collect()
+            }
+            ClaimSpec::RatioOfRatios { numerator, denominator, .. } => {
+                numerator.iter().chain(denominator).map(String::as_str).collect()
+            }
+        }
+    }
+
+    /// Refuses a claim that compares an estimator with itself, or an ordering or optimum with an
+    /// empty side: the error names it.
+    pub fn check(&self) -> Result<(), String> {
+        let same = |names: &[&str]| claims::ordering::repeated(names).map(String::from);
+        let clash = match self {
+            ClaimSpec::Speedup { estimator, baseline: Some(b), .. } if estimator == b => Some(b.clone()),
+            ClaimSpec::Ratio { estimator, baseline, .. } if estimator == baseline => Some(baseline.clone()),
+            ClaimSpec::Ordering { estimators: a, others: b, .. } | ClaimSpec::Optimum { inside: a, outside: b, .. } => {
+                if a.is_empty() || b.is_empty() {
+                    return Err("an ordering or optimum needs estimators on both sides".into());
+                }
+                same(&self.estimators())
+            }
+            ClaimSpec::RatioOfRatios { numerator: n, denominator: d, .. } => {
+                [n, d].into_iter().find(|p| p[0] == p[1]).map(|p| p[0].clone())
+            }
+            _ => None,
+        };
+        match clash {
+            Some(n) => Err(format!("a claim compares {n} with itself")),
+            None => Ok(()),
+        }
+    }
+
     /// Judges the claim on a finished run.
     pub fn judge(&self, report: &RunReport) -> Claim {
         match self {
@@ -226,17 +400,61 @@ impl ClaimSpec {
                 claims::speedup_claim(report, split(testbed), (estimator, baseline.as_deref()), *value, text, *regime)
             }
             ClaimSpec::Ratio { testbed, estimator, baseline, budget, metric, threshold, side, value, text } => {
+                let tb = split(testbed);
+                let budget = budget.or_else(|| claims::ordering::largest_budget(report, tb)).unwrap_or(0);
                 let spec = RatioSpec {
-                    tb: split(testbed),
+                    tb,
                     estimator,
                     baseline,
-                    budget: *budget,
+                    budget,
                     metric: *metric,
                     threshold: *threshold,
                     above: *side == Side::Above,
                     paper: *value,
                 };
+                if estimator == baseline {
+                    let base = Claim {
+                        testbed: testbed.clone(),
+                        claim: text.clone(),
+                        paper_value: *value,
+                        pair: format!("{estimator} vs {baseline}"),
+                        ..Default::default()
+                    };
+                    return claims::ordering::refused(base, estimator);
+                }
                 claims::ratio_claim(report, &spec, text, "")
+            }
+            ClaimSpec::Ordering { testbed, estimators, others, budget, metric, order, value, text } => {
+                let family = Family { tb: split(testbed), budget: *budget, metric: *metric, paper: *value };
+                let (e, o) = (names(estimators), names(others));
+                claims::ordering_claim(report, &family, (&e, &o), *order == Order::Lowest, text)
+            }
+            ClaimSpec::Optimum { testbed, inside, outside, budget, metric, best, value, text } => {
+                let family = Family { tb: split(testbed), budget: *budget, metric: *metric, paper: None };
+                let lowest = best.map_or(claims::ordering::lower_is_better(*metric), |b| b == Order::Lowest);
+                let (i, o) = (names(inside), names(outside));
+                let mut c = claims::optimum_claim(report, &family, (&i, &o), lowest, text);
+                if let Some(v) = value {
+                    c.note = format!("{}; the paper's optimum: {v}", c.note);
+                }
+                c
+            }
+            ClaimSpec::RatioOfRatios {
+                testbed,
+                numerator,
+                denominator,
+                budget,
+                metric,
+                threshold,
+                side,
+                value,
+                text,
+            } => {
+                let family = Family { tb: split(testbed), budget: *budget, metric: *metric, paper: *value };
+                let n = [numerator[0].as_str(), numerator[1].as_str()];
+                let d = [denominator[0].as_str(), denominator[1].as_str()];
+                let claimed = (*threshold, *side == Side::Above);
+                claims::ratio_of_ratios_claim(report, &family, (n, d), claimed, text)
             }
             ClaimSpec::ControlFlagged { estimator } => claims::control_flagged(report, estimator),
         }

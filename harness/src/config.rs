@@ -350,6 +350,9 @@ impl Sweep {
                 .into());
             }
         }
+        for c in &self.claims {
+            c.check().map_err(|why| ConfigError::invalid("claims", c.testbed().unwrap_or("-"), why))?;
+        }
         Ok(())
     }
 }

@@ -1,7 +1,10 @@
-//! Judging paper claims against a run: slope claims, speed-up claims and ratio claims ([`ratio`]).
+//! Judging paper claims against a run: slope claims, speed-up claims, ratio claims ([`ratio`]) and
+//! claims about several cells at once: orderings, optima and ratios of ratios ([`ordering`]).
 
+pub mod ordering;
 pub mod ratio;
 
+pub use ordering::{optimum_claim, ordering_claim, ratio_of_ratios_claim, Family};
 pub use ratio::{ratio_claim, Ratio, RatioMetric, RatioSpec};
 
 use crate::analysis::{Fit, SlopeRange, SpeedUp, TestRow};
