@@ -253,6 +253,8 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "shadow_rays",
     "efficiency_renderer",
     "free_flights",
+    "target_evals",
+    "cache_ops",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).
