@@ -137,6 +137,7 @@ pub fn synthetic_report() -> RunReport {
             name: "cache_bytes".into(),
             mean: 4096.0,
         }],
+        counts: Vec::new(),
     }
 }
 
