@@ -55,6 +55,8 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
         ),
         ("bad_kind.toml", "name='x'\nbudget_kind='parsecs'\n".to_string(), "parsecs"),
         ("bad_cost.toml", format!("{SMALL}\n[cost_model]\nray_ns = -1.0\n"), "cost_model.ray_ns"),
+        ("bad_eval_cost.toml", format!("{SMALL}\n[cost_model]\ntarget_eval_ns = -1.0\n"), "cost_model.target_eval_ns"),
+        ("bad_cache_cost.toml", format!("{SMALL}\n[cost_model]\ncache_op_ns = nan\n"), "cost_model.cache_op_ns"),
         ("typo_cost.toml", format!("{SMALL}\n[cost_model]\nray = 90.0\n"), "ray"),
         ("notes.txt", "name = 'x'".to_string(), ".toml or .json"),
     ];

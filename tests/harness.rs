@@ -290,3 +290,30 @@ fn claims_declared_in_a_config_are_judged() {
     let err = mcbench::config::SweepFile::read(&path).expect_err("unknown kind");
     assert!(err.to_string().contains("slop") && err.exit_code() == 2, "{err}");
 }
+
+/// Target evaluations and cache operations are the last columns of summary.csv and a `counts`
+/// section of summary.json, per estimate: paper 001's cache counts a read and a record per sample
+/// plus its refinements, the independent estimator neither.
+#[test]
+fn summary_files_report_target_evaluations_and_cache_operations() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = run_into(dir.path(), sweep(&["is0_cv0", "is1_cv2"], 2), 2, false);
+    let res = dir.path().join("results/itest");
+    let csv = std::fs::read_to_string(res.join("summary.csv")).expect("read");
+    assert!(csv.lines().next().unwrap_or_default().ends_with(",free_flights,target_evals,cache_ops"), "{csv}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(res.join("summary.json")).expect("read")).expect("json");
+    let counts = json["counts"].as_array().expect("a counts section");
+    assert_eq!(counts.len(), out.report.rows.len());
+    for (row, c) in out.report.rows.iter().zip(counts) {
+        assert_eq!(c["estimator"], row.estimator.as_str());
+        assert_eq!((c["target_evals"].as_f64(), c["cache_ops"].as_f64()), (Some(0.0), Some(row.cache_ops)));
+        assert_eq!(row.target_evals, 0.0);
+        if row.estimator == "is1_cv2" {
+            assert!(row.cache_ops >= 2.0 * row.samples, "{} at {}: {}", row.estimator, row.budget, row.cache_ops);
+            assert!(row.cache_ops <= 2.0 * row.samples + 8.0, "{} at {}: {}", row.estimator, row.budget, row.cache_ops);
+        } else {
+            assert_eq!(row.cache_ops, 0.0);
+        }
+    }
+}

@@ -36,6 +36,26 @@ pub struct Costs {
     /// `shadow_rays` are primary rays (camera and incident-radiance queries).
     #[serde(default)]
     pub free_flights: u64,
+    /// Evaluations of the unnormalised target density an adaptive sampler weights, resamples,
+    /// moves or adapts its samples by (0 in cells stored before they were counted, and in
+    /// estimators without such a target). Paper 004: every evaluation of the product
+    /// `p~_n(w) = L_n(w) f(w, w_o) cos(theta)` of some frame, wherever it is made (the candidates
+    /// of bidirectional importance sampling, the reweighting of carried particles, each MH
+    /// proposal, both frames at a bridge's proposal); there every sample is one, so it equals
+    /// `samples`. Paper 003: the integrand value of each population member of PMC-HI (the `f` of
+    /// its weight `f / K`) and each pixel sample of PMC-IP (whose luminance adapts the kernel).
+    /// Visibility and the rays an evaluation traces are counted in `rays`, not here.
+    #[serde(default)]
+    pub target_evals: u64,
+    /// Operations on an adaptive radiance cache (papers 000 and 001; 0 in cells stored before
+    /// they were counted, and in estimators without a cache): one per read of the cache for an
+    /// estimate (paper 001: the pixel's cache read for `G`, the drawn direction and `g`; paper
+    /// 000: the octree descent to a scattering vertex's leaf and the same reads there), one per
+    /// record written (a radiance record into one cell and its partial-sum branch), and one per
+    /// refinement (paper 001: the cache doubling its resolution; paper 000: a leaf splitting into
+    /// eight, its cache doubled).
+    #[serde(default)]
+    pub cache_ops: u64,
 }
 
 /// Under a fetch budget, an estimate also stops after `budget x FETCH_BUDGET_SAMPLE_CAP` samples
@@ -149,6 +169,16 @@ impl<'a> Task<'a> {
     pub fn image_plane(&self) -> Option<ImageProbe<'_>> {
         Some(ImageProbe { scene: self.bed.image_plane()?, task: self })
     }
+    /// Counts `n` evaluations of an adaptive sampler's target density ([`Costs::target_evals`])
+    /// that no probe counts: the estimator calls it where it evaluates its target.
+    pub fn count_target_evals(&self, n: u64) {
+        self.count(|c| c.target_evals += n);
+    }
+    /// Counts `n` radiance-cache operations ([`Costs::cache_ops`]): the estimator calls it where
+    /// it reads, writes or refines its cache.
+    pub fn count_cache_ops(&self, n: u64) {
+        self.count(|c| c.cache_ops += n);
+    }
     fn count(&self, f: impl FnOnce(&mut Costs)) {
         let mut c = self.costs.get();
         f(&mut c);
@@ -167,6 +197,10 @@ impl HemisphereProbe<'_> {
     /// The shading point (geometry and BRDF are known locally and cost nothing).
     pub fn point(&self) -> &ShadingPoint {
         &self.point
+    }
+    /// Counts `n` radiance-cache operations on this integral ([`Task::count_cache_ops`]).
+    pub fn count_cache_ops(&self, n: u64) {
+        self.task.count_cache_ops(n);
     }
     /// The scene's area lights (geometry only, free); sample them, then evaluate the sampled
     /// direction with [`HemisphereProbe::integrand`], which counts it.
@@ -208,10 +242,15 @@ impl ImageProbe<'_> {
     pub fn note(&self, name: &'static str, value: f64) {
         self.task.note(name, value);
     }
+    /// Counts `n` target evaluations on this pixel ([`Task::count_target_evals`]).
+    pub fn count_target_evals(&self, n: u64) {
+        self.task.count_target_evals(n);
+    }
 }
 
 /// Counted access to one frame of one pixel of an environment sequence (paper 004). Every
-/// evaluation of the product `L_i f cos` counts one sample and every visibility test one ray.
+/// evaluation of the product `L_i f cos` counts one sample and one target evaluation, and every
+/// visibility test one ray.
 pub struct EnvProbe<'a> {
     scene: &'a dyn EnvSequenceScene,
     task: &'a Task<'a>,
@@ -239,17 +278,23 @@ impl EnvProbe<'_> {
         self.scene.quantity()
     }
     /// The unnormalised product `p~_n(w) = L_n(w) f(w, w_o) cos(theta)` of this frame per channel,
-    /// without visibility (paper 004 Eq. 2): one sample.
+    /// without visibility (paper 004 Eq. 2): one sample and one target evaluation.
     pub fn target(&self, wi: Vec3) -> Rgb {
         self.eval(&self.env, wi)
     }
     /// The same product for another frame of the sequence (bridges between frames need
-    /// `p~_{n-1}` at new points, paper 004 Eq. 11): one sample, counted on this integral.
+    /// `p~_{n-1}` at new points, paper 004 Eq. 11): one sample and one target evaluation,
+    /// counted on this integral.
     pub fn target_in_frame(&self, frame: usize, wi: Vec3) -> Rgb {
         self.eval(&self.scene.environment(frame), wi)
     }
     fn eval(&self, env: &EnvFrame<'_>, wi: Vec3) -> Rgb {
-        self.task.count(|c| c.samples += 1);
+        // A direction below the horizon is still an evaluation the sampler asked for (its value,
+        // zero, weights or rejects it).
+        self.task.count(|c| {
+            c.samples += 1;
+            c.target_evals += 1;
+        });
         let p = &self.point;
         let cos = wi.dot(p.normal);
         if cos <= 0.0 {
@@ -317,6 +362,10 @@ impl MediumProbe<'_> {
             c.shadow_rays += 1;
         });
     }
+    /// Counts `n` radiance-cache operations on this integral ([`Task::count_cache_ops`]).
+    pub fn count_cache_ops(&self, n: u64) {
+        self.task.count_cache_ops(n);
+    }
     /// Counts one more free-flight segment of the current path (the ray leaving a scattering
     /// vertex): a renderer traces it like any other ray, so `rays` counts segments, not paths.
     pub fn scattered_ray(&self) {
@@ -368,5 +417,19 @@ impl MediumProbe<'_> {
     /// True while this integral's budget is not spent ([`Task::more`]).
     pub fn more(&self) -> bool {
         self.task.more()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Costs;
+
+    /// Costs stored before target evaluations and cache operations were counted still read, as 0.
+    #[test]
+    fn costs_stored_before_the_new_counts_read_as_zero() {
+        let old = r#"{"samples":5,"fetches":2,"cheap_fetches":0,"rays":7,"shadow_rays":1,"free_flights":3}"#;
+        let c: Costs = serde_json::from_str(old).expect("reads");
+        assert_eq!(c, Costs { samples: 5, fetches: 2, rays: 7, shadow_rays: 1, free_flights: 3, ..Costs::default() });
+        assert_eq!((c.target_evals, c.cache_ops), (0, 0));
     }
 }

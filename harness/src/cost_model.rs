@@ -18,7 +18,14 @@
 //! shadow_ray_ns = 59.0    # one shadow (any-hit) ray (default 41)
 //! fetch_ns = 39.0         # one medium extinction lookup (default 4.6)
 //! cheap_fetch_ns = 4.6    # one lookup of the approximate (cheap) extinction (default 4.6)
+//! target_eval_ns = 0.0    # one evaluation of an adaptive sampler's target (default 0)
+//! cache_op_ns = 0.0       # one radiance-cache read, record or refinement (default 0)
 //! ```
+//!
+//! Target evaluations and cache operations are CPU work of the estimator itself, already in its
+//! measured CPU seconds; their default price is 0 so that the `renderer` regime does not count
+//! them twice. A non-zero price models a renderer where they cost more than here (a target with a
+//! measured BRDF, a cache whose cells miss the processor's caches).
 
 use crate::metrics::SummaryRow;
 use estimators::error::ConfigError;
@@ -44,6 +51,13 @@ pub struct CostModel {
     pub fetch_ns: f64,
     /// One lookup of the cheap approximate extinction (`cheap_fetches`).
     pub cheap_fetch_ns: f64,
+    /// One evaluation of an adaptive sampler's target density (`target_evals`: paper 004's
+    /// `p~`, paper 003's PMC population members), beyond the rays it traces. Default 0: the
+    /// evaluation is CPU work already in `cpu_seconds`.
+    pub target_eval_ns: f64,
+    /// One radiance-cache operation (`cache_ops`: a read, a record or a refinement of papers 000
+    /// and 001's caches). Default 0: the operation is CPU work already in `cpu_seconds`.
+    pub cache_op_ns: f64,
 }
 
 /// Default unit cost of a traced ray, ns (see [`CostModel`]).
@@ -52,6 +66,12 @@ pub const RENDERER_RAY_NS: f64 = 91.0;
 pub const RENDERER_SHADOW_RAY_NS: f64 = 41.0;
 /// Default unit cost of an extinction lookup, ns (see [`CostModel`]).
 pub const RENDERER_FETCH_NS: f64 = 4.6;
+/// Default unit cost of a target evaluation, ns: 0, since its work is in the measured CPU seconds
+/// (see [`CostModel`]).
+pub const RENDERER_TARGET_EVAL_NS: f64 = 0.0;
+/// Default unit cost of a radiance-cache operation, ns: 0, since its work is in the measured CPU
+/// seconds (see [`CostModel`]).
+pub const RENDERER_CACHE_OP_NS: f64 = 0.0;
 
 impl Default for CostModel {
     fn default() -> Self {
@@ -60,6 +80,8 @@ impl Default for CostModel {
             shadow_ray_ns: RENDERER_SHADOW_RAY_NS,
             fetch_ns: RENDERER_FETCH_NS,
             cheap_fetch_ns: RENDERER_FETCH_NS,
+            target_eval_ns: RENDERER_TARGET_EVAL_NS,
+            cache_op_ns: RENDERER_CACHE_OP_NS,
         }
     }
 }
@@ -93,8 +115,11 @@ impl CostModel {
     pub fn validate(&self) -> Result<(), ConfigError> {
         for (field, v) in [
             ("cost_model.ray_ns", self.ray_ns),
+            ("cost_model.shadow_ray_ns", self.shadow_ray_ns),
             ("cost_model.fetch_ns", self.fetch_ns),
             ("cost_model.cheap_fetch_ns", self.cheap_fetch_ns),
+            ("cost_model.target_eval_ns", self.target_eval_ns),
+            ("cost_model.cache_op_ns", self.cache_op_ns),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(ConfigError::invalid(field, v, "a unit cost must be a finite number of nanoseconds >= 0"));
@@ -109,7 +134,9 @@ impl CostModel {
         1e-9 * (self.ray_ns * (row.rays - shadow)
             + self.shadow_ray_ns * shadow
             + self.fetch_ns * row.fetches
-            + self.cheap_fetch_ns * row.cheap_fetches)
+            + self.cheap_fetch_ns * row.cheap_fetches
+            + self.target_eval_ns * row.target_evals
+            + self.cache_op_ns * row.cache_ops)
     }
 
     /// Seconds per estimate of `row` in `regime`.
@@ -270,11 +297,33 @@ mod tests {
     fn the_renderer_regime_prices_each_count_at_its_unit_cost() {
         let mut row = crate::plot::tests::synthetic_report().rows[0].clone();
         (row.cpu_seconds, row.rays, row.shadow_rays, row.fetches, row.cheap_fetches) = (1e-6, 10.0, 4.0, 100.0, 50.0);
-        let m = CostModel { ray_ns: 100.0, shadow_ray_ns: 40.0, fetch_ns: 5.0, cheap_fetch_ns: 1.0 };
-        // 6 closest-hit rays, 4 shadow rays, 100 fetches, 50 cheap ones: 600 + 160 + 500 + 50 ns.
+        (row.target_evals, row.cache_ops) = (30.0, 20.0);
+        let m = CostModel {
+            ray_ns: 100.0,
+            shadow_ray_ns: 40.0,
+            fetch_ns: 5.0,
+            cheap_fetch_ns: 1.0,
+            target_eval_ns: 0.0,
+            cache_op_ns: 0.0,
+        };
+        // 6 closest-hit rays, 4 shadow rays, 100 fetches, 50 cheap ones: 600 + 160 + 500 + 50 ns;
+        // target evaluations and cache operations are free at their unit costs of 0.
         assert!((m.priced_seconds(&row) - 1.31e-6).abs() < 1e-18);
         assert_eq!(m.seconds(Regime::Measured, &row), 1e-6);
         assert!((m.seconds(Regime::Renderer, &row) - 2.31e-6).abs() < 1e-18);
+        // Priced: 30 evaluations at 10 ns and 20 cache operations at 2 ns add 340 ns.
+        let priced = CostModel { target_eval_ns: 10.0, cache_op_ns: 2.0, ..m };
+        assert!((priced.priced_seconds(&row) - 1.65e-6).abs() < 1e-18);
+    }
+
+    #[test]
+    fn target_evaluations_and_cache_operations_are_free_by_default() {
+        let mut row = crate::plot::tests::synthetic_report().rows[0].clone();
+        let before = CostModel::default().priced_seconds(&row);
+        (row.target_evals, row.cache_ops) = (1e6, 1e6);
+        assert_eq!(CostModel::default().priced_seconds(&row), before, "the defaults price them at 0");
+        let parsed: CostModel = toml::from_str("target_eval_ns = 12.5\ncache_op_ns = 3.0").expect("parses");
+        assert_eq!(parsed, CostModel { target_eval_ns: 12.5, cache_op_ns: 3.0, ..CostModel::default() });
     }
 
     #[test]
@@ -283,6 +332,16 @@ mod tests {
         let e = m.validate().expect_err("negative");
         assert!(e.to_string().contains("cost_model.fetch_ns"), "{e}");
         assert!(CostModel::default().validate().is_ok());
+        for (m, field) in [
+            (CostModel { shadow_ray_ns: -1.0, ..CostModel::default() }, "cost_model.shadow_ray_ns"),
+            (CostModel { target_eval_ns: -0.5, ..CostModel::default() }, "cost_model.target_eval_ns"),
+            (CostModel { target_eval_ns: f64::INFINITY, ..CostModel::default() }, "cost_model.target_eval_ns"),
+            (CostModel { cache_op_ns: f64::NAN, ..CostModel::default() }, "cost_model.cache_op_ns"),
+            (CostModel { cache_op_ns: -2.0, ..CostModel::default() }, "cost_model.cache_op_ns"),
+        ] {
+            let e = m.validate().expect_err(field);
+            assert!(e.to_string().contains(field), "{e}");
+        }
         let parsed: CostModel = toml::from_str("ray_ns = 500.0").expect("parses");
         assert_eq!(parsed, CostModel { ray_ns: 500.0, ..CostModel::default() });
         assert!(toml::from_str::<CostModel>("ray = 500.0").is_err());

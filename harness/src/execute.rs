@@ -193,6 +193,7 @@ pub fn finish(
         speedups,
         skipped: plan.skipped.clone(),
         unavailable: Vec::new(),
+        counts: rows.iter().map(Into::into).collect(),
         rows,
         labels: plan.estimators.iter().map(|e| (e.name.clone(), e.entry.label.to_string())).collect(),
         diagnostics,

@@ -113,6 +113,16 @@ pub struct SummaryRow {
     /// counted apart); `rays - shadow_rays - free_flights` are primary rays.
     #[serde(default)]
     pub free_flights: f64,
+    /// Target-density evaluations per estimate ([`estimators::task::Costs::target_evals`]: paper
+    /// 004's `p~` evaluations, paper 003's PMC population members; 0 elsewhere and in files
+    /// written before they were counted).
+    #[serde(default)]
+    pub target_evals: f64,
+    /// Radiance-cache operations per estimate ([`estimators::task::Costs::cache_ops`]: reads,
+    /// records and refinements of papers 000 and 001's caches; 0 elsewhere and in files written
+    /// before they were counted).
+    #[serde(default)]
+    pub cache_ops: f64,
 }
 
 impl SummaryRow {
@@ -222,6 +232,8 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         shadow_rays: per(cell.costs.shadow_rays),
         efficiency_renderer: None,
         free_flights: per(cell.costs.free_flights),
+        target_evals: per(cell.costs.target_evals),
+        cache_ops: per(cell.costs.cache_ops),
     }
 }
 

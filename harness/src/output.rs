@@ -144,6 +144,41 @@ pub struct RunReport {
     /// Mean per estimate of each diagnostic an estimator noted (cache bytes, cells, ESS, ...).
     #[serde(default)]
     pub diagnostics: Vec<Diagnostic>,
+    /// Per cell, the target evaluations and cache operations per estimate (the `target_evals` and
+    /// `cache_ops` columns of summary.csv; empty in files written before they were counted).
+    #[serde(default)]
+    pub counts: Vec<CellCounts>,
+}
+
+/// The adaptive methods' counted operations of one cell, per estimate
+/// ([`estimators::task::Costs::target_evals`], [`estimators::task::Costs::cache_ops`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CellCounts {
+    /// Test bed id.
+    pub testbed: String,
+    /// Variant.
+    pub variant: String,
+    /// Estimator name.
+    pub estimator: String,
+    /// Budget.
+    pub budget: u64,
+    /// Target-density evaluations per estimate.
+    pub target_evals: f64,
+    /// Radiance-cache operations per estimate.
+    pub cache_ops: f64,
+}
+
+impl From<&SummaryRow> for CellCounts {
+    fn from(r: &SummaryRow) -> Self {
+        CellCounts {
+            testbed: r.testbed.clone(),
+            variant: r.variant.clone(),
+            estimator: r.estimator.clone(),
+            budget: r.budget,
+            target_evals: r.target_evals,
+            cache_ops: r.cache_ops,
+        }
+    }
 }
 
 /// The mean of one estimator diagnostic over a cell's estimates.
@@ -253,6 +288,8 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "shadow_rays",
     "efficiency_renderer",
     "free_flights",
+    "target_evals",
+    "cache_ops",
 ];
 
 /// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).

@@ -85,6 +85,8 @@ pub(crate) fn add_costs(a: &mut Costs, b: &Costs) {
     a.rays += b.rays;
     a.shadow_rays += b.shadow_rays;
     a.free_flights += b.free_flights;
+    a.target_evals += b.target_evals;
+    a.cache_ops += b.cache_ops;
 }
 
 /// Repetition index of the pilot stream that calibrates fetch budgets (never a real repetition).

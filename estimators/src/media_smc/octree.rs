@@ -93,6 +93,11 @@ impl<S: Scalar> Octree<S> {
         }
     }
 
+    /// Leaf splits so far (each turns one leaf into eight), `O(1)`.
+    pub fn splits(&self) -> usize {
+        (self.leaves - 1) / 7
+    }
+
     /// The cache of leaf `leaf`.
     pub fn cache_of(&self, leaf: usize) -> &RadianceCache<S> {
         &self.caches[self.nodes[leaf].cache as usize]

@@ -190,3 +190,60 @@ fn optically_thick_box_is_finite_and_agrees_with_its_reference() {
         assert!(holm > 1e-3, "{id} thick: Holm {holm}");
     }
 }
+
+/// Paper 000's cache operations are exact: per scattering vertex one read (the descent to its
+/// leaf, `G`, the drawn direction, `g`) and one record, plus one per split. Every vertex leaves
+/// along one free flight, so a path's operations are twice its free flights plus its splits.
+#[test]
+fn cache_operations_are_two_per_vertex_plus_one_per_split() {
+    let b = GradientBox::without_reference("albedo-0.8", &Params::new()).unwrap();
+    let params = MediaSmcParams { criterion: 4.0, ..MediaSmcParams::default() };
+    let est = MediaSmc::from_params(Sampling::Cache, ControlVariate::Bilinear, &params);
+    let mut tree = Octree::<f64>::new(Vec3::default(), 0.5, est.config);
+    let mut rng = crate::rng::stream(4, "cache ops");
+    let mut vertices = Vec::new();
+    let task = Task::new(&b, 100, Budget::samples(1).unwrap());
+    let probe = task.medium().unwrap();
+    for _ in 0..2000 {
+        let (before, splits) = (task.costs(), tree.splits());
+        walk::smc_path(
+            &mut tree,
+            &probe,
+            Sampling::Cache,
+            ControlVariate::Bilinear,
+            Transport::FreeFlight,
+            &mut rng,
+            &mut vertices,
+        );
+        let after = task.costs();
+        let vertices = after.free_flights - before.free_flights;
+        assert_eq!(after.cache_ops - before.cache_ops, 2 * vertices + (tree.splits() - splits) as u64);
+    }
+    let st = tree.stats();
+    assert!(st.nodes > 1, "the tree split: {st:?}");
+    assert_eq!(tree.splits(), (st.nodes - 1) / 8);
+    let c = task.costs();
+    assert_eq!(c.cache_ops, 2 * c.free_flights + tree.splits() as u64);
+    assert_eq!(c.target_evals, 0);
+}
+
+/// Over a whole image sharing one octree, the pixels' operations add up to twice the vertices
+/// plus the splits the `leaves` note implies; the independent path tracer has no cache.
+#[test]
+fn image_cache_operations_add_up_and_the_path_tracer_counts_none() {
+    let b = GradientBox::without_reference("albedo-0.8", &Params::new().with("resolution", 4.0)).unwrap();
+    for (id, cached) in [("is1_cv2", true), ("rm_is1_cv2", true), ("is0_cv0", false)] {
+        let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+        let tasks: Vec<Task<'_>> = (0..b.integrals()).map(|i| Task::new(&b, i, Budget::samples(16).unwrap())).collect();
+        est.estimate_sequence(&tasks, &mut crate::rng::stream(6, id)).unwrap();
+        let (ops, flights) =
+            tasks.iter().fold((0, 0), |(o, f), t| (o + t.costs().cache_ops, f + t.costs().free_flights));
+        if cached {
+            let leaves = tasks[0].diagnostics().iter().find(|(n, _)| *n == "leaves").unwrap().1 as u64;
+            assert_eq!(ops, 2 * flights + (leaves - 1) / 7, "{id}");
+            assert!(ops > 0, "{id}");
+        } else {
+            assert_eq!(ops, 0, "{id}");
+        }
+    }
+}

@@ -224,6 +224,7 @@ pub fn smc_path<S: Scalar, R: Rng + ?Sized>(
     let (albedo, phase) = (probe.albedo(), probe.phase());
     let (mut pos, mut dir, mut throughput) = (ray.origin, ray.dir, 1.0);
     vertices.clear();
+    let splits = tree.splits();
     let mut radiance = loop {
         let (flight, w) = match transport {
             Transport::FreeFlight => (free_flight(probe, pos, dir, rng), 1.0),
@@ -249,8 +250,12 @@ pub fn smc_path<S: Scalar, R: Rng + ?Sized>(
             }
         }
     };
+    // Cache operations of the path: per vertex one read (the descent to its leaf, G, the drawn
+    // direction, g) and one record, and every split its records triggered.
+    let reads_and_records = 2 * vertices.len() as u64;
     while let Some(v) = vertices.pop() {
         radiance = v.estimate_and_record(tree, radiance);
     }
+    probe.count_cache_ops(reads_and_records + (tree.splits() - splits) as u64);
     radiance
 }

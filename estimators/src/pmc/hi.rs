@@ -201,6 +201,8 @@ impl PmcHi {
                     let w = kernel.sample(k, rng);
                     let pdf = kernel.pdf(w);
                     let f = probe.integrand(w);
+                    // The target of the population's weight f / K (Eq. 8) and of the adaptation.
+                    task.count_target_evals(1);
                     spent += 1;
                     // K > 0 at every sample drawn from a component with alpha_k > 0, except on a
                     // null set (a lobe sample exactly at the lobe's edge); there f/K := 0.

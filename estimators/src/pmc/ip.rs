@@ -221,6 +221,8 @@ fn sample_pixel(probe: &ImageProbe<'_>, n: usize, stats: &mut Moments, rng: &mut
     for _ in 0..n {
         let (u, v): (f64, f64) = (rng.gen(), rng.gen());
         let x = probe.sample(u, v, rng);
+        // The pixel value is the target the kernel adapts to (through its luminance statistics).
+        probe.count_target_evals(1);
         stats.push(luminance(x));
         sum += x;
     }

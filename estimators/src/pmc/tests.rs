@@ -110,3 +110,36 @@ fn a_threshold_stopping_sampler_is_detected_as_biased() {
     eprintln!("threshold-stopping sampler: smallest Holm-adjusted p {p:.3e}");
     assert!(p < 1e-6, "not flagged: {p:e}");
 }
+
+/// PMC evaluates its target once per population member: PMC-HI the integrand of each weight
+/// `f / K` (Eq. 8), PMC-IP each pixel sample; the independent and threshold samplers weight
+/// nothing by a target, and no paper 003 estimator keeps a radiance cache.
+#[test]
+fn pmc_evaluates_its_target_once_per_sample() {
+    let b = bed("default");
+    for (id, per_sample) in [("pmc_hi", 1), ("pmc_hi_feedback", 1), ("mis", 0)] {
+        let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+        for spp in [1u64, 7, 64] {
+            let task = Task::new(b.as_ref(), 12, Budget::samples(spp).unwrap());
+            est.estimate(&task, &mut crate::rng::stream(spp, id)).unwrap();
+            let c = task.costs();
+            assert_eq!((c.target_evals, c.cache_ops), (per_sample * c.samples, 0), "{id} at {spp} spp");
+        }
+    }
+    let image = (registry::testbed("checker-image").unwrap().build)(
+        "default",
+        &Params::new(),
+        &crate::references::repository::Repository,
+    )
+    .unwrap();
+    for (id, per_sample) in [("pmc_ip", 1), ("uniform_image", 0), ("threshold_image", 0)] {
+        let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+        let tasks: Vec<Task<'_>> =
+            (0..image.integrals()).map(|i| Task::new(image.as_ref(), i, Budget::samples(10).unwrap())).collect();
+        est.estimate_sequence(&tasks, &mut crate::rng::stream(3, id)).unwrap();
+        let (evals, samples) =
+            tasks.iter().fold((0, 0), |(e, s), t| (e + t.costs().target_evals, s + t.costs().samples));
+        assert!(samples > 0, "{id}");
+        assert_eq!(evals, per_sample * samples, "{id}");
+    }
+}

@@ -204,3 +204,76 @@ fn stable_under_a_1e6_sun_and_30_degree_rotations() {
         }
     }
 }
+
+/// The target evaluations of one pixel's frames under `id`, with its estimates' `fallback` notes.
+fn frame_counts(id: &str, params: Params, n: u64) -> Vec<(u64, u64, bool)> {
+    let b = bed("mixed");
+    let est = (registry::estimator(id).unwrap().build)(&params).unwrap();
+    let f = b.sequence_length();
+    let tasks: Vec<Task<'_>> = (0..f).map(|i| Task::new(b.as_ref(), i, Budget::samples(n).unwrap())).collect();
+    est.estimate_sequence(&tasks, &mut crate::rng::stream(5, id)).unwrap();
+    tasks
+        .iter()
+        .map(|t| {
+            let c = t.costs();
+            (c.target_evals, c.samples, t.diagnostics().iter().any(|(name, v)| *name == "fallback" && *v > 0.0))
+        })
+        .collect()
+}
+
+/// Bidirectional importance sampling evaluates the target once per candidate on every frame:
+/// M per frame, whatever N.
+#[test]
+fn bidirectional_is_evaluates_the_target_once_per_candidate() {
+    for (m, n) in [(16u64, 4u64), (128, 8)] {
+        for (evals, samples, _) in frame_counts("bidirectional_is", Params::new().with("candidates", m as f64), n) {
+            assert_eq!((evals, samples), (m, m), "M = {m}, N = {n}");
+        }
+    }
+}
+
+/// SMC (Algorithm 1): the first frame is bidirectional (M evaluations); every later frame
+/// reweights the N carried particles (N evaluations, Eq. 3) and moves each K times (one
+/// evaluation per MH proposal, local or independent): N (1 + K).
+#[test]
+fn smc_evaluates_the_target_at_each_reweight_and_each_move() {
+    let (m, n) = (16u64, 6u64);
+    for k in [1u64, 3] {
+        let counts = frame_counts("smc", Params::new().with("candidates", m as f64).with("moves", k as f64), n);
+        assert_eq!(counts[0].0, m, "K = {k}: frame 0");
+        for (frame, (evals, samples, fallback)) in counts.iter().enumerate().skip(1) {
+            assert!(!fallback, "K = {k}: frame {frame} fell back");
+            assert_eq!(*evals, n * (1 + k), "K = {k}: frame {frame}");
+            assert_eq!(evals, samples, "every sample of paper 004 is one target evaluation");
+        }
+    }
+}
+
+/// SMC with P bridges (Algorithm 2): N reweighting evaluations, then per bridge one MH move per
+/// particle that evaluates both frames' products at its proposal (Eq. 11): N (1 + 2P).
+#[test]
+fn bridged_smc_evaluates_both_frames_at_each_proposal() {
+    let (m, n, p) = (16u64, 5u64, 3u64);
+    let counts = frame_counts("smc_bridge", Params::new().with("candidates", m as f64).with("bridges", p as f64), n);
+    assert_eq!(counts[0].0, m);
+    for (frame, (evals, _, fallback)) in counts.iter().enumerate().skip(1) {
+        assert!(!fallback, "frame {frame} fell back");
+        assert_eq!(*evals, n * (1 + 2 * p), "frame {frame}");
+    }
+}
+
+/// Counting does not draw random numbers or change an estimate: two runs from the same stream
+/// agree bit for bit, and no cache operation is counted where there is no cache.
+#[test]
+fn counted_runs_repeat_bit_for_bit_and_count_no_cache() {
+    let b = bed("mixed");
+    let est = (registry::estimator("smc").unwrap().build)(&Params::new()).unwrap();
+    let run = || {
+        let tasks: Vec<Task<'_>> = (0..4).map(|i| Task::new(b.as_ref(), i, Budget::samples(8).unwrap())).collect();
+        let v = est.estimate_sequence(&tasks, &mut crate::rng::stream(11, "repeat")).unwrap();
+        (v, tasks.iter().map(Task::costs).collect::<Vec<_>>())
+    };
+    let (a, b2) = (run(), run());
+    assert_eq!(a, b2);
+    assert!(a.1.iter().all(|c| c.cache_ops == 0 && c.target_evals > 0), "{:?}", a.1);
+}

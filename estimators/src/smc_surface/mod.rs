@@ -133,17 +133,19 @@ impl SmcSurface {
         // `draw.pdf > 0`: uniform, or a tree leaf that can only be drawn when its weight is >= 1.
         let f = probe.integrand(state.frame.to_world(domain.direction(draw.st)));
         let g = cache.g(self.cv, draw.st);
-        match self.snapshot {
+        let (estimate, refined) = match self.snapshot {
             Snapshot::BeforeRecord => {
                 let estimate = big_g + (f - g) / draw.pdf;
-                cache.add_record(draw.cell, f, g);
-                estimate
+                (estimate, cache.add_record(draw.cell, f, g))
             }
             Snapshot::AfterRecord => {
-                cache.add_record(draw.cell, f, g);
-                cache.integral(self.cv) + (f - cache.g(self.cv, draw.st)) / draw.pdf
+                let refined = cache.add_record(draw.cell, f, g);
+                (cache.integral(self.cv) + (f - cache.g(self.cv, draw.st)) / draw.pdf, refined)
             }
-        }
+        };
+        // One read (G, the drawn direction, g), one record, and the refinement it may trigger.
+        probe.count_cache_ops(2 + u64::from(refined));
+        estimate
     }
 
     /// `brdf_is1_cv2` (paper 001 §4.5-4.6, Fig. 3): the tracker picks the estimator, the direction is
@@ -182,9 +184,13 @@ impl SmcSurface {
         let chosen = if use_smc { smc } else { mcmc };
         state.tracker.update(smc, mcmc, chosen);
         state.smc_chosen += u64::from(use_smc);
+        // One read (G, the direction or its density, g); a record unless the BRDF drew a direction
+        // below the horizon, and the refinement it may trigger.
+        let mut ops = 1;
         if let Some((_, cell)) = st {
-            cache.add_record(cell, f, g);
+            ops += 1 + u64::from(cache.add_record(cell, f, g));
         }
+        probe.count_cache_ops(ops);
         chosen
     }
 }

@@ -148,3 +148,38 @@ fn parameters_are_validated_and_named() {
     assert_eq!((est.config().criterion, est.config().max_depth), (16.0, 8));
     assert_eq!((p.medium().criterion, p.medium().max_depth), (16.0, 5));
 }
+
+/// Paper 001's cache operations are exact: every sample reads the pixel's cache once (`G`, the
+/// drawn direction, `g`) and writes one record, and every refinement is one more. Four samples
+/// stay below the criterion (8 records per cell), so the cache of one cell never refines.
+#[test]
+fn cache_operations_are_a_read_and_a_record_per_sample_plus_refinements() {
+    let bed = GradientPlane::new("default", &Params::new().with("resolution", 4.0)).unwrap();
+    for id in ["is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1", "is1_cv2"] {
+        let est = build(id, &Params::new());
+        let task = Task::new(&bed, 5, Budget::samples(4).unwrap());
+        est.estimate(&task, &mut crate::rng::stream(1, id)).unwrap();
+        assert_eq!(task.costs().cache_ops, 8, "{id}");
+        for spp in [64u64, 1024] {
+            let task = Task::new(&bed, 5, Budget::samples(spp).unwrap());
+            est.estimate(&task, &mut crate::rng::stream(2, id)).unwrap();
+            let refinements = task.diagnostics().iter().find(|(n, _)| *n == "refinements").unwrap().1 as u64;
+            assert!(refinements > 0, "{id} at {spp} spp refined");
+            assert_eq!(task.costs().cache_ops, 2 * spp + refinements, "{id} at {spp} spp");
+            assert_eq!(task.costs().target_evals, 0, "{id}");
+        }
+    }
+    // The tracked estimator records every sample whose direction lies in the cache's hemisphere
+    // (a BRDF draw below the horizon has none): between one and two operations per sample.
+    let task = Task::new(&bed, 5, Budget::samples(256).unwrap());
+    build("brdf_is1_cv2", &Params::new()).estimate(&task, &mut crate::rng::stream(3, "tracked")).unwrap();
+    let refinements = task.diagnostics().iter().find(|(n, _)| *n == "refinements").unwrap().1 as u64;
+    let ops = task.costs().cache_ops - refinements;
+    assert!((256..=512).contains(&ops), "{ops}");
+    // The independent estimators keep no cache.
+    for id in ["is0_cv0", "brdf_is0_cv0"] {
+        let task = Task::new(&bed, 5, Budget::samples(64).unwrap());
+        build(id, &Params::new()).estimate(&task, &mut crate::rng::stream(4, id)).unwrap();
+        assert_eq!((task.costs().cache_ops, task.costs().target_evals), (0, 0), "{id}");
+    }
+}

@@ -220,6 +220,8 @@ mod tests {
             shadow_rays: 0.0,
             efficiency_renderer: None,
             free_flights: 0.0,
+            target_evals: 0.0,
+            cache_ops: 0.0,
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {

@@ -41,6 +41,8 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         shadow_rays: 0.0,
         efficiency_renderer: None,
         free_flights: 0.0,
+        target_evals: 0.0,
+        cache_ops: 0.0,
     }
 }
 
@@ -135,6 +137,7 @@ pub fn synthetic_report() -> RunReport {
             name: "cache_bytes".into(),
             mean: 4096.0,
         }],
+        counts: Vec::new(),
     }
 }
 
