@@ -220,6 +220,7 @@ mod tests {
             shadow_rays: 0.0,
             efficiency_renderer: None,
             free_flights: 0.0,
+            rep_blocks: Default::default(),
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {

@@ -41,6 +41,7 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         shadow_rays: 0.0,
         efficiency_renderer: None,
         free_flights: 0.0,
+        rep_blocks: Default::default(),
     }
 }
 
