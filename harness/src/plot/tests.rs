@@ -118,6 +118,9 @@ pub fn synthetic_report() -> RunReport {
             cpu_seconds: Some((1.75e-6, 1e-6)),
             rays: Some((64.0, 64.0)),
             reps: 16,
+            speedup_renderer_ci_low: 16.0 / 0.2f64.exp(),
+            speedup_renderer_ci_high: 16.0 * 0.2f64.exp(),
+            interval_method: "delta method".into(),
         }],
         skipped: vec![Skipped {
             testbed: "gradient-plane".into(),
