@@ -87,7 +87,7 @@ fn ratio_intervals_are_paired_bootstraps_that_rerun_identically_and_fall_back_wi
     let rows: Vec<_> = p
         .pairs
         .iter()
-        .flat_map(|&(bi, ei)| std::iter::repeat((bi, ei)).take(p.sweep.budgets.len()))
+        .flat_map(|&(bi, ei)| std::iter::repeat_n((bi, ei), p.sweep.budgets.len()))
         .zip(&cells)
         .map(|((bi, ei), c)| p.summary_row(bi, ei, c))
         .collect();
