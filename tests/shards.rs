@@ -48,6 +48,8 @@ fn deterministic_json(path: &Path) -> serde_json::Value {
                             "speedup_ci_high",
                             "overhead_renderer",
                             "speedup_renderer",
+                            "speedup_renderer_ci_low",
+                            "speedup_renderer_ci_high",
                             "break_even_ray_ns",
                         ]
                         .contains(&k.as_str())

@@ -1,7 +1,10 @@
 //! One cell of a sweep, (test bed, variant, estimator, budget), and its sufficient statistics:
 //! per-integral moments over repetitions, cost totals, and log-histograms of estimate times (wall
 //! clock and the thread's CPU clock).
-//! Cells are what the harness stores for resuming and what shards will merge.
+//! Cells are what the harness stores for resuming and what shards will merge. Beside the totals, a
+//! cell keeps a few contiguous blocks of repetitions ([`RepBlock`]) with the aggregates that
+//! resampling needs: the intervals of ratio claims are a bootstrap over them
+//! ([`crate::claims::bootstrap`]).
 
 use estimators::budget::Budget;
 use estimators::stats::Moments;
@@ -102,6 +105,64 @@ impl TimeStats {
     }
 }
 
+/// At most this many repetition blocks per cell ([`CellResult::blocks`]).
+pub const MAX_REP_BLOCKS: usize = 32;
+
+/// Repetitions per block of a cell of `reps` repetitions: the fewest that make at most
+/// [`MAX_REP_BLOCKS`] blocks. Block `k` holds repetitions `k * size .. (k + 1) * size` (the last may
+/// be shorter), so the layout depends on `reps` alone, never on threads or shards.
+pub fn rep_block_size(reps: usize) -> usize {
+    reps.div_ceil(MAX_REP_BLOCKS).max(1)
+}
+
+/// The number of repetition blocks of a cell of `reps` repetitions.
+pub fn rep_block_count(reps: usize) -> usize {
+    reps.div_ceil(rep_block_size(reps))
+}
+
+/// The aggregates of one contiguous block of a cell's repetitions: what a bootstrap over
+/// repetitions needs to recompute every ratio metric (MSE, paper 003's `Err`, CPU seconds and
+/// counted costs per estimate) from a resample of blocks. Sums run in repetition order.
+///
+/// Two cells of one (test bed, budget) computed by one run were interleaved repetition by
+/// repetition ([`crate::interleave`]), so their block `k` covers the same stretch of time: load
+/// that slowed one slowed the other in the same block, which a paired resample keeps.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RepBlock {
+    /// Repetitions in the block.
+    pub reps: u64,
+    /// Sum over the block's repetitions of each repetition's mean squared deviation from the
+    /// reference over integrals and channels (the values of [`CellResult::rep_sq`]).
+    pub sq: f64,
+    /// Sum over the block's repetitions of each repetition's paper 003 error: the mean over
+    /// integrals of the channel-mean squared deviation over `tvi(L_ref)`.
+    pub p_err: f64,
+    /// CPU seconds of the block's estimates (the clock of [`CellResult::metric_time`]; timing).
+    pub cpu_seconds: f64,
+    /// Wall-clock seconds of the block's estimates (timing).
+    pub wall_seconds: f64,
+    /// Counted costs of the block's estimates.
+    pub costs: Costs,
+}
+
+impl RepBlock {
+    /// Adds another part of the same block (repetitions in order).
+    pub fn merge(&mut self, o: &RepBlock) {
+        self.reps += o.reps;
+        self.sq += o.sq;
+        self.p_err += o.p_err;
+        self.cpu_seconds += o.cpu_seconds;
+        self.wall_seconds += o.wall_seconds;
+        let (a, b) = (&mut self.costs, &o.costs);
+        a.samples += b.samples;
+        a.fetches += b.fetches;
+        a.cheap_fetches += b.cheap_fetches;
+        a.rays += b.rays;
+        a.shadow_rays += b.shadow_rays;
+        a.free_flights += b.free_flights;
+    }
+}
+
 /// The sufficient statistics of one cell.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CellResult {
@@ -133,6 +194,12 @@ pub struct CellResult {
     /// and channels (their mean is the cell's MSE before the reference-variance correction).
     #[serde(default)]
     pub rep_sq: Moments,
+    /// The repetitions in [`rep_block_count`] contiguous blocks ([`rep_block_size`] each), with
+    /// what a bootstrap over repetitions resamples. A part of a cell (a shard's block of
+    /// repetitions) has every block, empty ones where it holds none of their repetitions. Empty
+    /// in cells stored before blocks were kept: their ratio intervals use the delta method.
+    #[serde(default)]
+    pub blocks: Vec<RepBlock>,
 }
 
 impl CellResult {
@@ -151,6 +218,16 @@ impl CellResult {
         match (&mut self.cpu_time, &other.cpu_time) {
             (Some(a), Some(b)) => a.merge(b),
             _ => self.cpu_time = None,
+        }
+    }
+
+    /// Merges another part's repetition blocks into this one's, block by block; a part without
+    /// them (or with another layout) leaves the merged cell without them.
+    pub fn merge_blocks(&mut self, other: &CellResult) {
+        if self.blocks.len() == other.blocks.len() {
+            self.blocks.iter_mut().zip(&other.blocks).for_each(|(a, b)| a.merge(b));
+        } else {
+            self.blocks.clear();
         }
     }
 
@@ -194,6 +271,26 @@ impl CellResult {
                 return Err(format!("{name} holds {} repetitions, not {reps}", m.count()));
             }
             m.check().map_err(|e| format!("{name}: {e}"))?;
+        }
+        if !self.blocks.is_empty() {
+            let expected = rep_block_count(self.key.reps);
+            if self.blocks.len() != expected {
+                return Err(format!(
+                    "{} repetition blocks, {} repetitions make {expected}",
+                    self.blocks.len(),
+                    self.key.reps
+                ));
+            }
+            let held: u64 = self.blocks.iter().map(|b| b.reps).sum();
+            if held != reps as u64 {
+                return Err(format!("its repetition blocks hold {held} repetitions, not {reps}"));
+            }
+            let bad = |b: &RepBlock| {
+                [b.sq, b.p_err, b.cpu_seconds, b.wall_seconds].iter().any(|v| !(v.is_finite() && *v >= 0.0))
+            };
+            if self.blocks.iter().any(bad) {
+                return Err("a repetition block holds a negative or non-finite sum".into());
+            }
         }
         Ok(())
     }

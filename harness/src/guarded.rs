@@ -94,5 +94,6 @@ pub fn cell_of(bed: &dyn TestBed, estimator: &str, budget: Budget, seed: u64, pe
         diagnostics: Vec::new(),
         rep_dev,
         rep_sq,
+        blocks: Vec::new(),
     }
 }

@@ -9,7 +9,7 @@
 //! fixed order (repetition-major inside a block, blocks in the order given), so a cell's statistics
 //! are bit-identical to a run of that cell alone, whatever the thread count or the other cells.
 
-use crate::cell::{add_diagnostics, CellKey, CellResult, TimeStats};
+use crate::cell::{add_diagnostics, rep_block_count, rep_block_size, CellKey, CellResult, RepBlock, TimeStats};
 use crate::error::Result;
 use crate::plan::Plan;
 use crate::runner::{add_costs, calibrated_samples, cell_key, run_sequence, CellRun, Item, REP_BLOCK};
@@ -72,6 +72,10 @@ pub fn run_group_with(
     }
     let keys: Vec<CellKey> = cells.iter().map(|c| cell_key(plan, bi, c.ei, budget)).collect();
     let reference = &b.bed.reference().value;
+    // Paper 003's per-integral weight 1 / tvi(L_ref), for each repetition's `Err`.
+    let inv_tvi: Vec<f64> =
+        reference.iter().map(|v| 1.0 / estimators::perception::tvi(estimators::perception::luminance(*v))).collect();
+    let block_size = rep_block_size(reps);
     let per_chunk = (MAX_ITEMS / (REP_BLOCK * batches * cells.len()).max(1)).max(1);
     for start in (0..longest).step_by(per_chunk) {
         let end = (start + per_chunk).min(longest);
@@ -113,18 +117,23 @@ pub fn run_group_with(
             let r = r?;
             let acc = &mut rep_acc[k];
             if acc.as_ref().is_some_and(|(p, q, _)| (*p, *q) != (pos, rep)) {
-                if let Some((p, _, a)) = acc.take() {
-                    a.push_into(&mut parts[k][p - start]);
+                if let Some((p, q, a)) = acc.take() {
+                    a.push_into(&mut parts[k][p - start], q / block_size);
                 }
             }
             let acc = &mut acc.get_or_insert_with(|| (pos, rep, RepAggregate::default())).2;
             let part = &mut parts[k][pos - start];
             for (j, v) in r.values.iter().enumerate() {
                 let i = batch * per_item * frames + j;
+                let mut sq = 0.0;
                 for c in 0..3 {
                     part.moments[i][c].push(v[c]);
-                    acc.add(v[c] - reference[i][c]);
+                    let d = v[c] - reference[i][c];
+                    acc.add(d);
+                    sq += d * d;
                 }
+                acc.p_err.add(sq / 3.0 * inv_tvi[i]);
+                acc.integrals += 1;
             }
             part.estimates += r.values.len() as u64;
             add_costs(&mut part.costs, &r.costs);
@@ -133,10 +142,15 @@ pub fn run_group_with(
                 t.merge(&r.cpu_time);
             }
             add_diagnostics(&mut part.diagnostics, &r.diagnostics);
+            if let Some(blk) = part.blocks.get_mut(rep / block_size) {
+                blk.cpu_seconds += r.cpu_time.total;
+                blk.wall_seconds += r.time.total;
+                add_costs(&mut blk.costs, &r.costs);
+            }
         }
         for (k, acc) in rep_acc.into_iter().enumerate() {
-            if let Some((p, _, a)) = acc {
-                a.push_into(&mut parts[k][p - start]);
+            if let Some((p, q, a)) = acc {
+                a.push_into(&mut parts[k][p - start], q / block_size);
             }
         }
         for (k, cell_parts) in parts.into_iter().enumerate() {
@@ -149,12 +163,15 @@ pub fn run_group_with(
 }
 
 /// One repetition's aggregates over every integral and channel, compensated: the summed deviation
-/// from the reference and the sum of squared deviations.
+/// from the reference, the sum of squared deviations, and over integrals the channel-mean squared
+/// deviation weighted by `1 / tvi` (paper 003's `Err`).
 #[derive(Default)]
 struct RepAggregate {
     dev: NeumaierSum,
     sq: NeumaierSum,
+    p_err: NeumaierSum,
     count: u64,
+    integrals: u64,
 }
 
 impl RepAggregate {
@@ -163,15 +180,23 @@ impl RepAggregate {
         self.sq.add(deviation * deviation);
         self.count += 1;
     }
-    /// Adds the repetition to the cell's per-repetition statistics.
-    fn push_into(self, cell: &mut CellResult) {
+    /// Adds the repetition to the cell's per-repetition statistics and to its repetition block
+    /// `block`.
+    fn push_into(self, cell: &mut CellResult, block: usize) {
+        let sq = self.sq.value() / self.count.max(1) as f64;
         cell.rep_dev.push(self.dev.value());
-        cell.rep_sq.push(self.sq.value() / self.count.max(1) as f64);
+        cell.rep_sq.push(sq);
+        if let Some(b) = cell.blocks.get_mut(block) {
+            b.reps += 1;
+            b.sq += sq;
+            b.p_err += self.p_err.value() / self.integrals.max(1) as f64;
+        }
     }
 }
 
 /// A cell of `n` integrals with no estimates yet.
 pub(crate) fn empty_cell(key: CellKey, n: usize) -> CellResult {
+    let key_reps = key.reps;
     CellResult {
         key,
         moments: vec![[Moments::default(), Moments::default(), Moments::default()]; n],
@@ -182,5 +207,6 @@ pub(crate) fn empty_cell(key: CellKey, n: usize) -> CellResult {
         diagnostics: Vec::new(),
         rep_dev: Moments::default(),
         rep_sq: Moments::default(),
+        blocks: vec![RepBlock::default(); rep_block_count(key_reps)],
     }
 }

@@ -4,7 +4,7 @@
 //! estimating thread's CPU seconds, which load from other processes does not inflate; wall-clock
 //! seconds are reported beside them.
 
-use crate::cell::CellResult;
+use crate::cell::{CellResult, RepBlock};
 use estimators::stats::NeumaierSum;
 use estimators::testbed::Reference;
 use serde::{Deserialize, Serialize};
@@ -123,6 +123,40 @@ pub struct SummaryRow {
     /// before they were counted).
     #[serde(default)]
     pub cache_ops: f64,
+    /// The cell's repetition blocks, for the bootstrap intervals of ratio claims: carried in memory
+    /// only (neither `summary.csv` nor `summary.json` has them), so rows read back from files, and
+    /// rows of cells stored before blocks were kept, have none and fall back to the delta method.
+    #[serde(skip)]
+    pub rep_blocks: RowBlocks,
+}
+
+/// A cell's repetition blocks ([`crate::cell::RepBlock`]) with what turns a resample of them into
+/// the row's metrics: MSE = sum of `sq` / repetitions + `mse_offset`, paper 003's `Err` likewise
+/// with `p_err_offset` (the offsets carry the stored reference's variance, subtracted from both),
+/// costs and CPU seconds per estimate = sums / (repetitions x `integrals`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RowBlocks {
+    /// The blocks, in repetition order (empty: none kept).
+    pub blocks: Vec<RepBlock>,
+    /// Integrals per repetition.
+    pub integrals: usize,
+    /// The row's `mse` less the mean over repetitions of the per-repetition squared deviation.
+    pub mse_offset: f64,
+    /// The row's `p_err` less the mean over repetitions of the per-repetition `Err`.
+    pub p_err_offset: f64,
+}
+
+impl RowBlocks {
+    /// Whether there are blocks to resample (at least two, and every one holding repetitions).
+    pub fn usable(&self) -> bool {
+        self.blocks.len() >= 2 && self.integrals > 0 && self.blocks.iter().all(|b| b.reps > 0)
+    }
+
+    /// The blocks' repetition counts: two rows with the same layout were cut the same way and
+    /// are resampled jointly (paired).
+    pub fn layout(&self) -> Vec<u64> {
+        self.blocks.iter().map(|b| b.reps).collect()
+    }
 }
 
 impl SummaryRow {
@@ -196,6 +230,19 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
     let (metric_time, cpu) = cell.metric_time();
     let cpu_seconds = metric_time.mean();
     let fetches = per(cell.costs.fetches);
+    let p_err_v = p_err.value() / cell.moments.len().max(1) as f64;
+    let rep_blocks = if cpu && !cell.blocks.is_empty() {
+        let held = cell.blocks.iter().map(|b| b.reps).sum::<u64>().max(1) as f64;
+        let (sq, pe) = cell.blocks.iter().fold((0.0, 0.0), |(s, p), b| (s + b.sq, p + b.p_err));
+        RowBlocks {
+            blocks: cell.blocks.clone(),
+            integrals: cell.moments.len(),
+            mse_offset: mse_v - sq / held,
+            p_err_offset: p_err_v - pe / held,
+        }
+    } else {
+        RowBlocks::default()
+    };
     SummaryRow {
         testbed: cell.key.testbed.clone(),
         variant: cell.key.variant.clone(),
@@ -220,7 +267,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         cheap_fetches: per(cell.costs.cheap_fetches),
         seconds_median: cell.time.median(),
         efficiency_mse: inverse(mse_v * cpu_seconds),
-        p_err: p_err.value() / cell.moments.len().max(1) as f64,
+        p_err: p_err_v,
         p_eff: inverse(cpu_seconds * cell.moments.len() as f64 * p_err.value() / cell.moments.len().max(1) as f64),
         estimator_id: String::new(),
         params: String::new(),
@@ -234,6 +281,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         free_flights: per(cell.costs.free_flights),
         target_evals: per(cell.costs.target_evals),
         cache_ops: per(cell.costs.cache_ops),
+        rep_blocks,
     }
 }
 

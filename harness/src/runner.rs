@@ -250,6 +250,7 @@ fn merge_into(out: &mut CellResult, p: &CellResult) {
     add_diagnostics(&mut out.diagnostics, &p.diagnostics);
     out.rep_dev.merge(&p.rep_dev);
     out.rep_sq.merge(&p.rep_sq);
+    out.merge_blocks(p);
 }
 
 /// Merges the blocks of one cell, in the order given (block order for a bit-reproducible result),

@@ -162,7 +162,7 @@ import csv, json, sys
 timing = {"seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff", "wall_seconds", "overhead", "speedup", "run_id",
           "cpu_seconds", "efficiency_wall", "overhead_wall", "speedup_wall", "cpu_seconds_total",
           "efficiency_renderer", "speedup_ci_low", "speedup_ci_high", "overhead_renderer", "speedup_renderer",
-          "break_even_ray_ns"}
+          "speedup_renderer_ci_low", "speedup_renderer_ci_high", "break_even_ray_ns"}
 def table(d):
     rows = list(csv.reader(open(d + "/summary.csv")))
     keep = [i for i, h in enumerate(rows[0]) if h not in timing]

@@ -47,6 +47,7 @@ pub(crate) fn cell_from(per_rep: &[Vec<[f64; 3]>], reference: &Reference) -> Cel
         diagnostics: Vec::new(),
         rep_dev,
         rep_sq,
+        blocks: Vec::new(),
     }
 }
 

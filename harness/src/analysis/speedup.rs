@@ -2,6 +2,8 @@
 //! ([`crate::cost_model`]), and as a function of the cost of a ray.
 
 use super::{group, Fit};
+use crate::claims::bootstrap::{self, Bootstrap};
+use crate::claims::Ratio;
 use crate::cost_model::{CostModel, RayCostCurve, Regime};
 use crate::metrics::SummaryRow;
 use serde::{Deserialize, Serialize};
@@ -22,10 +24,16 @@ fn quantile(reps: usize) -> f64 {
 /// error (from the baseline's fitted slope) over the method's samples, divided by the method's
 /// overhead (its seconds per estimate over the baseline's at that budget).
 ///
-/// Its interval is a delta-method one on the log scale over the noise of the two errors (each
-/// budget's `mse_se`) and of the baseline's slope, with a Student's t quantile at one less degree
-/// of freedom than the method's repetitions; the seconds per estimate are means over every
-/// estimate of a cell and are taken as exact. The overhead is reported in CPU time (`measured`),
+/// Its interval, in each cost regime, is a bootstrap over blocks of repetitions
+/// ([`crate::claims::bootstrap`]) when both cells at that budget carry them: each resample
+/// recomputes the method's error and CPU seconds and costs per estimate and the baseline's (paired
+/// when the two were cut into the same blocks), moves the baseline's fitted error at this budget by
+/// its own cell's resampled error (its point's noise, an upper bound for the fit's there), and
+/// draws the baseline's slope from a normal with its fitted standard error; the interval is the
+/// expanded percentile one of the log speed-up. Without blocks it is a delta-method one on the log scale over the
+/// noise of the two errors (each budget's `mse_se`) and of the baseline's slope, with a Student's t
+/// quantile at one less degree of freedom than the method's repetitions, the seconds per estimate
+/// taken as exact. `interval_method` says which. The overhead is reported in CPU time (`measured`),
 /// on the wall clock (load-dependent, for comparison) and with counted operations priced by the
 /// sweep's [`CostModel`] (`renderer`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -91,6 +99,16 @@ pub struct SpeedUp {
     /// Repetitions of the method's cell (what `log_se` was measured at).
     #[serde(default)]
     pub reps: usize,
+    /// 95% interval of `speedup_renderer`, low end (NaN in files written before it).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup_renderer_ci_low: f64,
+    /// 95% interval of `speedup_renderer`, high end (NaN in files written before it).
+    #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
+    pub speedup_renderer_ci_high: f64,
+    /// How the intervals were made: "bootstrap over 16 blocks of repetitions, paired (expanded
+    /// percentile, 2000 resamples)" or "delta method" (empty in files written before it: the delta method).
+    #[serde(default)]
+    pub interval_method: String,
 }
 
 impl SpeedUp {
@@ -99,6 +117,21 @@ impl SpeedUp {
         match regime {
             Regime::Measured => self.speedup,
             Regime::Renderer => self.speedup_renderer,
+        }
+    }
+
+    /// The 95% interval of the speed-up in `regime` with the method that made it, as a [`Ratio`]
+    /// for the verdict rule of ratio claims.
+    pub fn ratio(&self, regime: Regime) -> Ratio {
+        let value = self.in_regime(regime);
+        let (lo, hi) = match regime {
+            Regime::Measured => (self.speedup_ci_low, self.speedup_ci_high),
+            Regime::Renderer => (self.speedup_renderer_ci_low, self.speedup_renderer_ci_high),
+        };
+        if self.interval_method.starts_with("bootstrap") && lo.is_finite() && hi.is_finite() && lo > 0.0 {
+            Ratio::with_bootstrap(value, self.reps, Bootstrap::from_interval(value, (lo, hi), &self.interval_method))
+        } else {
+            Ratio::delta(value, self.log_se, self.reps)
         }
     }
 
@@ -146,6 +179,38 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str, model: &CostM
         let overhead_wall = last.seconds / base.seconds;
         let speedup = sample_ratio / overhead;
         let w = (quantile(last.reps) * log_se).exp();
+        let speedup_renderer = sample_ratio / overhead_renderer;
+        // The bootstrap: the baseline's fitted log error at this budget moves with its own
+        // cell's resampled error, the slope by a normal draw with its standard error, and the
+        // sample ratio pivots about this budget as in the delta method above.
+        let fitted = fit.intercept + fit.slope * (last.budget as f64).ln();
+        let slope_se = slope_var.sqrt();
+        let boot = |regime: Regime| {
+            let seed = bootstrap::seed_of(&format!(
+                "speedup|{}|{}/{}|{}|{}@{}",
+                regime.name(),
+                last.testbed,
+                last.variant,
+                last.estimator,
+                baseline,
+                last.budget
+            ));
+            bootstrap::log_ratio(&last.rep_blocks, &base.rep_blocks, seed, |m, b, z| {
+                let slope = fit.slope + if slope_se.is_finite() { slope_se * z } else { 0.0 };
+                if slope >= 0.0 {
+                    return None;
+                }
+                let f = fitted + 0.5 * (b.mse().ln() - base.mse.ln());
+                let log_ratio = (0.5 * m.mse().ln() - f) / slope;
+                Some(log_ratio - (m.seconds(regime, model) / b.seconds(regime, model)).ln())
+            })
+        };
+        let (ci, ci_renderer, interval_method) = match (boot(Regime::Measured), boot(Regime::Renderer)) {
+            (Some(m), Some(r)) => {
+                ((m.log95.0.exp(), m.log95.1.exp()), (r.log95.0.exp(), r.log95.1.exp()), m.describe())
+            }
+            _ => ((speedup / w, speedup * w), (speedup_renderer / w, speedup_renderer * w), "delta method".into()),
+        };
         let curve = RayCostCurve {
             sample_ratio,
             method: (last.metric_seconds(), last.rays),
@@ -163,15 +228,18 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str, model: &CostM
             overhead_wall,
             speedup_wall: sample_ratio / overhead_wall,
             log_se,
-            speedup_ci_low: speedup / w,
-            speedup_ci_high: speedup * w,
+            speedup_ci_low: ci.0,
+            speedup_ci_high: ci.1,
             overhead_renderer,
-            speedup_renderer: sample_ratio / overhead_renderer,
+            speedup_renderer,
             speedup_ray_limit: curve.limit(),
             break_even_ray_ns: curve.reaching(1.0).ns(),
             cpu_seconds: Some(curve.method.0).zip(Some(curve.baseline.0)),
             rays: Some((last.rays, base.rays)),
             reps: last.reps,
+            speedup_renderer_ci_low: ci_renderer.0,
+            speedup_renderer_ci_high: ci_renderer.1,
+            interval_method,
         });
     }
     out
@@ -222,6 +290,7 @@ mod tests {
             free_flights: 0.0,
             target_evals: 0.0,
             cache_ops: 0.0,
+            rep_blocks: Default::default(),
         };
         let mut rows = Vec::new();
         for b in [4u64, 16, 64] {

@@ -1,6 +1,7 @@
 //! Judging paper claims against a run: slope claims, speed-up claims, ratio claims ([`ratio`]) and
 //! claims about several cells at once: orderings, optima and ratios of ratios ([`ordering`]).
 
+pub mod bootstrap;
 pub mod ordering;
 pub mod ratio;
 
@@ -234,8 +235,8 @@ pub fn speedup_claim(
         return Claim { regime: regime.name().into(), ..not_measured(tb.0, &text, paper, why) };
     };
     let value = s.in_regime(regime);
-    // The speed-up's interval is that of a ratio with its log-scale error: the same verdict rule.
-    let ratio = Ratio { value, log_se: s.log_se, reps: s.reps };
+    // The speed-up's interval (bootstrap or delta method) judged by the verdict rule of ratios.
+    let ratio = s.ratio(regime);
     let (lo, hi) = ratio.interval();
     let target = SPEEDUP_SHARE * paper;
     let (verdict, held, why) = ratio.verdict(target, true);
@@ -252,7 +253,7 @@ pub fn speedup_claim(
         )
     });
     let note = format!(
-        "{estimator} against {base} at {} spp: {:.3}x fewer samples; overhead {:.3}x in CPU time, {:.3}x with rays at {} ns and fetches at {} ns (renderer), {:.3}x on the wall clock; speed-up {:.3} (CPU) [{:.3}, {:.3}], {:.3} (renderer); {}",
+        "{estimator} against {base} at {} spp: {:.3}x fewer samples; overhead {:.3}x in CPU time, {:.3}x with rays at {} ns and fetches at {} ns (renderer), {:.3}x on the wall clock; speed-up {:.3} (CPU) [{:.3}, {:.3}], {:.3} (renderer) [{:.3}, {:.3}] ({}); {}",
         s.budget,
         s.sample_ratio,
         s.overhead,
@@ -264,6 +265,9 @@ pub fn speedup_claim(
         s.speedup_ci_low,
         s.speedup_ci_high,
         s.speedup_renderer,
+        s.speedup_renderer_ci_low,
+        s.speedup_renderer_ci_high,
+        ratio.method(),
         reach.unwrap_or_else(|| "no ray-cost curve (file written before it)".into())
     );
     Claim {

@@ -1,19 +1,30 @@
 //! Ratio and ordering claims between two cells at one budget, judged on a 95% interval: "A has
 //! lower error than B", "A's figure of merit is k times B's", "A ranks first".
 //!
-//! Each cell's MSE carries its standard error `mse_se` (the spread of the per-repetition squared
-//! errors), so the log of a ratio of MSE-based metrics has the delta-method standard error
-//! `sqrt((se_a / mse_a)^2 + (se_b / mse_b)^2)` for independent cells (halved for an RMSE ratio;
-//! [`RatioMetric::PEff`] says what stands in for the error of `Err`).
-//! Costs per estimate (fetches, CPU seconds) are means over every estimate of a cell and are taken
-//! as exact. Intervals use Student's t with one less degree of freedom than the smaller cell's
-//! repetitions, since each `mse_se` is itself estimated from them. A claim holds when the interval clears its threshold, does not when it lies on the
-//! other side, and is `inconclusive`, with the repetitions that would decide, when it straddles.
+//! The interval is a bootstrap over blocks of repetitions ([`super::bootstrap`]) when both rows
+//! carry their cell's repetition blocks ([`SummaryRow::rep_blocks`]): each resample recomputes
+//! both cells' MSE, `Err`, CPU seconds and fetches per estimate, so the noise of costs enters as
+//! that of errors, and cells cut into the same blocks (interleaved in one run) are resampled
+//! jointly. Seeded from the claim, a rerun gives the same interval.
+//!
+//! Rows without blocks (cells stored before them, rows read back from `summary.csv`) fall back to
+//! the delta method: each cell's MSE carries its standard error `mse_se` (the spread of the
+//! per-repetition squared errors), so the log of a ratio of MSE-based metrics has the standard
+//! error `sqrt((se_a / mse_a)^2 + (se_b / mse_b)^2)` for independent cells (halved for an RMSE
+//! ratio; [`RatioMetric::PEff`] says what stands in for the error of `Err`), costs per estimate are
+//! taken as exact, and the quantile is Student's t with one less degree of freedom than the
+//! smaller cell's repetitions, since each `mse_se` is itself estimated from them.
+//!
+//! A claim holds when the interval clears its threshold, does not when it lies on the other side,
+//! and is `inconclusive`, with the repetitions that would decide, when it straddles; its note says
+//! which method made the interval.
 
+use super::bootstrap::{self, Bootstrap, CellSample};
 use crate::cost_model::Regime;
 use crate::metrics::SummaryRow;
 use crate::output::{Claim, RunReport};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 use estimators::stats::hypothesis::t_quantile;
 
@@ -33,12 +44,13 @@ pub enum RatioMetric {
     Fom,
     /// Efficiency 1 / (MSE x CPU seconds).
     EfficiencyMse,
-    /// Paper 003's perceptual efficiency `P-Eff = 1 / (T Err)`. Its interval uses the relative
-    /// standard error of the MSE for that of `Err` (a tvi-weighted MSE: the two coincide where the
-    /// weights are even, and the weighting of a bright image changes the spread little).
+    /// Paper 003's perceptual efficiency `P-Eff = 1 / (T Err)`. The bootstrap resamples `Err`
+    /// itself (each repetition's tvi-weighted error is in the blocks); the delta method uses the
+    /// relative standard error of the MSE for that of `Err` (a tvi-weighted MSE: the two coincide
+    /// where the weights are even, and the weighting of a bright image changes the spread little).
     PEff,
-    /// Paper 003's perceptual error `Err` (mean over integrals of MSE / tvi), with the MSE's
-    /// relative standard error standing in for its own as for [`RatioMetric::PEff`].
+    /// Paper 003's perceptual error `Err` (mean over integrals of MSE / tvi), resampled like
+    /// [`RatioMetric::PEff`]'s.
     PErr,
 }
 
@@ -67,6 +79,19 @@ impl RatioMetric {
         v.filter(|v| v.is_finite() && *v > 0.0)
     }
 
+    /// The log of the metric recomputed from a resample of a cell's blocks.
+    fn log_of(self, s: &CellSample<'_>) -> Option<f64> {
+        let v = match self {
+            RatioMetric::Rmse => s.mse().sqrt(),
+            RatioMetric::Mse => s.mse(),
+            RatioMetric::Fom => 1.0 / (s.mse() * s.fetches()),
+            RatioMetric::EfficiencyMse => 1.0 / (s.mse() * s.cpu_seconds()),
+            RatioMetric::PEff => 1.0 / (s.cpu_seconds() * s.integrals() * s.p_err()),
+            RatioMetric::PErr => s.p_err(),
+        };
+        (v.is_finite() && v > 0.0).then(|| v.ln())
+    }
+
     /// The cost regime of a time-based metric (the CPU seconds it divides by).
     fn regime(self) -> Option<Regime> {
         matches!(self, RatioMetric::EfficiencyMse | RatioMetric::PEff).then_some(Regime::Measured)
@@ -81,24 +106,67 @@ impl RatioMetric {
     }
 }
 
-/// A ratio `a / b` of one metric between two cells, with the log-scale standard error.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A ratio `a / b` of one metric between two cells, with the log-scale standard error and, when
+/// the cells carry repetition blocks, its bootstrap distribution.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Ratio {
     /// The ratio.
     pub value: f64,
-    /// Standard error of its logarithm (NaN without `mse_se` on both cells).
+    /// Standard error of its logarithm: the bootstrap's when there is one, else the delta
+    /// method's (NaN without `mse_se` on both cells).
     pub log_se: f64,
     /// The smaller repetition count of the two cells.
     pub reps: usize,
+    /// The bootstrap over repetition blocks that gives the interval (`None`: the delta method).
+    pub bootstrap: Option<Arc<Bootstrap>>,
 }
 
 impl Ratio {
-    /// Of `metric` between rows `a` and `b`.
+    /// Of `metric` between rows `a` and `b`: a bootstrap over their repetition blocks when both
+    /// carry them ([`bootstrap::log_ratio`], seeded from the metric and the two cells), the delta
+    /// method otherwise.
     pub fn of(metric: RatioMetric, a: &SummaryRow, b: &SummaryRow) -> Option<Ratio> {
         let value = metric.value(a)? / metric.value(b)?;
         let rel = |r: &SummaryRow| r.mse_se / r.mse;
         let log_se = metric.mse_power() * (rel(a).powi(2) + rel(b).powi(2)).sqrt();
-        Some(Ratio { value, log_se, reps: a.reps.min(b.reps) })
+        let seed = bootstrap::seed_of(&format!(
+            "ratio|{}|{}/{}|{}@{}|{}@{}",
+            metric.name(),
+            a.testbed,
+            a.variant,
+            a.estimator,
+            a.budget,
+            b.estimator,
+            b.budget
+        ));
+        let boot = bootstrap::log_ratio(&a.rep_blocks, &b.rep_blocks, seed, |x, y, _| {
+            Some(metric.log_of(x)? - metric.log_of(y)?)
+        });
+        let reps = a.reps.min(b.reps);
+        Some(match boot {
+            Some(bs) => Ratio { value, log_se: bs.log_se(), reps, bootstrap: Some(Arc::new(bs)) },
+            None => Ratio::delta(value, log_se, reps),
+        })
+    }
+
+    /// A ratio whose interval is the delta method's: `value` times or over `exp(t log_se)`.
+    pub fn delta(value: f64, log_se: f64, reps: usize) -> Ratio {
+        Ratio { value, log_se, reps, bootstrap: None }
+    }
+
+    /// A ratio with a bootstrap interval already made (e.g. a speed-up's): `log95` is the 95%
+    /// interval of its logarithm; other levels fall back to the normal approximation.
+    pub fn with_bootstrap(value: f64, reps: usize, boot: Bootstrap) -> Ratio {
+        Ratio { value, log_se: boot.log_se(), reps, bootstrap: Some(Arc::new(boot)) }
+    }
+
+    /// Which method made the interval, for notes: "bootstrap over 16 blocks of repetitions, paired
+    /// (expanded percentile, 2000 resamples)" or "delta method".
+    pub fn method(&self) -> String {
+        match &self.bootstrap {
+            Some(b) => b.describe(),
+            None => "delta method".into(),
+        }
     }
 
     /// The quantile of a two-sided interval at `level`.
@@ -111,8 +179,15 @@ impl Ratio {
         self.interval_at(LEVEL)
     }
 
-    /// The interval at a two-sided `level` (e.g. a Bonferroni-adjusted one for a family).
+    /// The interval at a two-sided `level` (e.g. a Bonferroni-adjusted one for a family): the
+    /// bootstrap's at that level when there is one, else the delta method's.
     pub fn interval_at(&self, level: f64) -> (f64, f64) {
+        if let Some(b) = &self.bootstrap {
+            let ends = if level == LEVEL { Some(b.log95) } else { b.log_interval_at(level) };
+            if let Some((lo, hi)) = ends {
+                return (lo.exp(), hi.exp());
+            }
+        }
         let w = (self.quantile(level) * self.log_se).exp();
         (self.value / w, self.value * w)
     }
@@ -204,11 +279,12 @@ pub fn ratio_claim(report: &RunReport, spec: &RatioSpec<'_>, claim: &str, note: 
         our_value: Some(r.value),
         held,
         note: format!(
-            "{} {estimator} / {baseline} at {budget} {}: {:.4} [{lo:.4}, {hi:.4}] ({} repetitions); {note}",
+            "{} {estimator} / {baseline} at {budget} {}: {:.4} [{lo:.4}, {hi:.4}] ({} repetitions; {}); {note}",
             metric.name(),
             a.budget_kind,
             r.value,
-            r.reps
+            r.reps,
+            r.method()
         ),
         verdict: verdict.into(),
         interval: Some([lo, hi]),

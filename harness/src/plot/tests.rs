@@ -43,6 +43,7 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         free_flights: 0.0,
         target_evals: 0.0,
         cache_ops: 0.0,
+        rep_blocks: Default::default(),
     }
 }
 
@@ -119,6 +120,9 @@ pub fn synthetic_report() -> RunReport {
             cpu_seconds: Some((1.75e-6, 1e-6)),
             rays: Some((64.0, 64.0)),
             reps: 16,
+            speedup_renderer_ci_low: 16.0 / 0.2f64.exp(),
+            speedup_renderer_ci_high: 16.0 * 0.2f64.exp(),
+            interval_method: "delta method".into(),
         }],
         skipped: vec![Skipped {
             testbed: "gradient-plane".into(),
