@@ -336,14 +336,26 @@ pub fn post(
             "{} p = {:.2e} ({}), statistic {:.2}, relative bias detectable with 80% power ~{:.1e}; Holm per-integral t-tests and the pooled t-test over repetitions (valid whatever the frames of one SMC sequence share), each behind the skewness gate of a pilot on its own seed",
             t.test, t.p_value, t.verdict, t.statistic, t.detectable_rel_bias
         );
-        report.paper.push(claim(
+        let mut c = claim(
             &format!("envmap-sequence/{} (2x2, 4 frames, N = 4)", t.variant),
             &format!("unbiasedness of {}: {theory}", t.estimator),
             None,
             Some(t.p_value),
             held,
             note,
-        ));
+        );
+        // An unbiased id's claim is decided by its test (inconclusive when the test cannot
+        // decide); a consistent one's verdict is reported, not required, and so is the control's
+        // on L_ns, where it is unbiased.
+        (c.verdict, c.reason) = match (t.claim.as_str(), held) {
+            ("unbiased", _) => {
+                let (_, v, why) = mcbench::claims::unbiased_verdict(t);
+                (v, why)
+            }
+            (_, None) => ("reported".into(), format!("test verdict {}: {}", t.verdict, t.reason)),
+            _ => (String::new(), t.reason.clone()),
+        };
+        report.paper.push(c);
     }
     report.tests.extend(dedicated);
     let mut files = Vec::new();

@@ -43,11 +43,9 @@ fn unbiased_claim(r: &RunReport, variant: &str, estimator: &str) -> Claim {
         claim: format!("paper 003 §4.2: PMC-IP ({estimator}) is unbiased (against the stored reference)"),
         paper_value: None,
         our_value: ours,
-        held: decisive.and_then(|t| match t.verdict.as_str() {
-            "pass" => Some(true),
-            "biased" => Some(false),
-            _ => None,
-        }),
+        held: decisive.and_then(|t| mcbench::claims::unbiased_verdict(t).0),
+        verdict: decisive.map_or(String::new(), |t| mcbench::claims::unbiased_verdict(t).1),
+        reason: decisive.map_or(String::new(), |t| t.reason.clone()),
         note: format!(
             "{} (Holm-Welch per pixel and the pooled t-test over repetitions, Bonferroni); smallest Holm-adjusted p {} (pooled t {}); uniform_image on the same bed: Holm-Welch {}, pooled t {}; {} repetitions (see README: heavy-tailed pixel samples)",
             decisive.map_or("-".to_string(), |t| format!("{}: {}", t.verdict, t.reason)),

@@ -85,8 +85,9 @@ pub struct Claim {
     pub held: Option<bool>,
     /// How it was judged, or why it was not.
     pub note: String,
-    /// `held`, `not held`, `inconclusive` (the interval does not decide) or `not measured`; empty
-    /// in files written before it, where `held` is the verdict ([`Claim::verdict`]).
+    /// `held`, `not held`, `inconclusive` (the interval or test does not decide), `reported` (a
+    /// measurement shown beside the paper's number, with no verdict) or `not measured`; empty in
+    /// files written before it, where `held` is the verdict ([`Claim::verdict`]).
     #[serde(default)]
     pub verdict: String,
     /// 95% interval of `our_value`, for claims judged on an interval.
@@ -106,15 +107,17 @@ pub struct Claim {
 }
 
 impl Claim {
-    /// The verdict: `verdict` when set, else read from `held`.
+    /// The verdict: `verdict` when set, else read from `held` (with no `held`: `reported` when
+    /// there is a value, `not measured` when there is none).
     pub fn verdict(&self) -> &str {
         if !self.verdict.is_empty() {
             return &self.verdict;
         }
-        match self.held {
-            Some(true) => "held",
-            Some(false) => "not held",
-            None => "not measured",
+        match (self.held, self.our_value) {
+            (Some(true), _) => "held",
+            (Some(false), _) => "not held",
+            (None, Some(_)) => "reported",
+            (None, None) => "not measured",
         }
     }
 }
@@ -396,6 +399,19 @@ fn one_line(s: &str) -> String {
 
 #[cfg(test)]
 mod tests {
+    use super::Claim;
+
+    #[test]
+    fn a_claim_without_a_verdict_reads_reported_when_it_has_a_value() {
+        let c = |held, our_value| Claim { held, our_value, ..Default::default() };
+        assert_eq!(c(Some(true), Some(1.0)).verdict(), "held");
+        assert_eq!(c(Some(false), None).verdict(), "not held");
+        assert_eq!(c(None, Some(1.0)).verdict(), "reported");
+        assert_eq!(c(None, None).verdict(), "not measured");
+        let set = Claim { verdict: "inconclusive".into(), ..c(None, Some(1.0)) };
+        assert_eq!(set.verdict(), "inconclusive");
+    }
+
     use crate::analysis::TestRow;
 
     #[test]

@@ -11,7 +11,9 @@ import sys
 def verdict(c):
     if c.get("verdict"):
         return c["verdict"]
-    return {True: "held", False: "not held"}.get(c.get("held"), "not measured")
+    if c.get("held") is None:
+        return "reported" if c.get("our_value") is not None else "not measured"
+    return "held" if c["held"] else "not held"
 
 
 def claims(root):

@@ -23,6 +23,17 @@ pub fn decisive_test<'a>(tests: &'a [TestRow], variant: &str, estimator: &str, s
     tests.iter().find(|t| t.variant == variant && t.estimator == estimator && t.test == format!("combined{suffix}"))
 }
 
+/// The verdict of a claim that an estimator is unbiased, from its deciding test row: `held` on
+/// `pass`, `not held` on `biased`, `inconclusive` otherwise, with the row's reason.
+pub fn unbiased_verdict(t: &TestRow) -> (Option<bool>, String, String) {
+    let (held, verdict) = match t.verdict.as_str() {
+        "pass" => (Some(true), "held"),
+        "biased" => (Some(false), "not held"),
+        _ => (None, "inconclusive"),
+    };
+    (held, verdict.into(), t.reason.clone())
+}
+
 fn not_measured(testbed: &str, claim: &str, paper: f64, why: String) -> Claim {
     Claim {
         testbed: testbed.into(),
