@@ -13,7 +13,7 @@
 //!
 //! Both are *gated* by skewness before the outcome is seen: a t-test's tail at a tiny `alpha` is
 //! only right when the skewness of the tested mean is small (the first Edgeworth term,
-//! [`t_test_skewness_limit`]), and the sample skewness of the cell itself is low exactly when its
+//! [`estimators::stats::t_test_skewness_limit`]), and the sample skewness of the cell itself is low exactly when its
 //! repetitions missed a rare large value. So the gate takes the larger of the cell's skewness and
 //! that of an independent [`Gate`] (the same pair on a pilot seed, or at the previous budget), and
 //! the pooled test's variance is the mean of the cell's and the gate's: half of it cannot have

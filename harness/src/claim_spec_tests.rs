@@ -1,0 +1,76 @@
+//! Unit tests of [`super`].
+
+use super::*;
+
+fn spec(extra: &str, kind: &str) -> ClaimSpec {
+    let text = format!(
+        "kind = '{kind}'\n{extra}testbed = 'gradient-plane/default'\nestimator = 'is1_cv2'\nvalue = -0.94\ntext = 't'"
+    );
+    toml::from_str(&text).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn slope_claims_are_judged_on_the_range_they_name() {
+    let mut report = crate::plot::tests::synthetic_report();
+    let f = report.fits.iter_mut().find(|f| f.estimator == "is1_cv2").expect("fit");
+    (f.slope, f.slope_ci_low, f.slope_ci_high) = (-0.8, -0.85, -0.75);
+    (f.slope_right, f.slope_right_ci_low, f.slope_right_ci_high) = (-0.93, -0.97, -0.89);
+    let whole = spec("", "slope").judge(&report);
+    assert_eq!((whole.held, whole.our_value), (Some(false), Some(-0.8)), "{whole:?}");
+    assert!(whole.note.contains("whole-range fit") && whole.note.contains("right-end slope -0.930"), "{whole:?}");
+    assert_eq!(whole.interval, Some([-0.85, -0.75]));
+    let right = spec("range = 'right'\n", "slope").judge(&report);
+    assert_eq!((right.held, right.our_value), (Some(true), Some(-0.93)), "{right:?}");
+    assert!(right.note.contains("right-end fit"), "{right:?}");
+    // slope_below -0.94: the right end's interval holds it (inconclusive), the whole range's
+    // lies above it (not held).
+    let straddles = spec("range = 'right'\n", "slope_below").judge(&report);
+    assert_eq!((straddles.held, straddles.verdict()), (None, "inconclusive"), "{straddles:?}");
+    assert_eq!(spec("range = \"whole\"\n", "slope_below").judge(&report).verdict(), "not held");
+    // An interval wider than the tolerance holds the slope but cannot confirm it.
+    let f = report.fits.iter_mut().find(|f| f.estimator == "is1_cv2").expect("fit");
+    (f.slope_right_ci_low, f.slope_right_ci_high) = (-1.1, -0.8);
+    let wide = spec("range = 'right'\n", "slope").judge(&report);
+    assert_eq!((wide.held, wide.verdict()), (None, "inconclusive"), "{wide:?}");
+    assert!(wide.reason.contains("wider than"), "{}", wide.reason);
+    // No right-end slope (too few budgets): not measured, not failed.
+    let f = report.fits.iter_mut().find(|f| f.estimator == "is1_cv2").expect("fit");
+    f.slope_right = f64::NAN;
+    let none = spec("range = 'right'\n", "slope").judge(&report);
+    assert_eq!(none.held, None, "{none:?}");
+    // Unknown ranges are refused.
+    let bad = "kind = 'slope'\nrange = 'left'\ntestbed = 'a/b'\nestimator = 'e'\nvalue = -0.5\ntext = 't'";
+    assert!(toml::from_str::<ClaimSpec>(bad).is_err());
+}
+
+#[test]
+fn speedup_claims_are_judged_on_their_interval_in_their_regime() {
+    let report = crate::plot::tests::synthetic_report();
+    let judge = |value: f64, extra: &str| {
+        let text = format!(
+            "kind = 'speedup'\n{extra}testbed = 'gradient-plane/default'\nestimator = 'is1_cv2'\nvalue = {value}\ntext = 't'"
+        );
+        toml::from_str::<ClaimSpec>(&text).unwrap_or_else(|e| panic!("{e}")).judge(&report)
+    };
+    // Our CPU speed-up 11.43 with ln-scale SE 0.1 at 16 repetitions (t quantile 2.131): [9.24, 14.15] against half the paper's factor.
+    let held = judge(10.0, "");
+    assert_eq!((held.verdict.as_str(), held.held, held.regime.as_str()), ("held", Some(true), "measured"), "{held:?}");
+    assert_eq!(held.pair, "is1_cv2 vs is0_cv0");
+    let [lo, hi] = held.interval.expect("interval");
+    assert!((lo - 9.236).abs() < 1e-3 && (hi - 14.145).abs() < 1e-3, "{lo} {hi}");
+    let straddles = judge(20.0, "");
+    assert_eq!((straddles.verdict.as_str(), straddles.held), ("inconclusive", None), "{straddles:?}");
+    assert!(straddles.reason.contains("repetitions would decide"), "{}", straddles.reason);
+    assert_eq!(judge(40.0, "").verdict, "not held");
+    // In the renderer regime the same pair is 16x: [12.93, 19.80] clears half of 20.
+    let renderer = judge(20.0, "regime = 'renderer'\n");
+    assert_eq!((renderer.verdict.as_str(), renderer.our_value), ("held", Some(16.0)), "{renderer:?}");
+    assert!(renderer.note.contains("limit 20.000"), "{}", renderer.note);
+    // A pair the run has no speed-up for is not measured, not failed.
+    let missing = judge(2.0, "baseline = 'no_such_estimator'\n");
+    assert_eq!((missing.verdict(), missing.held), ("not measured", None), "{missing:?}");
+    assert!(toml::from_str::<ClaimSpec>(
+        "kind = 'speedup'\nregime = 'gpu'\ntestbed = 'a/b'\nestimator = 'e'\nvalue = 2.0\ntext = 't'"
+    )
+    .is_err());
+}
