@@ -153,13 +153,7 @@ impl RepBlock {
         self.p_err += o.p_err;
         self.cpu_seconds += o.cpu_seconds;
         self.wall_seconds += o.wall_seconds;
-        let (a, b) = (&mut self.costs, &o.costs);
-        a.samples += b.samples;
-        a.fetches += b.fetches;
-        a.cheap_fetches += b.cheap_fetches;
-        a.rays += b.rays;
-        a.shadow_rays += b.shadow_rays;
-        a.free_flights += b.free_flights;
+        crate::runner::add_costs(&mut self.costs, &o.costs);
     }
 }
 

@@ -33,15 +33,7 @@ fn regime(metric: RatioMetric) -> String {
 
 /// The value of `metric` in a row, when it is defined (finite and positive).
 pub fn metric_of(metric: RatioMetric, r: &SummaryRow) -> Option<f64> {
-    let v = match metric {
-        RatioMetric::Rmse => Some(r.rmse),
-        RatioMetric::Mse => Some(r.mse),
-        RatioMetric::Fom => r.fom,
-        RatioMetric::EfficiencyMse => r.efficiency_mse,
-        RatioMetric::PEff => r.p_eff,
-        RatioMetric::PErr => Some(r.p_err),
-    };
-    v.filter(|v| v.is_finite() && *v > 0.0)
+    metric.value(r)
 }
 
 /// The largest budget any row of `tb` has (the default budget of a claim that names none).

@@ -67,7 +67,8 @@ impl RatioMetric {
         }
     }
 
-    fn value(self, r: &SummaryRow) -> Option<f64> {
+    /// Its value in a row, when defined (finite and positive).
+    pub(crate) fn value(self, r: &SummaryRow) -> Option<f64> {
         let v = match self {
             RatioMetric::Rmse => Some(r.rmse),
             RatioMetric::Mse => Some(r.mse),
