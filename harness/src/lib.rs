@@ -90,6 +90,7 @@ pub mod references;
 pub mod registry;
 pub mod report;
 pub mod runner;
+pub mod sensitivity;
 pub mod shard;
 pub mod unbiasedness;
 

@@ -5,6 +5,7 @@
 //!
 //! Text uses the DejaVu Sans font bundled in `assets/fonts` (no system fonts are needed).
 
+pub mod claim_sweep;
 mod draw;
 pub mod heatmap;
 pub mod maps;

@@ -1,0 +1,212 @@
+//! A claim judged across the settings of one parameter: the claim's value at every setting with
+//! its interval, the paper's number as a horizontal line, and the verdict as the marker (filled
+//! green circle held, red cross not held, hollow grey circle inconclusive or reported). The x axis
+//! is categorical (one slot per setting, labelled with the setting), so numeric and named
+//! settings (a variant, a rule) plot alike; the y axis is logarithmic when every value is positive
+//! and they span more than a decade.
+
+use super::{ensure_font, write_png_with, PLOT_SIZE};
+use crate::error::{HarnessError, Result};
+use crate::output::write_atomic;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// One setting of the swept parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SettingPoint {
+    /// The setting as shown under the axis (`0.5`, `diffuse`); a trailing `*` marks our
+    /// default and `(paper)` the paper-like setting, as the caller writes them.
+    pub label: String,
+    /// The claim's value there.
+    pub value: Option<f64>,
+    /// Its interval.
+    pub interval: Option<[f64; 2]>,
+    /// The verdict (`held`, `not held`, `inconclusive`, ...).
+    pub verdict: String,
+}
+
+/// A claim against a parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClaimSweepFigure {
+    /// Title.
+    pub title: String,
+    /// x-axis title (the parameter).
+    pub x_desc: String,
+    /// y-axis title (the claim's quantity).
+    pub y_desc: String,
+    /// The settings, in order.
+    pub points: Vec<SettingPoint>,
+    /// The paper's number.
+    pub paper: Option<f64>,
+}
+
+impl ClaimSweepFigure {
+    /// The y range (padded) and whether it is logarithmic; `None` when nothing can be drawn.
+    fn y_range(&self) -> Option<(f64, f64, bool)> {
+        let mut ys: Vec<f64> = self.points.iter().filter_map(|p| p.value).filter(|v| v.is_finite()).collect();
+        for p in &self.points {
+            ys.extend(p.interval.into_iter().flatten().filter(|v| v.is_finite()));
+        }
+        ys.extend(self.paper.filter(|v| v.is_finite()));
+        let (lo, hi) = ys.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| (a.min(y), b.max(y)));
+        if !lo.is_finite() || !hi.is_finite() {
+            return None;
+        }
+        if lo > 0.0 && hi / lo > 10.0 {
+            return Some((lo / 1.3, hi * 1.3, true));
+        }
+        let pad = ((hi - lo) * 0.08).max(hi.abs().max(lo.abs()) * 0.05).max(1e-12);
+        Some((lo - pad, hi + pad, false))
+    }
+}
+
+/// Writes `fig` as `<stem>.svg` and `<stem>.png` in `dir` (created if needed); nothing when no
+/// setting has a finite value.
+pub fn write_claim_sweep(dir: &Path, stem: &str, fig: &ClaimSweepFigure) -> Result<Vec<PathBuf>> {
+    let Some(range) = fig.y_range() else { return Ok(Vec::new()) };
+    std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
+    ensure_font(dir)?;
+    let (svg, png) = (dir.join(format!("{stem}.svg")), dir.join(format!("{stem}.png")));
+    let mut text = String::new();
+    guarded(|| render(&SVGBackend::with_string(&mut text, PLOT_SIZE).into_drawing_area(), fig, range))
+        .map_err(|e| HarnessError::write(&svg, e))?;
+    write_atomic(&svg, text.as_bytes())?;
+    write_png_with(&png, |tmp| {
+        guarded(|| render(&BitMapBackend::new(tmp, PLOT_SIZE).into_drawing_area(), fig, range))
+    })?;
+    Ok(vec![svg, png])
+}
+
+fn guarded<F: FnOnce() -> std::result::Result<(), String>>(f: F) -> std::result::Result<(), String> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f))
+        .unwrap_or_else(|_| Err("the plotting library panicked".to_string()))
+}
+
+const GREEN: RGBColor = RGBColor(0, 140, 60);
+const RED: RGBColor = RGBColor(200, 30, 30);
+const GREY: RGBColor = RGBColor(110, 110, 110);
+const PAPER: RGBColor = RGBColor(40, 70, 200);
+
+fn render<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &ClaimSweepFigure,
+    (lo, hi, log): (f64, f64, bool),
+) -> std::result::Result<(), String> {
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(e)?;
+    let n = fig.points.len().max(1);
+    let labels: Vec<String> = fig.points.iter().map(|p| p.label.clone()).collect();
+    let x_fmt = |x: &f64| {
+        let i = x.round();
+        if (x - i).abs() < 1e-6 && i >= 0.0 {
+            labels.get(i as usize).cloned().unwrap_or_default()
+        } else {
+            String::new()
+        }
+    };
+    let mut builder = ChartBuilder::on(root);
+    builder.margin(16).caption(&fig.title, ("sans-serif", 18)).x_label_area_size(50).y_label_area_size(80);
+    let x_range = -0.5..(n as f64 - 0.5);
+    let paper_line = |y: f64| vec![(-0.5, y), (n as f64 - 0.5, y)];
+    if log {
+        let mut chart = builder.build_cartesian_2d(x_range, (lo..hi).log_scale()).map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_labels(n)
+            .x_label_formatter(&x_fmt)
+            .x_desc(&fig.x_desc)
+            .y_desc(&fig.y_desc)
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(e)?;
+        if let Some(p) = fig.paper {
+            chart.draw_series(LineSeries::new(paper_line(p), PAPER.stroke_width(2))).map_err(e)?;
+        }
+        draw_points(&mut chart, fig).map_err(e)?;
+    } else {
+        let mut chart = builder.build_cartesian_2d(x_range, lo..hi).map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_labels(n)
+            .x_label_formatter(&x_fmt)
+            .x_desc(&fig.x_desc)
+            .y_desc(&fig.y_desc)
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(e)?;
+        if let Some(p) = fig.paper {
+            chart.draw_series(LineSeries::new(paper_line(p), PAPER.stroke_width(2))).map_err(e)?;
+        }
+        draw_points(&mut chart, fig).map_err(e)?;
+    }
+    root.present().map_err(e)
+}
+
+fn draw_points<DB: DrawingBackend, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    fig: &ClaimSweepFigure,
+) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+where
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    for (i, p) in fig.points.iter().enumerate() {
+        let x = i as f64;
+        if let Some([a, b]) = p.interval.filter(|[a, b]| a.is_finite() && b.is_finite()) {
+            chart.draw_series(std::iter::once(PathElement::new(vec![(x, a), (x, b)], GREY.stroke_width(2))))?;
+            for y in [a, b] {
+                chart.draw_series(std::iter::once(PathElement::new(vec![(x - 0.08, y), (x + 0.08, y)], GREY)))?;
+            }
+        }
+        let Some(y) = p.value.filter(|v| v.is_finite()) else { continue };
+        match p.verdict.as_str() {
+            "held" => chart.draw_series(std::iter::once(Circle::new((x, y), 6, GREEN.filled())))?,
+            "not held" => chart.draw_series(std::iter::once(Cross::new((x, y), 7, RED.stroke_width(3))))?,
+            _ => chart.draw_series(std::iter::once(Circle::new((x, y), 6, GREY.stroke_width(2))))?,
+        };
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(label: &str, value: f64, verdict: &str) -> SettingPoint {
+        SettingPoint {
+            label: label.into(),
+            value: Some(value),
+            interval: Some([value * 0.9, value * 1.1]),
+            verdict: verdict.into(),
+        }
+    }
+
+    #[test]
+    fn a_claim_sweep_is_drawn_on_log_and_linear_axes_and_nothing_without_values() {
+        let dir = std::env::temp_dir().join(format!("mcbench-claim-sweep-{}", std::process::id()));
+        let mut fig = ClaimSweepFigure {
+            title: "15.3x against sigma_t".into(),
+            x_desc: "sigma_t".into(),
+            y_desc: "speed-up".into(),
+            points: vec![
+                point("0.125", 9.0, "not held"),
+                point("2*", 0.75, "not held"),
+                point("0.5 (paper)", 3.0, "held"),
+            ],
+            paper: Some(15.3),
+        };
+        assert_eq!(fig.y_range().map(|r| r.2), Some(true));
+        let files = write_claim_sweep(&dir, "log", &fig).unwrap();
+        assert_eq!(files.len(), 2);
+        assert!(std::fs::read_to_string(&files[0]).unwrap().contains("sigma_t"));
+        fig.points = vec![point("a", -0.6, "held"), point("b", -0.5, "inconclusive")];
+        fig.paper = Some(-0.62);
+        assert_eq!(fig.y_range().map(|r| r.2), Some(false));
+        assert_eq!(write_claim_sweep(&dir, "linear", &fig).unwrap().len(), 2);
+        fig.points.iter_mut().for_each(|p| (p.value, p.interval) = (None, None));
+        fig.paper = None;
+        assert!(write_claim_sweep(&dir, "empty", &fig).unwrap().is_empty());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

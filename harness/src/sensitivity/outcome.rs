@@ -1,0 +1,124 @@
+//! How a part ends: one outcome from its verdicts at every setting, decided in a fixed order
+//! (held at the paper-like setting; else holds where it held; else cannot hold, when a ceiling
+//! lies below the claim at every setting; else unsupportable as written, when the file states
+//! why; else not held anywhere tried).
+
+use super::table::SettingRow;
+use super::{setting_text, Part};
+
+/// The outcome of a part.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Outcome {
+    /// Held at the setting closest to the paper's.
+    HeldAtPaperLike {
+        /// That setting.
+        setting: String,
+        /// The claim's value and interval there.
+        value: String,
+    },
+    /// Held at these settings (and not at the others).
+    HoldsWhere {
+        /// Where it held, with values.
+        held: Vec<String>,
+        /// The verdict at our default and the paper-like setting, with values.
+        elsewhere: String,
+    },
+    /// A ceiling of the scene lies below the claim at every setting.
+    CannotHold {
+        /// The largest ceiling and where.
+        best: String,
+        /// The paper's number.
+        paper: f64,
+    },
+    /// The file's reason the claim cannot be supported as written.
+    Unsupportable(String),
+    /// Held at no setting tried, with no ceiling or reason that explains it.
+    NotHeldAnywhere {
+        /// The best value and where.
+        best: String,
+    },
+}
+
+fn value_text(r: &SettingRow) -> String {
+    let v = r.value.map_or("-".to_string(), |v| format!("{v:.3}"));
+    match (r.low, r.high) {
+        (Some(a), Some(b)) => format!("{v} [{a:.3}, {b:.3}]"),
+        _ => v,
+    }
+}
+
+fn at(r: &SettingRow, vary: &str) -> String {
+    format!("{vary} = {}: {} ({})", r.setting, value_text(r), r.verdict)
+}
+
+impl Outcome {
+    /// The outcome's class, one of the four the report names (or `not held at any setting tried`).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Outcome::HeldAtPaperLike { .. } => "held at the paper-like setting",
+            Outcome::HoldsWhere { .. } => "holds where",
+            Outcome::CannotHold { .. } => "cannot hold on this scene",
+            Outcome::Unsupportable(_) => "unsupportable as written",
+            Outcome::NotHeldAnywhere { .. } => "not held at any setting tried",
+        }
+    }
+
+    /// One sentence: the class and the numbers behind it.
+    pub fn sentence(&self) -> String {
+        match self {
+            Outcome::HeldAtPaperLike { setting, value } => {
+                format!("held at the paper-like setting {setting}: {value}")
+            }
+            Outcome::HoldsWhere { held, elsewhere } => {
+                format!("holds where {}; {elsewhere}", held.join("; "))
+            }
+            Outcome::CannotHold { best, paper } => {
+                format!("cannot hold on this scene: the ceiling is below the paper's {paper} at every setting (largest {best})")
+            }
+            Outcome::Unsupportable(why) => format!("unsupportable as written: {why}"),
+            Outcome::NotHeldAnywhere { best } => format!("not held at any setting tried; the closest: {best}"),
+        }
+    }
+}
+
+/// The outcome of `part` from its rows (one per setting, in setting order).
+pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
+    let find = |v: &estimators::params::ParamValue| rows.iter().find(|r| r.setting == setting_text(v)).copied();
+    if let Some(r) = part.paper_like.as_ref().and_then(find).filter(|r| r.verdict == "held") {
+        return Outcome::HeldAtPaperLike { setting: format!("{} = {}", part.vary, r.setting), value: value_text(r) };
+    }
+    let held: Vec<String> = rows.iter().filter(|r| r.verdict == "held").map(|r| at(r, &part.vary)).collect();
+    if !held.is_empty() {
+        let mut elsewhere = Vec::new();
+        if let Some(r) = find(&part.default) {
+            elsewhere.push(format!("at our default {}", at(r, &part.vary)));
+        }
+        if let Some(r) = part.paper_like.as_ref().and_then(find) {
+            elsewhere.push(format!("at the paper-like {}", at(r, &part.vary)));
+        }
+        return Outcome::HoldsWhere { held, elsewhere: elsewhere.join("; ") };
+    }
+    let paper = rows.iter().find_map(|r| r.paper_value);
+    let ceilings: Vec<(f64, &SettingRow)> = rows.iter().filter_map(|r| Some((r.ceiling?, *r))).collect();
+    if let (Some(p), false) = (paper, ceilings.is_empty()) {
+        let all = ceilings.len() == rows.len();
+        let (best, r) =
+            ceilings.iter().fold((f64::NEG_INFINITY, rows[0]), |acc, (c, r)| if *c > acc.0 { (*c, r) } else { acc });
+        if all && best < p {
+            return Outcome::CannotHold { best: format!("{best:.3} at {} = {}", part.vary, r.setting), paper: p };
+        }
+    }
+    if let Some(why) = &part.unsupportable {
+        return Outcome::Unsupportable(why.clone());
+    }
+    let target = paper.unwrap_or(0.0);
+    let best = rows
+        .iter()
+        .filter(|r| r.value.is_some())
+        .min_by(|a, b| {
+            let d = |r: &SettingRow| (r.value.unwrap_or(f64::NAN) - target).abs();
+            d(a).total_cmp(&d(b))
+        })
+        .map_or_else(|| "no setting measured".to_string(), |r| at(r, &part.vary));
+    Outcome::NotHeldAnywhere { best }
+}

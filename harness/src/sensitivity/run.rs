@@ -1,0 +1,201 @@
+//! Running a sensitivity file: every part at every setting into the experiment's results folder,
+//! each claim judged on its setting's cells alone.
+
+use super::outcome::{classify, Outcome};
+use super::table::{self, SettingRow};
+use super::{setting_text, Ceiling, Part, SensitivityFile};
+use crate::analysis;
+use crate::config::{Mode, Sweep};
+use crate::error::{HarnessError, Result};
+use crate::folder::OutputDir;
+use crate::output::{Claim, Diagnostic, RunReport};
+use crate::plan::Plan;
+use crate::progress::Progress;
+use crate::registry::{Experiment, Registry, Sweeps};
+use crate::runner::{self, RunOptions, RunResults};
+use std::path::{Path, PathBuf};
+
+/// The sweep the experiment runs first (the first part at its default setting); the other
+/// settings run in [`post`].
+pub fn first_sweep(file: &SensitivityFile, mode: Mode) -> Result<Sweep> {
+    let part = file.parts.first().ok_or_else(|| HarnessError::bad_file("sensitivity file", "no parts"))?;
+    Ok(part.setting(&file.name, 1, mode, &part.default)?.0)
+}
+
+/// The experiment of a sensitivity file, with the crate's own `post` and `preflight` (functions
+/// that call [`post`] and [`preflight`] with the file).
+pub fn experiment(
+    file: &SensitivityFile,
+    post: crate::registry::PostFn,
+    preflight: crate::registry::PreflightFn,
+) -> Result<Experiment> {
+    Ok(Experiment {
+        name: file.name.clone(),
+        reproduces: file.reproduces.clone(),
+        summary: file.summary.clone(),
+        sweeps: Sweeps::Fixed {
+            quick: Box::new(first_sweep(file, Mode::Quick)?),
+            full: Box::new(first_sweep(file, Mode::Full)?),
+        },
+        claims: None,
+        post: Some(post),
+        preflight: Some(preflight),
+    })
+}
+
+/// Every setting's sweep as it will run after `first` (seed and mode from it).
+fn settings<'a>(
+    file: &'a SensitivityFile,
+    first: &Sweep,
+) -> Result<Vec<(&'a Part, usize, Sweep, crate::claim_spec::ClaimSpec)>> {
+    let mut out = Vec::new();
+    for part in &file.parts {
+        for (i, v) in part.values.iter().enumerate() {
+            let (sweep, claim) = part.setting(&first.experiment, first.seed, first.mode, v)?;
+            out.push((part, i, sweep, claim));
+        }
+    }
+    Ok(out)
+}
+
+/// Checks, before anything is written, that every setting builds (names, parameters, stored
+/// references) and that its stored cells read back.
+pub fn preflight(file: &SensitivityFile, registry: &Registry, first: &Sweep, cells: &Path) -> Result<()> {
+    for (_, _, sweep, _) in settings(file, first)? {
+        let plan = Plan::prepare(sweep, registry)?;
+        runner::preload(&plan, Some(cells))?;
+    }
+    Ok(())
+}
+
+fn run_plan(p: &Plan, results: &OutputDir, threads: usize) -> Result<RunResults> {
+    let progress = Progress::default();
+    let opts = RunOptions { threads: Some(threads), cell_dir: Some(results.join("cells")), observer: &progress };
+    let r = runner::run(p, &opts);
+    progress.finish();
+    r
+}
+
+/// The report of one setting's cells, as the claims read it: rows, fits, speed-ups, diagnostics.
+pub fn setting_report(plan: &Plan, run: &RunResults, like: &RunReport) -> RunReport {
+    let rows: Vec<_> = run.cells.iter().map(|(bi, ei, cell)| plan.summary_row(*bi, *ei, cell)).collect();
+    let diagnostics = run
+        .cells
+        .iter()
+        .flat_map(|(_, _, cell)| {
+            cell.diagnostics.iter().map(move |(name, sum)| Diagnostic {
+                testbed: cell.key.testbed.clone(),
+                variant: cell.key.variant.clone(),
+                estimator: cell.key.estimator.clone(),
+                budget: cell.key.budget.amount,
+                name: name.clone(),
+                mean: sum / cell.estimates.max(1) as f64,
+            })
+        })
+        .collect();
+    let fits = analysis::fits(&rows);
+    let model = &plan.sweep.cost_model;
+    let speedups =
+        plan.sweep.baseline.as_deref().map(|b| analysis::speedups(&rows, &fits, b, model)).unwrap_or_default();
+    RunReport {
+        meta: like.meta.clone(),
+        fits,
+        tests: Vec::new(),
+        paper: Vec::new(),
+        speedups,
+        skipped: plan.skipped.clone(),
+        unavailable: Vec::new(),
+        counts: rows.iter().map(Into::into).collect(),
+        rows,
+        labels: plan.estimators.iter().map(|e| (e.name.clone(), e.entry.label.to_string())).collect(),
+        diagnostics,
+    }
+}
+
+/// The ceiling of `claim` on one setting's report.
+fn ceiling(kind: Ceiling, claim: &crate::claim_spec::ClaimSpec, sweep: &Sweep, report: &RunReport) -> Option<f64> {
+    match kind {
+        Ceiling::WorkRatio => {
+            let crate::claim_spec::ClaimSpec::Speedup { estimator, baseline, .. } = claim else { return None };
+            let base = baseline.as_deref().or(sweep.baseline.as_deref())?;
+            let last = report.rows.iter().map(|r| r.budget).max()?;
+            let at = |name: &str| report.rows.iter().find(|r| r.estimator == name && r.budget == last);
+            let (m, b) = (at(estimator)?, at(base)?);
+            let work = |r: &crate::metrics::SummaryRow| r.variance * r.rays.max(f64::MIN_POSITIVE);
+            let v = work(b) / work(m);
+            v.is_finite().then_some(v)
+        }
+    }
+}
+
+/// Runs every setting of every part (the first part's default is the experiment's own run),
+/// judges each part's claim per setting, and writes `sensitivity.csv`, `sensitivity.md`, one
+/// plot per part and one claim per part (its outcome) into the report.
+pub fn post(
+    file: &SensitivityFile,
+    plan: &Plan,
+    run: &RunResults,
+    report: &mut RunReport,
+    results: &OutputDir,
+    plots: Option<&Path>,
+    registry: &Registry,
+) -> Result<Vec<PathBuf>> {
+    let threads = report.meta.threads;
+    let mut rows: Vec<SettingRow> = Vec::new();
+    for (part, i, sweep, claim) in settings(file, &plan.sweep)? {
+        let value = &part.values[i];
+        let sub = if sweep == plan.sweep {
+            setting_report(plan, run, report)
+        } else {
+            let p = Plan::prepare(sweep.clone(), registry)?;
+            let r = run_plan(&p, results, threads)?;
+            setting_report(&p, &r, report)
+        };
+        let judged = claim.judge(&sub);
+        let ceiling = part.ceiling.and_then(|k| ceiling(k, &claim, &sweep, &sub));
+        rows.push(SettingRow::new(part, value, &judged, ceiling));
+    }
+    let mut written = Vec::new();
+    let mut outcomes: Vec<(&Part, Outcome)> = Vec::new();
+    for part in &file.parts {
+        let mine: Vec<&SettingRow> = rows.iter().filter(|r| r.part == part.id).collect();
+        let outcome = classify(part, &mine);
+        report.paper.push(outcome_claim(part, &mine, &outcome));
+        if let Some(dir) = plots {
+            written.extend(table::plot(dir, part, &mine)?);
+        }
+        outcomes.push((part, outcome));
+    }
+    results.write_csv("sensitivity.csv", &rows)?;
+    results.write("sensitivity.md", table::markdown(&outcomes, &rows).as_bytes())?;
+    report.meta.notes.push(format!(
+        "sensitivity: {} parts, {} settings; each claim judged on its setting's cells alone (sensitivity.csv)",
+        file.parts.len(),
+        rows.len()
+    ));
+    Ok(written)
+}
+
+/// A part's outcome as a claim of the report: the verdict at the paper-like setting (else at our
+/// default), the outcome in the note.
+fn outcome_claim(part: &Part, rows: &[&SettingRow], outcome: &Outcome) -> Claim {
+    let at = part.paper_like.as_ref().unwrap_or(&part.default);
+    let row = rows.iter().find(|r| r.setting == setting_text(at));
+    Claim {
+        testbed: row.map(|r| r.testbed.clone()).unwrap_or_default(),
+        claim: format!("paper {}: {} (against {})", part.paper, part.headline, part.vary),
+        paper_value: row.and_then(|r| r.paper_value),
+        our_value: row.and_then(|r| r.value),
+        held: row.and_then(|r| match r.verdict.as_str() {
+            "held" => Some(true),
+            "not held" => Some(false),
+            _ => None,
+        }),
+        note: outcome.sentence(),
+        verdict: row.map(|r| r.verdict.clone()).unwrap_or_else(|| "not measured".into()),
+        interval: row.and_then(|r| Some([r.low?, r.high?])),
+        pair: row.map(|r| r.pair.clone()).unwrap_or_default(),
+        regime: row.map(|r| r.regime.clone()).unwrap_or_default(),
+        reason: format!("{}: {}", outcome.kind(), part.open),
+    }
+}

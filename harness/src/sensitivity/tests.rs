@@ -1,0 +1,115 @@
+use super::outcome::{classify, Outcome};
+use super::table::SettingRow;
+use super::*;
+use crate::claim_spec::ClaimSpec;
+
+const FILE: &str = r#"
+name = "s"
+reproduces = "r"
+summary = "s"
+[[parts]]
+id = "a"
+paper = "p"
+headline = "h"
+vary = "estimator.smc.moves"
+values = [1, 5]
+default = 5
+paper_like = 1
+open = "o"
+testbed = { id = "envmap-sequence", variant = "mixed" }
+estimators = [{ id = "smc", params = { moves = 5 } }, { id = "bidirectional_is" }]
+baseline = "smc[moves=5]"
+claim = { kind = "ratio", testbed = "envmap-sequence/mixed", estimator = "smc[moves=5]", baseline = "bidirectional_is", text = "smc[moves=5] wins" }
+ceiling = "work_ratio"
+quick = { reps = 4, budgets = [4, 16, 64] }
+full = { reps = 8, budgets = [4, 16, 64, 256] }
+"#;
+
+fn file_with(replace: (&str, &str)) -> std::result::Result<SensitivityFile, String> {
+    SensitivityFile::parse(&FILE.replace(replace.0, replace.1))
+}
+
+#[test]
+fn settings_rewrite_the_sweep_and_the_names_the_claim_uses() {
+    let f = file_with(("", "")).unwrap();
+    let p = &f.parts[0];
+    let (sweep, claim) = p.setting("s", 3, Mode::Quick, &p.values[0]).unwrap();
+    assert_eq!((sweep.seed, sweep.reps, sweep.budgets.len()), (3, 4, 3));
+    assert_eq!(sweep.estimators[0].name(), "smc[moves=1]");
+    assert_eq!(sweep.baseline.as_deref(), Some("smc[moves=1]"));
+    assert_eq!(claim.estimators(), vec!["smc[moves=1]", "bidirectional_is"]);
+    let ClaimSpec::Ratio { text, .. } = &claim else { panic!("kind kept") };
+    assert_eq!(text, "smc[moves=5] wins", "the claim's words are not renamed");
+
+    let f = file_with((
+        "vary = \"estimator.smc.moves\"\nvalues = [1, 5]\ndefault = 5\npaper_like = 1",
+        "vary = \"budget_max\"\nvalues = [16, 64]\ndefault = 64",
+    ))
+    .unwrap();
+    let p = &f.parts[0];
+    assert_eq!(p.setting("s", 1, Mode::Quick, &p.values[0]).unwrap().0.budgets.len(), 2);
+
+    let f = file_with((
+        "vary = \"estimator.smc.moves\"\nvalues = [1, 5]\ndefault = 5\npaper_like = 1",
+        "vary = \"variant\"\nvalues = [\"mixed\", \"specular\"]\ndefault = \"mixed\"",
+    ))
+    .unwrap();
+    let p = &f.parts[0];
+    let (sweep, claim) = p.setting("s", 1, Mode::Full, &p.values[1]).unwrap();
+    assert_eq!(sweep.testbeds[0].variant.as_deref(), Some("specular"));
+    assert_eq!(claim.testbed(), Some("envmap-sequence/specular"));
+    assert!(p.setting("s", 1, Mode::Full, &estimators::params::ParamValue::Number(2.0)).is_err());
+}
+
+#[test]
+fn bad_files_are_refused_with_the_part_named() {
+    let e = file_with(("default = 5", "default = 7")).unwrap_err();
+    assert!(e.contains("part a") && e.contains("default 7"), "{e}");
+    let e = file_with(("paper_like = 1", "paper_like = 2")).unwrap_err();
+    assert!(e.contains("paper-like setting 2"), "{e}");
+    let e = file_with(("vary = \"estimator.smc.moves\"", "vary = \"moves\"")).unwrap_err();
+    assert!(e.contains("is not testbed"), "{e}");
+    assert!(file_with(("open = \"o\"", "open = \"o\"\nextra = 1")).is_err());
+    let twice = format!("{FILE}{}", &FILE[FILE.find("[[parts]]").unwrap()..]);
+    assert!(SensitivityFile::parse(&twice).unwrap_err().contains("listed twice"));
+}
+
+fn row(setting: &str, role: &str, value: f64, verdict: &str, ceiling: Option<f64>) -> SettingRow {
+    SettingRow {
+        part: "a".into(),
+        paper: "p".into(),
+        headline: "h".into(),
+        vary: "estimator.smc.moves".into(),
+        setting: setting.into(),
+        role: role.into(),
+        testbed: "t/v".into(),
+        paper_value: Some(15.3),
+        value: Some(value),
+        low: Some(value * 0.9),
+        high: Some(value * 1.1),
+        verdict: verdict.into(),
+        ceiling,
+        pair: String::new(),
+        regime: String::new(),
+        reason: String::new(),
+    }
+}
+
+#[test]
+fn the_outcome_is_decided_in_order() {
+    let f = file_with(("", "")).unwrap();
+    let p = &f.parts[0];
+    let (a, b) = (row("1", "paper-like", 16.0, "held", Some(20.0)), row("5", "default", 2.0, "not held", Some(3.0)));
+    assert!(matches!(classify(p, &[&a, &b]), Outcome::HeldAtPaperLike { .. }));
+    let (a, b) = (row("1", "paper-like", 4.0, "not held", Some(5.0)), row("5", "default", 16.0, "held", Some(30.0)));
+    let o = classify(p, &[&a, &b]);
+    assert!(matches!(o, Outcome::HoldsWhere { .. }) && o.sentence().contains("estimator.smc.moves = 5"), "{o:?}");
+    let (a, b) = (row("1", "paper-like", 4.0, "not held", Some(5.0)), row("5", "default", 2.0, "not held", Some(3.0)));
+    let o = classify(p, &[&a, &b]);
+    assert!(matches!(o, Outcome::CannotHold { .. }) && o.sentence().contains("5.000"), "{o:?}");
+    let (a, b) = (row("1", "paper-like", 4.0, "not held", Some(50.0)), row("5", "default", 2.0, "inconclusive", None));
+    assert!(matches!(classify(p, &[&a, &b]), Outcome::NotHeldAnywhere { .. }), "a missing ceiling decides nothing");
+    let mut q = p.clone();
+    q.unsupportable = Some("the paper's own numbers give 3x".into());
+    assert_eq!(classify(&q, &[&a, &b]).kind(), "unsupportable as written");
+}
