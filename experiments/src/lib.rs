@@ -24,6 +24,7 @@ pub mod pmc_hi;
 pub mod pmc_hi_post;
 pub mod pmc_ip;
 pub mod pmc_ip_post;
+pub mod sensitivity;
 pub mod single_scatter;
 pub mod single_scatter_post;
 pub mod stability;
@@ -80,13 +81,14 @@ pub static EXPERIMENTS: &[&ExperimentDef] = &[
 
 /// The built-in estimators and test beds with every experiment of the suite, in the order the
 /// default suite runs them (the harness's `unbiasedness` before `stability`), and the harness's
-/// `calibration`, which runs only when named: what the `mcbench` binary runs.
+/// `calibration` and the suite's `sensitivity`, which run only when named: what the `mcbench`
+/// binary runs.
 pub fn registry() -> Registry {
     let (papers, last) = EXPERIMENTS.split_at(EXPERIMENTS.len() - 1);
     let r = papers.iter().fold(Registry::builtin().without_experiments(), |r, d| r.with_experiment(d.experiment()));
     let r = r.with_experiment(mcbench::unbiasedness::experiment());
     let r = last.iter().fold(r, |r, d| r.with_experiment(d.experiment()));
-    r.with_experiment_on_demand(mcbench::calibration::experiment())
+    r.with_experiment_on_demand(mcbench::calibration::experiment()).with_experiment_on_demand(sensitivity::experiment())
 }
 
 /// The registry for the crate's own tests: [`registry`] reading the repository's stored
