@@ -29,7 +29,6 @@ pub mod single_scatter;
 pub mod single_scatter_post;
 pub mod stability;
 pub mod stability_cases;
-pub mod stability_list;
 pub mod stability_numeric;
 pub mod surface_smc;
 pub mod transmittance;

@@ -4,16 +4,14 @@
 //!
 //! The sweep itself is small (albedo exactly 1 and exactly 0 on `gradient-box` through the normal
 //! harness, so those cells get the usual summary, fits and tests); the post hook runs every case of
-//! [`crate::stability_list::cases`] with [`crate::stability_cases::run`] plus the numeric cases of
-//! [`crate::stability_numeric`], writes `stability.csv` and `pdf_zero.csv`, and adds one claim
-//! per case: held when the outcome is what theory expects ([`Expect`]).
+//! `stability_cases.toml` ([`CaseFile`]) with [`crate::stability_cases::run`] plus the numeric
+//! cases of [`crate::stability_numeric`], writes `stability.csv` and `pdf_zero.csv` (the file's
+//! table), and adds one claim per case: held when the outcome is what theory expects ([`Expect`]).
 
-use crate::stability_cases::{self as sc, Expect, Outcome};
-use crate::stability_list::{cases, PDF_ZERO};
+use crate::stability_cases::{self as sc, CaseFile, Expect, Outcome};
 use crate::stability_numeric::{self as num, Sequence};
 use crate::ExperimentDef;
 use estimators::params::Params;
-use mcbench::config::Mode;
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::guarded::one_line;
@@ -97,17 +95,6 @@ struct StabilityRow {
     error_text: String,
 }
 
-/// One row of `pdf_zero.csv`: a place where a sampling pdf can be 0, and how it is guarded.
-#[derive(Serialize)]
-struct PdfZeroRow {
-    /// The source file (and function) of the guard.
-    site: &'static str,
-    /// What the guard does.
-    guard: &'static str,
-    /// The stability cases that exercise it.
-    cases: &'static str,
-}
-
 /// None (an empty cell) for NaN, else the number.
 fn nan_to_none(x: f64) -> Option<f64> {
     (!x.is_nan()).then_some(x)
@@ -122,9 +109,8 @@ pub fn post(
     _plots: Option<&Path>,
     registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
-    let mode = plan.sweep.mode;
+    let file = CaseFile::load()?;
     let seed = plan.sweep.seed;
-    let k = if mode == Mode::Quick { 1 } else { 4 };
     let mut rows = Vec::new();
     let mut push = |id: &str, item: &str, bed: String, est: String, params: String, expect: Expect, o: Outcome| {
         let expected = if expect == Expect::Correct { "correct" } else { "refused" };
@@ -154,7 +140,7 @@ pub fn post(
             error_text: one_line(&o.text),
         });
     };
-    for c in cases(k) {
+    for c in file.cases(plan.sweep.mode) {
         let o = sc::run(&c, seed, registry);
         let bed_params = params_text(&c.bed);
         let est_params = params_text(&c.params);
@@ -163,14 +149,12 @@ pub fn post(
             (true, false) => format!("bed[{bed_params}]"),
             (false, false) => format!("{est_params} bed[{bed_params}]"),
         };
-        push(c.id, c.spec_item, format!("{}/{}", c.testbed, c.variant), c.estimator.into(), params, c.expect, o);
+        push(&c.id, &c.spec_item, format!("{}/{}", c.testbed, c.variant), c.estimator, params, c.expect, o);
     }
     for (id, item, expect, o) in numeric_cases() {
         push(id, item, "numeric/".into(), "-".into(), String::new(), expect, o);
     }
     results.write_csv("stability.csv", &rows)?;
-    let pdf_zero: Vec<PdfZeroRow> =
-        PDF_ZERO.iter().map(|&(site, guard, cases)| PdfZeroRow { site, guard, cases }).collect();
-    results.write_csv("pdf_zero.csv", &pdf_zero)?;
+    results.write_csv("pdf_zero.csv", &file.pdf_zero)?;
     Ok(Vec::new())
 }

@@ -10,6 +10,9 @@
 //!
 //! A panic is caught per repetition ([`std::panic::catch_unwind`]) so one bad case cannot abort
 //! the run.
+//!
+//! The cases themselves, and the table of places where a pdf can be zero, are data:
+//! `stability_cases.toml` beside this file, embedded and read by [`CaseFile::load`].
 
 use estimators::budget::Budget;
 use estimators::error::EstimateError;
@@ -20,13 +23,17 @@ use estimators::task::Task;
 use estimators::testbed::TestBed;
 use mcbench::analysis::unbiasedness;
 use mcbench::claims::decisive_test;
+use mcbench::config::Mode;
+use mcbench::error::HarnessError;
 use mcbench::guarded::{self, one_line, Stopped};
 use mcbench::registry::Registry;
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-/// What theory says a case must do.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// What theory says a case must do (`expect = "correct"` or `"refused"` in the case file).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Expect {
     /// Finite and unbiased (or as its bias claim says) within error bars.
     Correct,
@@ -34,28 +41,83 @@ pub enum Expect {
     Refused,
 }
 
-/// One estimator case.
+/// One estimator case (a `[[case]]` of `stability_cases.toml`).
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Case {
     /// Short id (`stability.csv` column `case`).
-    pub id: &'static str,
+    pub id: String,
     /// The SPEC §10 item (or pdf-zero site) it covers.
-    pub spec_item: &'static str,
+    pub spec_item: String,
     /// Test bed id.
-    pub testbed: &'static str,
+    pub testbed: String,
     /// Variant.
-    pub variant: &'static str,
-    /// Test-bed parameters.
+    pub variant: String,
+    /// Test-bed parameters (none when left out).
+    #[serde(default)]
     pub bed: Params,
     /// Estimator id.
-    pub estimator: &'static str,
-    /// Estimator parameters.
+    pub estimator: String,
+    /// Estimator parameters (none when left out).
+    #[serde(default)]
     pub params: Params,
     /// Samples per estimate.
     pub samples: u64,
-    /// Repetitions (of every integral).
+    /// Repetitions (of every integral); the file holds the quick-mode count.
     pub reps: u64,
     /// What theory expects.
     pub expect: Expect,
+}
+
+/// One row of `pdf_zero.csv` (a `[[pdf_zero]]` of `stability_cases.toml`): a place where a
+/// sampling pdf can be 0, and how it is guarded.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PdfZero {
+    /// The source file (and function) of the guard.
+    pub site: String,
+    /// What the guard does.
+    pub guard: String,
+    /// The stability cases that exercise it (comma separated).
+    pub cases: String,
+}
+
+/// The case file, `stability_cases.toml`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseFile {
+    /// The estimator cases, in order, with their quick-mode repetitions (read them through
+    /// [`CaseFile::cases`], which scales the repetitions to the mode).
+    #[serde(rename = "case")]
+    cases: Vec<Case>,
+    /// Where a pdf can be zero in `estimators/src`.
+    pub pdf_zero: Vec<PdfZero>,
+}
+
+/// Full mode runs this many times the repetitions the case file gives (those of quick mode).
+pub const FULL_REPS_FACTOR: u64 = 4;
+
+/// Where the case file lives (for messages).
+const CASE_FILE: &str = "experiments/src/stability_cases.toml";
+
+impl CaseFile {
+    /// The embedded `stability_cases.toml`, unknown keys refused; an error names the line and the
+    /// message (for an unknown key: the key and the valid ones).
+    pub fn load() -> mcbench::error::Result<Self> {
+        let text = include_str!("stability_cases.toml");
+        toml::from_str(text).map_err(|e: toml::de::Error| {
+            let line = e.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+            let at = line.map(|l| format!("line {l}: ")).unwrap_or_default();
+            HarnessError::bad_file(CASE_FILE, format!("{at}{}", one_line(e.message())))
+        })
+    }
+
+    /// The cases of a mode: the file's repetitions in quick mode, [`FULL_REPS_FACTOR`] times them
+    /// in full mode.
+    pub fn cases(&self, mode: Mode) -> Vec<Case> {
+        let k = if mode == Mode::Quick { 1 } else { FULL_REPS_FACTOR };
+        self.cases.iter().map(|c| Case { reps: c.reps * k, ..c.clone() }).collect()
+    }
 }
 
 /// The outcome of a case (one row of `stability.csv`).
@@ -105,8 +167,8 @@ fn one_rep(
     for first in (0..bed.integrals()).step_by(f) {
         let key = StreamKey {
             seed,
-            testbed: case.id,
-            estimator: case.estimator,
+            testbed: &case.id,
+            estimator: &case.estimator,
             budget: case.samples,
             rep,
             integral: first as u64,
@@ -128,15 +190,15 @@ pub fn run(case: &Case, seed: u64, registry: &Registry) -> Outcome {
 }
 
 fn run_inner(case: &Case, seed: u64, registry: &Registry) -> Outcome {
-    let entry = match registry.test_bed(case.testbed) {
+    let entry = match registry.test_bed(&case.testbed) {
         Ok(e) => e,
         Err(e) => return Outcome::refused(e),
     };
-    let bed = match (entry.build)(case.variant, &case.bed, registry.references()) {
+    let bed = match (entry.build)(&case.variant, &case.bed, registry.references()) {
         Ok(b) => b,
         Err(e) => return Outcome::refused(e),
     };
-    let est_entry = match registry.estimator(case.estimator) {
+    let est_entry = match registry.estimator(&case.estimator) {
         Ok(e) => e,
         Err(e) => return Outcome::refused(e),
     };
@@ -167,7 +229,7 @@ fn run_inner(case: &Case, seed: u64, registry: &Registry) -> Outcome {
     let per_rep: Vec<Vec<[f64; 3]>> = reps.into_iter().flatten().collect();
     let budget =
         Budget::samples(case.samples).unwrap_or(Budget { kind: estimators::budget::BudgetKind::Samples, amount: 1 });
-    let cell = guarded::cell_of(bed.as_ref(), case.estimator, budget, seed, &per_rep);
+    let cell = guarded::cell_of(bed.as_ref(), &case.estimator, budget, seed, &per_rep);
     let moments = &cell.moments;
     if moments.iter().flatten().any(|m| !m.mean().is_finite()) {
         return Outcome::failed("non-finite estimate");
@@ -180,7 +242,7 @@ fn run_inner(case: &Case, seed: u64, registry: &Registry) -> Outcome {
     }
     // No independent gate here: a correct unbiased estimator is one the test does not flag.
     let rows = unbiasedness(&cell, reference, est_entry.bias, None, mcbench::analysis::DEFAULT_TOLERANCE);
-    let Some(t) = decisive_test(&rows, case.variant, case.estimator, "") else {
+    let Some(t) = decisive_test(&rows, &case.variant, &case.estimator, "") else {
         return Outcome::failed("no unbiasedness test could run");
     };
     let note = format!(
@@ -261,19 +323,39 @@ mod tests {
         }
     }
 
-    fn case(estimator: &'static str, params: Params, expect: Expect) -> Case {
+    fn case(estimator: &str, params: Params, expect: Expect) -> Case {
         Case {
-            id: "t",
-            spec_item: "test",
-            testbed: "canonical-1d",
-            variant: "constant-T0.5",
+            id: "t".into(),
+            spec_item: "test".into(),
+            testbed: "canonical-1d".into(),
+            variant: "constant-T0.5".into(),
             bed: Params::new().with("tau", 0.0),
-            estimator,
+            estimator: estimator.into(),
             params,
             samples: 2,
             reps: 8,
             expect,
         }
+    }
+
+    /// The case file parses, its case ids are unique, and every case names a registered test bed
+    /// and estimator that build with its parameters (a misspelled parameter name fails here).
+    #[test]
+    fn every_case_of_the_file_builds() {
+        let file = CaseFile::load().unwrap_or_else(|e| panic!("{e}"));
+        assert!(!file.cases.is_empty() && !file.pdf_zero.is_empty());
+        let registry = crate::test_registry();
+        let mut ids = std::collections::BTreeSet::new();
+        for c in &file.cases {
+            assert!(ids.insert(c.id.as_str()), "case id {} appears twice", c.id);
+            assert!(c.samples > 0 && c.reps > 0, "{}: no samples or repetitions", c.id);
+            let bed = registry.test_bed(&c.testbed).unwrap_or_else(|e| panic!("{}: {e}", c.id));
+            (bed.build)(&c.variant, &c.bed, registry.references()).unwrap_or_else(|e| panic!("{}: {e}", c.id));
+            let est = registry.estimator(&c.estimator).unwrap_or_else(|e| panic!("{}: {e}", c.id));
+            (est.build)(&c.params).unwrap_or_else(|e| panic!("{}: {e}", c.id));
+        }
+        let full = file.cases(Mode::Full);
+        assert!(full.iter().zip(&file.cases).all(|(f, q)| f.reps == FULL_REPS_FACTOR * q.reps));
     }
 
     #[test]
@@ -291,7 +373,7 @@ mod tests {
         assert!(unknown.outcome == "refused" && unknown.text.contains("no_such_estimator"), "{unknown:?}");
         // A panicking estimator is caught and reported in one line.
         let c = case("delta_tracking", Params::new(), Expect::Correct);
-        let bed = Registry::builtin().test_bed("canonical-1d").unwrap().build_exact(c.variant, &c.bed).unwrap();
+        let bed = Registry::builtin().test_bed("canonical-1d").unwrap().build_exact(&c.variant, &c.bed).unwrap();
         let err = one_rep(&Panics, bed.as_ref(), &c, 1, 0).unwrap_err();
         assert_eq!(err, "panic: boom");
     }
