@@ -1,6 +1,7 @@
 //! A claim judged across the settings of one parameter: the claim's value at every setting with
 //! its interval, the paper's number as a horizontal line, and the verdict as the marker (filled
-//! green circle held, red cross not held, hollow grey circle inconclusive or reported). The x axis
+//! green circle held, red cross not held, hollow grey circle inconclusive or reported) and, where
+//! the scene bounds the claim, its ceiling (orange triangle). The x axis
 //! is categorical (one slot per setting, labelled with the setting), so numeric and named
 //! settings (a variant, a rule) plot alike; the y axis is logarithmic when every value is positive
 //! and they span more than a decade.
@@ -24,6 +25,8 @@ pub struct SettingPoint {
     pub interval: Option<[f64; 2]>,
     /// The verdict (`held`, `not held`, `inconclusive`, ...).
     pub verdict: String,
+    /// The scene's ceiling of the claim there, drawn as an orange triangle.
+    pub ceiling: Option<f64>,
 }
 
 /// A claim against a parameter.
@@ -47,6 +50,7 @@ impl ClaimSweepFigure {
         let mut ys: Vec<f64> = self.points.iter().filter_map(|p| p.value).filter(|v| v.is_finite()).collect();
         for p in &self.points {
             ys.extend(p.interval.into_iter().flatten().filter(|v| v.is_finite()));
+            ys.extend(p.ceiling.filter(|v| v.is_finite()));
         }
         ys.extend(self.paper.filter(|v| v.is_finite()));
         let (lo, hi) = ys.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &y| (a.min(y), b.max(y)));
@@ -87,6 +91,7 @@ const GREEN: RGBColor = RGBColor(0, 140, 60);
 const RED: RGBColor = RGBColor(200, 30, 30);
 const GREY: RGBColor = RGBColor(110, 110, 110);
 const PAPER: RGBColor = RGBColor(40, 70, 200);
+const CEILING: RGBColor = RGBColor(230, 120, 0);
 
 fn render<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -159,6 +164,9 @@ where
                 chart.draw_series(std::iter::once(PathElement::new(vec![(x - 0.08, y), (x + 0.08, y)], GREY)))?;
             }
         }
+        if let Some(c) = p.ceiling.filter(|v| v.is_finite()) {
+            chart.draw_series(std::iter::once(TriangleMarker::new((x, c), 7, CEILING.filled())))?;
+        }
         let Some(y) = p.value.filter(|v| v.is_finite()) else { continue };
         match p.verdict.as_str() {
             "held" => chart.draw_series(std::iter::once(Circle::new((x, y), 6, GREEN.filled())))?,
@@ -179,6 +187,7 @@ mod tests {
             value: Some(value),
             interval: Some([value * 0.9, value * 1.1]),
             verdict: verdict.into(),
+            ceiling: Some(value * 2.0),
         }
     }
 
@@ -204,7 +213,7 @@ mod tests {
         fig.paper = Some(-0.62);
         assert_eq!(fig.y_range().map(|r| r.2), Some(false));
         assert_eq!(write_claim_sweep(&dir, "linear", &fig).unwrap().len(), 2);
-        fig.points.iter_mut().for_each(|p| (p.value, p.interval) = (None, None));
+        fig.points.iter_mut().for_each(|p| (p.value, p.interval, p.ceiling) = (None, None, None));
         fig.paper = None;
         assert!(write_claim_sweep(&dir, "empty", &fig).unwrap().is_empty());
         let _ = std::fs::remove_dir_all(&dir);

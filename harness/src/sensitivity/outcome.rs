@@ -87,7 +87,13 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
     if let Some(r) = part.paper_like.as_ref().and_then(find).filter(|r| r.verdict == "held") {
         return Outcome::HeldAtPaperLike { setting: format!("{} = {}", part.vary, r.setting), value: value_text(r) };
     }
-    let held: Vec<String> = rows.iter().filter(|r| r.verdict == "held").map(|r| at(r, &part.vary)).collect();
+    let mut held: Vec<String> = rows.iter().filter(|r| r.verdict == "held").map(|r| at(r, &part.vary)).collect();
+    if held.len() == rows.len() && rows.len() > 1 {
+        let values: Vec<f64> = rows.iter().filter_map(|r| r.value).collect();
+        let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
+        let (first, last) = (&rows[0].setting, &rows[rows.len() - 1].setting);
+        held = vec![format!("every setting tried ({} from {first} to {last}: {lo:.3} to {hi:.3})", part.vary)];
+    }
     if !held.is_empty() {
         let mut elsewhere = Vec::new();
         if let Some(r) = find(&part.default) {

@@ -139,12 +139,13 @@ pub fn plot(dir: &Path, part: &Part, rows: &[&SettingRow]) -> Result<Vec<PathBuf
             value: r.value,
             interval: r.low.zip(r.high).map(|(a, b)| [a, b]),
             verdict: r.verdict.clone(),
+            ceiling: r.ceiling,
         })
         .collect();
     let fig = ClaimSweepFigure {
         title: format!("paper {}: {}", part.paper, part.headline),
         x_desc: format!("{} (* our default)", part.vary),
-        y_desc: "claim value (line: the paper's)".into(),
+        y_desc: "claim value (line: the paper's; triangle: ceiling)".into(),
         points,
         paper: rows.iter().find_map(|r| r.paper_value),
     };

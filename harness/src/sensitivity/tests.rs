@@ -104,6 +104,11 @@ fn the_outcome_is_decided_in_order() {
     let (a, b) = (row("1", "paper-like", 4.0, "not held", Some(5.0)), row("5", "default", 16.0, "held", Some(30.0)));
     let o = classify(p, &[&a, &b]);
     assert!(matches!(o, Outcome::HoldsWhere { .. }) && o.sentence().contains("estimator.smc.moves = 5"), "{o:?}");
+    let (a, b) = (row("1", "paper-like", 4.0, "held", None), row("5", "default", 16.0, "held", None));
+    let mut q = p.clone();
+    q.paper_like = None;
+    let o = classify(&q, &[&a, &b]);
+    assert!(o.sentence().contains("every setting tried") && o.sentence().contains("4.000 to 16.000"), "{o:?}");
     let (a, b) = (row("1", "paper-like", 4.0, "not held", Some(5.0)), row("5", "default", 2.0, "not held", Some(3.0)));
     let o = classify(p, &[&a, &b]);
     assert!(matches!(o, Outcome::CannotHold { .. }) && o.sentence().contains("5.000"), "{o:?}");
