@@ -1,5 +1,5 @@
 //! Per-thread CPU time of whole estimates (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`), the
-//! load-proof numbers of docs/performance.md: the time one thread spent, not wall time, so a busy
+//! load-proof numbers of docs/src/performance.md: the time one thread spent, not wall time, so a busy
 //! machine slows the run but does not change the ratios much. Not a criterion bench: it prints one
 //! line per measurement and ignores criterion's options.
 //!

@@ -8,7 +8,7 @@
 //!
 //! Fixed-sample mode (the default): every estimate averages `N` rays, so variance x fetches per
 //! estimate is the cost-normalised variance and the prediction is exact (`Var = V_ray / N`).
-//! Equal-cost mode: a config file with `budget_kind = "fetches"` (see the README); the harness buys
+//! Equal-cost mode: a config file with `budget_kind = "fetches"` (see docs/src/paper-002.md); the harness buys
 //! each estimate a fixed, pilot-calibrated number of rays, for which the prediction is exact too.
 //!
 //! Estimators (family key: what runs): `delta`, `ratio`, `double` (double particle), `double-cv-linear`

@@ -17,7 +17,7 @@ use mcbench::report::sig;
 
 const TB: &str = "canonical-1d";
 
-/// What equal-cost mode changes (the harness fixes the ray count by a pilot run, README).
+/// What equal-cost mode changes (the harness fixes the ray count by a pilot run, docs/src/experiments.md).
 fn mode_note(a: &Analysis) -> &'static str {
     if a.equal_cost {
         " Equal-cost mode: each fetch budget buys a fixed number of rays per estimate, calibrated by the harness's pilot run on its own stream, so the estimates stay unbiased and the prediction V_ray / n is exact for that n."

@@ -47,7 +47,7 @@ fn unbiased_claim(r: &RunReport, variant: &str, estimator: &str) -> Claim {
         verdict: decisive.map_or(String::new(), |t| mcbench::claims::unbiased_verdict(t).1),
         reason: decisive.map_or(String::new(), |t| t.reason.clone()),
         note: format!(
-            "{} (Holm-Welch per pixel and the pooled t-test over repetitions, Bonferroni); smallest Holm-adjusted p {} (pooled t {}); uniform_image on the same bed: Holm-Welch {}, pooled t {}; {} repetitions (see README: heavy-tailed pixel samples)",
+            "{} (Holm-Welch per pixel and the pooled t-test over repetitions, Bonferroni); smallest Holm-adjusted p {} (pooled t {}); uniform_image on the same bed: Holm-Welch {}, pooled t {}; {} repetitions (see docs/src/paper-003.md: heavy-tailed pixel samples)",
             decisive.map_or("-".to_string(), |t| format!("{}: {}", t.verdict, t.reason)),
             p(test(estimator, "holm_welch")),
             p(test(estimator, "pooled_t")),

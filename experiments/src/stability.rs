@@ -46,7 +46,7 @@ fn numeric_cases() -> Vec<(&'static str, &'static str, Expect, Outcome)> {
         ("running-mean-1e8-trend-rgbmean", item, Expect::Correct, trend_r),
         ("cache-1e7-mixed", "1e7 samples into one cache", Expect::Correct, cache_mixed),
         // Judged at the same 1e-12 as every running mean: paper 001's uncompensated cell mean
-        // fails it on the trend sequence, and the table says so (README, "Stability").
+        // fails it on the trend sequence, and the table says so (docs/src/stability.md).
         ("cache-1e7-trend", "1e7 samples into one cache", Expect::Correct, cache_trend),
         ("smc-log-weights-underflow", "SMC weights that underflow", Expect::Correct, num::underflowing_weights()),
         ("smc-all-weights-zero", "every weight zero (ESS undefined)", Expect::Refused, num::all_zero_weights()),

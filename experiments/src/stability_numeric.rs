@@ -121,7 +121,7 @@ pub fn running_means(seq: Sequence, n: u64) -> (Outcome, Outcome) {
 /// `n` records of `seq` into one cell of a radiance cache grid (f64 storage): the record counter
 /// must count them all (a `u32`, saturating) and the cell's running mean is compared with the
 /// double-double reference. The cell mean is the paper's plain running mean `g += (f - g) / (C+1)`
-/// (paper 001 §4.1), not compensated: on the `trend` sequence it drifts (reported, see the README).
+/// (paper 001 §4.1), not compensated: on the `trend` sequence it drifts (reported, see docs/src/stability.md).
 pub fn cache_cell(seq: Sequence, n: u64, limit: f64) -> Outcome {
     let mut grid = Grid::<f64>::with_resolution(Domain::Hemisphere, 1, 1);
     let mut exact = DoubleDouble::default();

@@ -8,7 +8,7 @@
 //!
 //! - `measured`: the estimating thread's CPU seconds, nothing added;
 //! - `renderer`: the CPU seconds plus each counted operation priced at a unit cost measured in a
-//!   real renderer on a real scene (`docs/cost_model_source.md` says where the defaults come from).
+//!   real renderer on a real scene (`docs/src/cost_model_source.md` says where the defaults come from).
 //!
 //! A sweep may set the unit costs in a `[cost_model]` table:
 //!
@@ -36,7 +36,7 @@ use serde::{Deserialize, Serialize};
 /// The defaults are Mitsuba 3.9 (`llvm_ad_rgb`, one thread, AMD EPYC) on its Cornell box: 91 ns
 /// for a closest-hit ray with its hit record, 41 ns for a shadow ray, 4.6 ns for a trilinear
 /// lookup in a 64³ grid volume;
-/// the cheap approximate extinction is priced as a fetch (`docs/cost_model_source.md`, measured by
+/// the cheap approximate extinction is priced as a fetch (`docs/src/cost_model_source.md`, measured by
 /// `scripts/peer/ray_cost.sh`). Heavier scenes cost more: 268 ns per ray at 10⁶ triangles, 39 ns
 /// per fetch from a 256³ grid.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -109,3 +109,8 @@ pub use registry::{Experiment, Registry};
 #[cfg(doctest)]
 #[doc = include_str!("../../README.md")]
 pub struct ReadmeDoctests;
+
+/// The Rust blocks of the book's plug-in chapter, compiled and run as doc tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../docs/src/extending.md")]
+pub struct BookPluginDoctests;

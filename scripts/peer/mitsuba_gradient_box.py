@@ -19,7 +19,7 @@ The scene, as SPEC 3.2 defines it:
 - orthographic camera looking along +y from y = -1, covering x, z in [-0.5, 0.5], 16 x 16 pixels;
 - background L_b(w) = max(0, c0 + c1 w_z + c2 w_x) per channel (SPEC 3.1 coefficients) over the
   whole sphere, w the direction of travel of the ray leaving the scene.
-Differences from mcbench (stated in docs/performance.md):
+Differences from mcbench (stated in docs/src/performance.md):
 - Mitsuba has no analytic-gradient emitter: the background is a lat-long `envmap` tabulated at
   the texel centres (--env-width x width/2, bilinear lookup); `--check` shows the lookup error.
 - Mitsuba's film integrates each pixel's footprint (box filter, jittered positions); mcbench's

@@ -3,7 +3,7 @@
 
 Not built or run by cargo. Run `scripts/peer/ray_cost.sh` (from the repository root): it installs
 Mitsuba and libLLVM 19 if they are missing, sets DRJIT_LIBLLVM_PATH (Dr.Jit 1.x emits intrinsics
-that libLLVM 14/15 cannot compile) and runs this at nice 5. docs/cost_model_source.md explains the
+that libLLVM 14/15 cannot compile) and runs this at nice 5. docs/src/cost_model_source.md explains the
 figures; this script writes them to scripts/peer/ray_cost.json.
 
 What is timed (llvm_ad_rgb variant, Dr.Jit thread pool set to ONE thread with

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Unit costs of a real renderer for the cost model (docs/cost_model_source.md): Mitsuba 3 ray casts
+# Unit costs of a real renderer for the cost model (docs/src/cost_model_source.md): Mitsuba 3 ray casts
 # and grid-volume lookups in ns of one CPU thread, written to scripts/peer/ray_cost.json.
 # Installs what it needs when missing (libLLVM 19 from Debian, a venv with mitsuba + numpy), then
 # runs ray_cost.py at nice 5. Extra arguments go to ray_cost.py (e.g. --repeats 9, --scalar 0).

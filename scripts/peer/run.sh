@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The peer comparison of docs/performance.md: mcbench's is0_cv0 and Mitsuba 3 volpath (LLVM and
+# The peer comparison of docs/src/performance.md: mcbench's is0_cv0 and Mitsuba 3 volpath (LLVM and
 # scalar) on gradient-box, 2 threads each, one after the other in the same session.
 # Needs: a release build of mcbench, /work/venv-mitsuba with mitsuba + numpy, libLLVM >= 19.
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Measurements for docs/performance.md (not run by cargo or CI).
+# Measurements for docs/src/performance.md (not run by cargo or CI).
 #   scripts/perf/measure.sh rss        peak RSS and wall time of each quick experiment (2 threads)
 #   scripts/perf/measure.sh scaling E  experiment E at 1 and 2 threads: wall times, identical results
 # Needs a release build: cargo build --release (mcbench from $CARGO_TARGET_DIR or target/).

@@ -43,7 +43,7 @@ pub const METHOD: &str = "independent expected-value walk (analytic transmittanc
 pub const ROULETTE_BELOW: f64 = 0.05;
 
 /// Default paths per pixel, every variant: 2^20 (the standard errors then stay below those of the
-/// previous references, made with 2^20 and, for `thick`, 2^18 phase-sampled paths; see README).
+/// previous references, made with 2^20 and, for `thick`, 2^18 phase-sampled paths; see docs/src/testbeds.md).
 pub fn default_samples(_variant: &str) -> u64 {
     1 << 20
 }

@@ -31,7 +31,7 @@ pub const RIGHT_END_BUDGETS: usize = 3;
 /// fit since `summary.csv` has `mse_se`; before, they were ordinary least squares, whose interval
 /// ignored the points' unequal noise and undercovered under heavy tails. Rows without `mse_se`
 /// (files written before it, one repetition, or an error with no spread) are fitted by ordinary
-/// least squares, and `method` says which. Formulas and measured coverage: `docs/slope-fits.md`.
+/// least squares, and `method` says which. Formulas and measured coverage: `docs/src/slope-fits.md`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Fit {
     /// Test bed id.

@@ -257,7 +257,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
     out
 }
 
-/// The table as markdown (report and README).
+/// The table as markdown (report and docs/src/unbiasedness.md).
 pub fn markdown(rows: &[Row]) -> String {
     let body: Vec<Vec<String>> = rows
         .iter()
