@@ -87,9 +87,17 @@ fn num(x: Option<f64>) -> String {
 
 /// `sensitivity.md`: the outcome table, then per part its settings.
 pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
-    let mut s = String::from("# Where each claim holds\n\n| paper | claim | against | outcome |\n|---|---|---|---|\n");
+    let mut s = String::from(
+        "# Where each claim holds\n\n| paper | claim | against | at our default | at the paper-like setting | outcome |\n|---|---|---|---|---|---|\n",
+    );
     for (p, o) in outcomes {
-        let _ = writeln!(s, "| {} | {} | {} | {} |", p.paper, p.headline, p.vary, o.sentence().replace('|', "/"));
+        let at = |v: Option<&ParamValue>| {
+            v.and_then(|v| rows.iter().find(|r| r.part == p.id && r.setting == setting_text(v)))
+                .map_or("-".to_string(), |r| format!("{} = {}: {} ({})", p.vary, r.setting, num(r.value), r.verdict))
+        };
+        let (default, paper_like) = (at(Some(&p.default)), at(p.paper_like.as_ref()));
+        let outcome = format!("{}: {}", o.kind(), o.sentence().replace('|', "/"));
+        let _ = writeln!(s, "| {} | {} | {} | {default} | {paper_like} | {outcome} |", p.paper, p.headline, p.vary);
     }
     for (p, o) in outcomes {
         let _ = write!(
