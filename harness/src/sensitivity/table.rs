@@ -96,7 +96,7 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
                 .map_or("-".to_string(), |r| format!("{} = {}: {} ({})", p.vary, r.setting, num(r.value), r.verdict))
         };
         let (default, paper_like) = (at(Some(&p.default)), at(p.paper_like.as_ref()));
-        let outcome = format!("{}: {}", o.kind(), o.sentence().replace('|', "/"));
+        let outcome = o.sentence().replace('|', "/");
         let _ = writeln!(s, "| {} | {} | {} | {default} | {paper_like} | {outcome} |", p.paper, p.headline, p.vary);
     }
     for (p, o) in outcomes {
