@@ -139,6 +139,12 @@ pub struct RepBlock {
     pub p_err: f64,
     /// CPU seconds of the block's estimates (the clock of [`CellResult::metric_time`]; timing).
     pub cpu_seconds: f64,
+    /// Sum over the block's repetitions of each repetition's mean squared deviation of the
+    /// display-clamped values: every estimate and the reference clamped to `[0, 1]`, as an image
+    /// is shown (paper 002 §4.2 clips negative estimates for display). `None` in cells stored
+    /// before it was kept.
+    #[serde(default)]
+    pub display_sq: Option<f64>,
     /// Wall-clock seconds of the block's estimates (timing).
     pub wall_seconds: f64,
     /// Counted costs of the block's estimates.
@@ -148,6 +154,11 @@ pub struct RepBlock {
 impl RepBlock {
     /// Adds another part of the same block (repetitions in order).
     pub fn merge(&mut self, o: &RepBlock) {
+        self.display_sq = match (self.reps, o.reps) {
+            (0, _) => o.display_sq,
+            (_, 0) => self.display_sq,
+            _ => self.display_sq.zip(o.display_sq).map(|(a, b)| a + b),
+        };
         self.reps += o.reps;
         self.sq += o.sq;
         self.p_err += o.p_err;
@@ -280,7 +291,9 @@ impl CellResult {
                 return Err(format!("its repetition blocks hold {held} repetitions, not {reps}"));
             }
             let bad = |b: &RepBlock| {
-                [b.sq, b.p_err, b.cpu_seconds, b.wall_seconds].iter().any(|v| !(v.is_finite() && *v >= 0.0))
+                [b.sq, b.p_err, b.cpu_seconds, b.wall_seconds, b.display_sq.unwrap_or(0.0)]
+                    .iter()
+                    .any(|v| !(v.is_finite() && *v >= 0.0))
             };
             if self.blocks.iter().any(bad) {
                 return Err("a repetition block holds a negative or non-finite sum".into());
@@ -314,5 +327,18 @@ mod tests {
         let mut u = TimeStats::default();
         u.merge(&t);
         assert_eq!(u, t);
+    }
+
+    #[test]
+    fn display_errors_merge_as_sums_and_a_block_without_them_leaves_none() {
+        let block = |reps, d| RepBlock { reps, sq: 1.0, display_sq: d, ..Default::default() };
+        let mut b = RepBlock::default();
+        b.merge(&block(2, Some(0.5)));
+        b.merge(&block(1, Some(0.25)));
+        assert_eq!((b.reps, b.display_sq), (3, Some(0.75)));
+        b.merge(&block(0, None));
+        assert_eq!(b.display_sq, Some(0.75), "an empty part changes nothing");
+        b.merge(&block(1, None));
+        assert_eq!(b.display_sq, None, "a part stored before display errors were kept");
     }
 }

@@ -49,7 +49,7 @@
 //! estimator = "delta_tracking"
 //! baseline = "residual_ratio_tracking"
 //! budget = 10                          # default: the largest budget of the test bed
-//! metric = "rmse"                      # rmse (default) | mse | fom | efficiency_mse | p_eff | p_err
+//! metric = "rmse"                      # rmse (default) | mse | fom | efficiency_mse | p_eff | p_err | rmse_display | fom_display
 //! side = "above"                       # its 95% interval lies above `threshold` (default 1)
 //! value = 6.8                          # the paper's ratio (optional)
 //! text = "Woodcock tracking has the larger error"
@@ -166,7 +166,8 @@ pub enum ClaimSpec {
         /// The budget both are compared at (default: the largest budget of the test bed).
         #[serde(default)]
         budget: Option<u64>,
-        /// `rmse` (default), `mse`, `fom`, `efficiency_mse`, `p_eff` or `p_err`.
+        /// `rmse` (default), `mse`, `fom`, `efficiency_mse`, `p_eff`, `p_err`, `rmse_display` or
+        /// `fom_display` (values clamped to `[0, 1]` as displayed).
         #[serde(default)]
         metric: RatioMetric,
         /// The level the ratio is claimed to clear (default 1).

@@ -131,6 +131,8 @@ pub fn run_group_with(
                     let d = v[c] - reference[i][c];
                     acc.add(d);
                     sq += d * d;
+                    let shown = v[c].clamp(0.0, 1.0) - reference[i][c].clamp(0.0, 1.0);
+                    acc.display.add(shown * shown);
                 }
                 acc.p_err.add(sq / 3.0 * inv_tvi[i]);
                 acc.integrals += 1;
@@ -164,12 +166,14 @@ pub fn run_group_with(
 
 /// One repetition's aggregates over every integral and channel, compensated: the summed deviation
 /// from the reference, the sum of squared deviations, and over integrals the channel-mean squared
-/// deviation weighted by `1 / tvi` (paper 003's `Err`).
+/// deviation weighted by `1 / tvi` (paper 003's `Err`), and the sum of squared deviations of the
+/// display-clamped values.
 #[derive(Default)]
 struct RepAggregate {
     dev: NeumaierSum,
     sq: NeumaierSum,
     p_err: NeumaierSum,
+    display: NeumaierSum,
     count: u64,
     integrals: u64,
 }
@@ -190,6 +194,7 @@ impl RepAggregate {
             b.reps += 1;
             b.sq += sq;
             b.p_err += self.p_err.value() / self.integrals.max(1) as f64;
+            b.display_sq = Some(b.display_sq.unwrap_or(0.0) + self.display.value() / self.count.max(1) as f64);
         }
     }
 }

@@ -123,6 +123,15 @@ pub struct SummaryRow {
     /// before they were counted).
     #[serde(default)]
     pub cache_ops: f64,
+    /// RMSE of the display-clamped values: every estimate and the reference clamped to `[0, 1]`
+    /// before the difference, as an image is shown (paper 002 §4.2). Clamping is not linear, so
+    /// this is the error a viewer sees, not an unbiased estimator's spread; the stored reference's
+    /// own noise is not subtracted. Empty for cells stored before it was kept.
+    #[serde(default)]
+    pub rmse_display: Option<f64>,
+    /// Figure of merit on display-clamped values, 1 / (`rmse_display`^2 x fetches).
+    #[serde(default)]
+    pub fom_display: Option<f64>,
     /// The cell's repetition blocks, for the bootstrap intervals of ratio claims: carried in memory
     /// only (neither `summary.csv` nor `summary.json` has them), so rows read back from files, and
     /// rows of cells stored before blocks were kept, have none and fall back to the delta method.
@@ -231,6 +240,10 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
     let cpu_seconds = metric_time.mean();
     let fetches = per(cell.costs.fetches);
     let p_err_v = p_err.value() / cell.moments.len().max(1) as f64;
+    let display_mse = (!cell.blocks.is_empty())
+        .then(|| cell.blocks.iter().map(|b| b.display_sq).sum::<Option<f64>>())
+        .flatten()
+        .map(|s| s / cell.blocks.iter().map(|b| b.reps).sum::<u64>().max(1) as f64);
     let rep_blocks = if cpu && !cell.blocks.is_empty() {
         let held = cell.blocks.iter().map(|b| b.reps).sum::<u64>().max(1) as f64;
         let (sq, pe) = cell.blocks.iter().fold((0.0, 0.0), |(s, p), b| (s + b.sq, p + b.p_err));
@@ -281,6 +294,8 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         free_flights: per(cell.costs.free_flights),
         target_evals: per(cell.costs.target_evals),
         cache_ops: per(cell.costs.cache_ops),
+        rmse_display: display_mse.map(f64::sqrt),
+        fom_display: display_mse.filter(|_| fetches > 0.0).and_then(|m| inverse(m * fetches)),
         rep_blocks,
     }
 }

@@ -290,6 +290,8 @@ mod tests {
             free_flights: 0.0,
             target_evals: 0.0,
             cache_ops: 0.0,
+            rmse_display: None,
+            fom_display: None,
             rep_blocks: Default::default(),
         };
         let mut rows = Vec::new();

@@ -48,6 +48,7 @@ struct Sums {
     reps: f64,
     sq: f64,
     p_err: f64,
+    display: f64,
     cpu: f64,
     wall: f64,
     samples: f64,
@@ -64,6 +65,7 @@ impl Sums {
         self.reps += b.reps as f64;
         self.sq += b.sq;
         self.p_err += b.p_err;
+        self.display += b.display_sq.unwrap_or(f64::NAN);
         self.cpu += b.cpu_seconds;
         self.wall += b.wall_seconds;
         self.samples += b.costs.samples as f64;
@@ -90,6 +92,10 @@ impl CellSample<'_> {
     /// Mean squared error (noise-corrected like the row's).
     pub fn mse(&self) -> f64 {
         self.sums.sq / self.sums.reps + self.rows.mse_offset
+    }
+    /// Mean squared error of the display-clamped values (NaN when a block lacks them).
+    pub fn mse_display(&self) -> f64 {
+        self.sums.display / self.sums.reps
     }
     /// Paper 003's `Err`.
     pub fn p_err(&self) -> f64 {

@@ -13,6 +13,7 @@ fn cell(blocks: usize, per: u64, mut draw: impl FnMut(usize) -> f64, seconds: im
                 reps: per,
                 sq,
                 p_err: sq,
+                display_sq: Some(sq),
                 cpu_seconds: seconds(k) * per as f64,
                 wall_seconds: seconds(k) * per as f64,
                 costs: Costs { samples: per * 4, fetches: per * 10, ..Default::default() },

@@ -21,7 +21,7 @@ use crate::output::{Claim, RunReport};
 
 /// Whether a smaller value of `metric` is better (errors) or a larger one (efficiencies).
 pub fn lower_is_better(metric: RatioMetric) -> bool {
-    matches!(metric, RatioMetric::Rmse | RatioMetric::Mse | RatioMetric::PErr)
+    matches!(metric, RatioMetric::Rmse | RatioMetric::Mse | RatioMetric::PErr | RatioMetric::RmseDisplay)
 }
 
 fn regime(metric: RatioMetric) -> String {

@@ -52,6 +52,10 @@ pub enum RatioMetric {
     /// Paper 003's perceptual error `Err` (mean over integrals of MSE / tvi), resampled like
     /// [`RatioMetric::PEff`]'s.
     PErr,
+    /// RMSE of the display-clamped values ([`SummaryRow::rmse_display`]).
+    RmseDisplay,
+    /// Figure of merit on display-clamped values, 1 / (MSE_display x fetches).
+    FomDisplay,
 }
 
 impl RatioMetric {
@@ -64,6 +68,8 @@ impl RatioMetric {
             RatioMetric::EfficiencyMse => "efficiency 1/(MSE x CPU s)",
             RatioMetric::PEff => "P-Eff",
             RatioMetric::PErr => "Err",
+            RatioMetric::RmseDisplay => "display RMSE",
+            RatioMetric::FomDisplay => "display FoM",
         }
     }
 
@@ -76,6 +82,8 @@ impl RatioMetric {
             RatioMetric::EfficiencyMse => r.efficiency_mse,
             RatioMetric::PEff => r.p_eff,
             RatioMetric::PErr => Some(r.p_err),
+            RatioMetric::RmseDisplay => r.rmse_display,
+            RatioMetric::FomDisplay => r.fom_display,
         };
         v.filter(|v| v.is_finite() && *v > 0.0)
     }
@@ -89,6 +97,8 @@ impl RatioMetric {
             RatioMetric::EfficiencyMse => 1.0 / (s.mse() * s.cpu_seconds()),
             RatioMetric::PEff => 1.0 / (s.cpu_seconds() * s.integrals() * s.p_err()),
             RatioMetric::PErr => s.p_err(),
+            RatioMetric::RmseDisplay => s.mse_display().sqrt(),
+            RatioMetric::FomDisplay => 1.0 / (s.mse_display() * s.fetches()),
         };
         (v.is_finite() && v > 0.0).then(|| v.ln())
     }
@@ -101,7 +111,7 @@ impl RatioMetric {
     /// The power of the MSE the metric scales with (an RMSE is its square root).
     fn mse_power(self) -> f64 {
         match self {
-            RatioMetric::Rmse => 0.5,
+            RatioMetric::Rmse | RatioMetric::RmseDisplay => 0.5,
             _ => 1.0,
         }
     }

@@ -43,6 +43,8 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         free_flights: 0.0,
         target_evals: 0.0,
         cache_ops: 0.0,
+        rmse_display: None,
+        fom_display: None,
         rep_blocks: Default::default(),
     }
 }
