@@ -5,17 +5,24 @@
 //! 1.5 degrees a frame about +z for F = 10 frames; an infinite ground plane at z = -1 gives
 //! `V = 1` iff `w_z >= 0`.
 //!
-//! Integral `pixel * F + frame` is `L_r` (variants `specular`, `mixed`) or `L_ns` (variants
-//! `specular-lns`, `mixed-lns`) of that pixel in that frame; references are exact per texel
-//! ([`super::envmap_reference`]).
+//! Integral `pixel * F + frame` is `L_r` (variants `specular`, `mixed`, `moving`) or `L_ns`
+//! (variants `specular-lns`, `mixed-lns`, `moving-lns`) of that pixel in that frame; references
+//! are exact per texel ([`super::envmap_reference`]).
+//!
+//! The `moving` variants keep the `mixed` BRDF under a map closer to paper 004 §7's
+//! ([`crate::envmap::moving_sky::MovingSky`]): five narrow bright lobes off the rotation axis at
+//! elevations 8 to 62 degrees over a dim background brighter on one side, so the rotation moves
+//! the target's mass (under the default sky only the sun moves it).
 //!
 //! Parameters: `resolution` (32), `frames` (10), `rotation` (degrees per frame, 1.5), `sun` (peak
-//! sun radiance, 1e3: dynamic range > 1e4), `dawn_dusk` (0 or 1: a slow intensity change over the
-//! sequence, one map per frame), `env_width` (256), `env_height` (128, even).
+//! radiance of the sun, or of the `moving` map's key lobe, 1e3: dynamic range > 1e4), `dawn_dusk`
+//! (0 or 1: a slow intensity change over the sequence, one map per frame), `env_width` (256),
+//! `env_height` (128, even).
 
 use super::envmap_reference::{PixelReference, TexelTable};
 use crate::brdf::Phong;
-use crate::envmap::sky::Sky;
+use crate::envmap::moving_sky::MovingSky;
+use crate::envmap::sky::{Sky, SkyModel};
 use crate::envmap::{EnvFrame, EnvMap};
 use crate::error::ConfigError;
 use crate::math::{Rgb, Vec3};
@@ -33,12 +40,12 @@ const ENVMAP_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1500, 
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "envmap-sequence",
-    variants: &["specular", "mixed", "specular-lns", "mixed-lns"],
+    variants: &["specular", "mixed", "specular-lns", "mixed-lns", "moving", "moving-lns"],
     // Not `SURFACE`: its integrals are per-frame environment integrals reached through
     // `env_sequence()`, not the hemisphere probe the surface estimators need.
     provides: Needs::ENV_SEQUENCE,
     summary:
-        "Phong sphere under a rotating HDR sky, L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
+        "Phong sphere under a rotating HDR sky (`moving`: narrow bright lobes that move with it), L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
     build: |variant, params, _| Ok(Box::new(EnvmapSequence::new(variant, params)?)),
     compute_reference: None,
     params: ParamSpec::of::<EnvmapSequenceParams>(),
@@ -53,6 +60,8 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "mixed", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "specular-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "mixed-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "moving", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "moving-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
     ],
 };
 
@@ -66,7 +75,8 @@ pub struct EnvmapSequenceParams {
     pub frames: usize,
     /// Rotation of the map about +z per frame, in degrees (-360 to 360).
     pub rotation: f64,
-    /// Peak radiance of the sun lobe (0 to 1e12; the sky's dynamic range follows it).
+    /// Peak radiance of the sun lobe, or of the `moving` map's key lobe (0 to 1e12; the sky's
+    /// dynamic range follows it).
     pub sun: f64,
     /// 1: the sky's intensity changes slowly over the frames (dawn to dusk); 0: constant.
     pub dawn_dusk: f64,
@@ -127,7 +137,7 @@ pub struct EnvmapSequence {
     reference: Reference,
 }
 
-/// The BRDF and quantity of a variant (SPEC §3.7).
+/// The BRDF and quantity of a variant (SPEC §3.7); the `moving` ones have the `mixed` BRDF.
 pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError> {
     let phong = |kd: f64, ks: f64| Phong { kd: Rgb::splat(kd), ks: Rgb::splat(ks), n: 50.0 };
     match variant {
@@ -135,6 +145,8 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
         "mixed" => Ok((phong(0.5, 0.5), EnvQuantity::Reflected)),
         "specular-lns" => Ok((phong(0.0, 1.0), EnvQuantity::Unoccluded)),
         "mixed-lns" => Ok((phong(0.5, 0.5), EnvQuantity::Unoccluded)),
+        "moving" => Ok((phong(0.5, 0.5), EnvQuantity::Reflected)),
+        "moving-lns" => Ok((phong(0.5, 0.5), EnvQuantity::Unoccluded)),
         _ => {
             Err(ConfigError::unknown("variant", &format!("envmap-sequence/{variant}"), ENTRY.variants.iter().copied()))
         }
@@ -148,13 +160,11 @@ impl EnvmapSequence {
         let (size, frames, rotation, sun) = (p.resolution, p.frames, p.rotation.to_radians(), p.sun);
         let (dawn_dusk, ew, eh) = (p.dawn_dusk != 0.0, p.env_width, p.env_height);
         let (brdf, quantity) = variant_setup(variant)?;
-        let sky = Sky::default_with_sun(sun);
-        let maps = if dawn_dusk {
-            (0..frames)
-                .map(|n| EnvMap::tabulate(ew, eh, |w| sky.at_time((n as f64 + 0.5) / frames as f64).radiance(w)))
-                .collect::<Result<Vec<_>, _>>()?
+        let moving = variant.starts_with("moving");
+        let maps = if moving {
+            tabulate(&MovingSky::with_key(sun), frames, dawn_dusk, (ew, eh))?
         } else {
-            vec![EnvMap::tabulate(ew, eh, |w| sky.radiance(w))?]
+            tabulate(&Sky::default_with_sun(sun), frames, dawn_dusk, (ew, eh))?
         };
         let mut points = Vec::with_capacity(size * size);
         for py in 0..size {
@@ -173,7 +183,7 @@ impl EnvmapSequence {
             quantity,
             maps,
             points,
-            setup: format!("{p:?}|{brdf:?}"),
+            setup: format!("{p:?}|{brdf:?}|{}", if moving { "moving" } else { "sky" }),
             reference: empty(),
         };
         bed.reference = bed.compute_reference();
@@ -208,6 +218,22 @@ impl EnvmapSequence {
             refs.iter().map(|r| if self.quantity == EnvQuantity::Reflected { r.lr } else { r.lns }).collect::<Vec<_>>();
         let method = "per-texel exact solid angles; closed-form diffuse moments and Gauss-Legendre of the Phong lobe per texel, horizon-split panels".into();
         Reference { kind: ReferenceKind::Exact { method, bound }, std_err: vec![Rgb::ZERO; value.len()], value }
+    }
+}
+
+/// The maps of a sequence: one, or with `dawn_dusk` one per frame, frame n at time (n + 1/2) / F.
+fn tabulate<S: SkyModel>(
+    sky: &S,
+    frames: usize,
+    dawn_dusk: bool,
+    (ew, eh): (usize, usize),
+) -> Result<Vec<EnvMap>, ConfigError> {
+    if dawn_dusk {
+        (0..frames)
+            .map(|n| EnvMap::tabulate(ew, eh, |w| sky.at_time((n as f64 + 0.5) / frames as f64).radiance(w)))
+            .collect()
+    } else {
+        Ok(vec![EnvMap::tabulate(ew, eh, |w| sky.radiance(w))?])
     }
 }
 
