@@ -12,7 +12,8 @@
 //! The `moving` variants keep the `mixed` BRDF under a map closer to paper 004 §7's
 //! ([`crate::envmap::moving_sky::MovingSky`]): five narrow bright lobes off the rotation axis at
 //! elevations 8 to 62 degrees over a dim background brighter on one side, so the rotation moves
-//! the target's mass (under the default sky only the sun moves it).
+//! the target's mass (under the default sky only the sun moves it). The expected share of pixels
+//! the SMC reweighting must resample is computed exactly in [`super::envmap_ess`].
 //!
 //! Parameters: `resolution` (32), `frames` (10), `rotation` (degrees per frame, 1.5), `sun` (peak
 //! radiance of the sun, or of the `moving` map's key lobe, 1e3: dynamic range > 1e4), `dawn_dusk`
@@ -156,6 +157,13 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
 impl EnvmapSequence {
     /// Builds a variant and computes its exact reference (parallel over pixels).
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+        let mut bed = Self::without_reference(variant, params)?;
+        bed.reference = bed.compute_reference();
+        Ok(bed)
+    }
+
+    /// The scene alone, its reference left empty (for computations on the maps and the BRDF).
+    pub(super) fn without_reference(variant: &str, params: &Params) -> Result<Self, ConfigError> {
         let p = parse::<EnvmapSequenceParams>("envmap-sequence", params)?;
         let (size, frames, rotation, sun) = (p.resolution, p.frames, p.rotation.to_radians(), p.sun);
         let (dawn_dusk, ew, eh) = (p.dawn_dusk != 0.0, p.env_width, p.env_height);
@@ -175,7 +183,7 @@ impl EnvmapSequence {
                 points.push(ShadingPoint { position: p, normal: p, wo: Vec3::new(0.0, -1.0, 0.0), brdf });
             }
         }
-        let mut bed = EnvmapSequence {
+        Ok(EnvmapSequence {
             variant: variant.to_string(),
             size,
             frames,
@@ -185,9 +193,7 @@ impl EnvmapSequence {
             points,
             setup: format!("{p:?}|{brdf:?}|{}", if moving { "moving" } else { "sky" }),
             reference: empty(),
-        };
-        bed.reference = bed.compute_reference();
-        Ok(bed)
+        })
     }
 
     /// The exact references of every pixel and frame (both quantities), computed once per process
