@@ -1,10 +1,10 @@
 //! The expected effective sample size of the SMC reweighting of `envmap-sequence` (paper 004
-//! Eq. 3-5), computed exactly from the map and the BRDF: a ceiling on how much resampling the
-//! scene can ask for.
+//! Eq. 3-4 and §3's ESS), computed exactly from the map and the BRDF: how much resampling the
+//! scene itself asks for, the ceiling its map and BRDF set on the share resampled.
 //!
 //! Algorithm 1 of paper 004 reweights particles drawn from `p_{n-1}` by the incremental weights
-//! `w = p~_n / p~_{n-1}` (Eq. 3) and resamples when the effective sample size (Eq. 5) falls below
-//! `N / 2`. For N particles drawn exactly from `p_{n-1}`, `ESS / N` tends to
+//! `w = p~_n / p~_{n-1}` (Eq. 3) and resamples when the effective sample size
+//! `(sum_j W_j^2)^-1` (§3, Liu and Chen 1998) falls below `N / 2`. For N particles drawn exactly from `p_{n-1}`, `ESS / N` tends to
 //! `E[w]^2 / E[w^2]` (Kong, Liu and Wong 1994). With `p~ = L f cos` (grey BRDF: `f` the same in
 //! every channel, as in every variant) and a piecewise-constant map rotated about +z, both frames
 //! are constant on the panels where one texel of frame n-1 meets one texel of frame n (the grids
