@@ -18,7 +18,8 @@ pub struct Lobe {
 }
 
 impl Lobe {
-    fn eval(&self, w: Vec3) -> Rgb {
+    /// Radiance of the lobe towards `w`.
+    pub fn eval(&self, w: Vec3) -> Rgb {
         self.colour * (self.peak * (self.sharpness * (w.dot(self.dir) - 1.0)).exp())
     }
 }
@@ -42,9 +43,27 @@ pub struct Sky {
     pub sun_scale: f64,
 }
 
-fn dir(elevation_deg: f64, azimuth_deg: f64) -> Vec3 {
+/// The unit direction at `elevation_deg` above the horizon and `azimuth_deg` from +x towards +y.
+pub fn direction(elevation_deg: f64, azimuth_deg: f64) -> Vec3 {
     let (e, a) = (elevation_deg.to_radians(), azimuth_deg.to_radians());
     Vec3::new(e.cos() * a.cos(), e.cos() * a.sin(), e.sin())
+}
+
+/// An analytic HDR map the test bed tabulates, with its dawn-to-dusk course.
+pub trait SkyModel: Sized {
+    /// The map at time `t` in [0, 1] of a dawn-to-dusk day.
+    fn at_time(&self, t: f64) -> Self;
+    /// Radiance arriving from direction `w`.
+    fn radiance(&self, w: Vec3) -> Rgb;
+}
+
+impl SkyModel for Sky {
+    fn at_time(&self, t: f64) -> Self {
+        Sky::at_time(self, t)
+    }
+    fn radiance(&self, w: Vec3) -> Rgb {
+        Sky::radiance(self, w)
+    }
 }
 
 impl Sky {
@@ -54,10 +73,10 @@ impl Sky {
             horizon: Rgb([0.9, 0.8, 0.7]),
             zenith: Rgb([0.2, 0.35, 0.8]),
             ground: Rgb([0.08, 0.07, 0.06]),
-            sun: Lobe { dir: dir(35.0, 40.0), peak: sun_peak, sharpness: 800.0, colour: Rgb([1.0, 0.9, 0.7]) },
+            sun: Lobe { dir: direction(35.0, 40.0), peak: sun_peak, sharpness: 800.0, colour: Rgb([1.0, 0.9, 0.7]) },
             lobes: [
-                Lobe { dir: dir(10.0, 200.0), peak: 8.0, sharpness: 30.0, colour: Rgb([0.6, 0.7, 1.0]) },
-                Lobe { dir: dir(60.0, 290.0), peak: 4.0, sharpness: 60.0, colour: Rgb([1.0, 0.6, 0.5]) },
+                Lobe { dir: direction(10.0, 200.0), peak: 8.0, sharpness: 30.0, colour: Rgb([0.6, 0.7, 1.0]) },
+                Lobe { dir: direction(60.0, 290.0), peak: 4.0, sharpness: 60.0, colour: Rgb([1.0, 0.6, 0.5]) },
             ],
             sky_scale: 1.0,
             sun_scale: 1.0,

@@ -1,7 +1,8 @@
 //! The particle machinery shared by the paper 004 estimators: bidirectional importance sampling
 //! (SIR, the first frame), the SMC reweight / resample / move step of Algorithm 1 (Eq. 3-4, 6-8),
 //! the bridged step of Algorithm 2 (Eq. 11-12) with the standard ratio (Eq. 10) or path sampling
-//! (Eq. 15-16) for `L_ns`, and the adaptive bridge schedule. Weights live in log space.
+//! (Eq. 15-16) for `L_ns`, the adaptive bridge schedule, and the periodic re-estimate of `L_ns`
+//! from scratch (paper 004 §7). Weights live in log space.
 //!
 //! Colour: the target is the channel mean `p~ = mean_c(L_c f_c cos)` (paper 004 §3); per-channel
 //! estimates use `L_c = L_ns * E_p[(p~_c / p~) V]` (Eq. 9 per channel), which is the same estimator
@@ -54,6 +55,10 @@ pub struct Config {
     pub threshold: f64,
     /// The frame-to-frame transition; `None` runs `bidirectional_is` on every frame.
     pub transition: Option<Transition>,
+    /// Every `recompute` frames (frame indices divisible by it), `L_ns` is estimated afresh by
+    /// bidirectional importance sampling with `candidates` M instead of carried forward as a
+    /// product of ratios; the particles stay. 0: never.
+    pub recompute: usize,
 }
 
 /// Weighted particles approximating `p_n`, with `log L_ns,n` (the normaliser estimate).
@@ -105,18 +110,7 @@ fn probe<'a>(task: &'a Task<'a>) -> Result<EnvProbe<'a>, EstimateError> {
 /// the unbiased `L_ns` estimate `mean(p~ / q)` as its normaliser) and the Rao-Blackwellised
 /// per-channel `L_ns` estimate `mean(p~_c / q)`; `None` when every candidate weight is zero.
 fn bidirectional(probe: &EnvProbe<'_>, n: usize, m: usize, rng: &mut StreamRng) -> (Option<Population>, Rgb) {
-    let (mut cand, mut targets, mut log_w) = (Vec::with_capacity(m), Vec::with_capacity(m), Vec::with_capacity(m));
-    let mut lns = Rgb::ZERO;
-    for _ in 0..m {
-        let s = probe.sample_environment(rng);
-        let t = probe.target(s.w);
-        // The sampler reports pdf > 0 for every direction it draws.
-        lns += t / s.pdf;
-        log_w.push(ln(t.mean()) - s.pdf.ln());
-        cand.push(s.w);
-        targets.push(t);
-    }
-    let lns = lns / m as f64;
+    let (cand, targets, log_w, lns) = candidates(probe, m, rng);
     let Some((weights, lse)) = normalise_log_weights(&log_w) else {
         return (None, lns);
     };
@@ -128,6 +122,34 @@ fn bidirectional(probe: &EnvProbe<'_>, n: usize, m: usize, rng: &mut StreamRng) 
         log_z: lse - (m as f64).ln(),
     };
     (Some(pop), lns)
+}
+
+/// M candidates from the environment map with their targets `p~`, log weights `ln(p~ / q)` and
+/// the per-channel estimate `mean(p~_c / q)` of `L_ns`.
+#[allow(clippy::type_complexity)]
+fn candidates(probe: &EnvProbe<'_>, m: usize, rng: &mut StreamRng) -> (Vec<Vec3>, Vec<Rgb>, Vec<f64>, Rgb) {
+    let (mut cand, mut targets, mut log_w) = (Vec::with_capacity(m), Vec::with_capacity(m), Vec::with_capacity(m));
+    let mut lns = Rgb::ZERO;
+    for _ in 0..m {
+        let s = probe.sample_environment(rng);
+        let t = probe.target(s.w);
+        // The sampler reports pdf > 0 for every direction it draws.
+        lns += t / s.pdf;
+        log_w.push(ln(t.mean()) - s.pdf.ln());
+        cand.push(s.w);
+        targets.push(t);
+    }
+    (cand, targets, log_w, lns / m as f64)
+}
+
+/// Paper 004 §7 keeps `L_ns` from drifting by computing it explicitly from time to time: the
+/// unbiased `log mean(p~ / q)` of M fresh environment-map candidates, replacing the carried
+/// product of Eq. 10 (or Eq. 16) increments. The weighted particle mean of Eq. 9 then multiplies
+/// an independent normaliser, so the estimate is consistent (its bias falls as 1/N), no longer
+/// unbiased.
+fn recomputed_log_normaliser(probe: &EnvProbe<'_>, m: usize, rng: &mut StreamRng) -> f64 {
+    let (_, _, log_w, _) = candidates(probe, m, rng);
+    log_sum_exp(&log_w) - (m as f64).ln()
 }
 
 /// Eq. 9 per channel: `L_ns * sum_j W_j (p~_c / p~)(w_j) [V(w_j)]` (one ray per particle with
@@ -160,7 +182,11 @@ pub fn run_sequence(cfg: &Config, tasks: &[Task<'_>], rng: &mut StreamRng) -> Re
             _ => None,
         };
         let estimate_now = match carried {
-            Some(p) => {
+            Some(mut p) => {
+                if cfg.recompute > 0 && probe.frame().is_multiple_of(cfg.recompute) {
+                    p.log_z = recomputed_log_normaliser(&probe, cfg.candidates, rng);
+                    probe.note("recomputed", 1.0);
+                }
                 let e = estimate(&p, &probe);
                 pop = Some(p);
                 e

@@ -61,8 +61,17 @@ impl Common {
             scheme: self.scheme(owner)?,
             threshold: self.threshold,
             transition,
+            recompute: 0,
         })
     }
+}
+
+/// `recompute`: 0 (never) to 1000 frames (the longest sequence `envmap-sequence` makes).
+fn check_recompute(k: usize) -> Result<(), ConfigError> {
+    if k > 1000 {
+        return Err(ConfigError::invalid("recompute", k, "must be a whole number in [0, 1000] (0: never)"));
+    }
+    Ok(())
 }
 
 /// Parameters of `bidirectional_is`.
@@ -168,6 +177,12 @@ impl ParamSet for BidirectionalSnParams {
 pub struct SmcParams {
     /// MH moves per frame, K (1 to 10000).
     pub moves: usize,
+    /// Frames between re-estimates of `L_ns` from scratch by bidirectional importance sampling with
+    /// the `candidates` M, instead of the carried product of ratios (paper 004 §7 recomputes it
+    /// explicitly when the carried estimate drifts); the particles stay. 0 (the default): never;
+    /// 0 to 1000. Above 0 the estimate is consistent, not unbiased (the self-normalised particle
+    /// mean times an independent normaliser), and each re-estimate costs M target evaluations.
+    pub recompute: usize,
     /// Environment-map candidates, M, of the bidirectional step that starts a pixel's sequence (and
     /// restarts it when every particle weight is zero); 1 to 2^20.
     pub candidates: usize,
@@ -186,6 +201,7 @@ impl Default for SmcParams {
         let c = Common::defaults(128);
         SmcParams {
             moves: 5,
+            recompute: 0,
             candidates: c.candidates,
             cone: c.cone,
             p_independent: c.p_independent,
@@ -211,6 +227,7 @@ impl SmcParams {
 impl ParamSet for SmcParams {
     fn validate(&self, owner: &str) -> Result<(), ConfigError> {
         check_count("moves", self.moves, 10_000)?;
+        check_recompute(self.recompute)?;
         self.common().validate(owner)
     }
 }
@@ -221,6 +238,12 @@ impl ParamSet for SmcParams {
 pub struct SmcBridgeParams {
     /// Intermediate distributions per frame, P, one MH move each (1 to 10000).
     pub bridges: usize,
+    /// Frames between re-estimates of `L_ns` from scratch by bidirectional importance sampling with
+    /// the `candidates` M, instead of the carried product of ratios (paper 004 §7 recomputes it
+    /// explicitly when the carried estimate drifts); the particles stay. 0 (the default): never;
+    /// 0 to 1000. Above 0 the estimate is consistent, not unbiased (the self-normalised particle
+    /// mean times an independent normaliser), and each re-estimate costs M target evaluations.
+    pub recompute: usize,
     /// Environment-map candidates, M, of the bidirectional step that starts a pixel's sequence (and
     /// restarts it when every particle weight is zero); 1 to 2^20.
     pub candidates: usize,
@@ -239,6 +262,7 @@ impl Default for SmcBridgeParams {
         let c = Common::defaults(128);
         SmcBridgeParams {
             bridges: 5,
+            recompute: 0,
             candidates: c.candidates,
             cone: c.cone,
             p_independent: c.p_independent,
@@ -264,6 +288,7 @@ impl SmcBridgeParams {
 impl ParamSet for SmcBridgeParams {
     fn validate(&self, owner: &str) -> Result<(), ConfigError> {
         check_count("bridges", self.bridges, 10_000)?;
+        check_recompute(self.recompute)?;
         self.common().validate(owner)
     }
 }

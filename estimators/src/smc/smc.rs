@@ -3,7 +3,10 @@
 //! `L_ns,n = L_ns,n-1 sum_j W_{n-1,j} w~_j` (Eq. 10), resampling when ESS < N/2, K MH moves of the
 //! Eq. 6-8 mixture kernel, and `L_r` by Eq. 9. The product of Eq. 10 increments times the weighted
 //! mean is the unbiased SMC estimate (Del Moral, Doucet and Jasra 2006), so the claim is unbiased.
-//! Parameters: `moves` (K, default 5) and the common ones ([`super::params::SmcParams`]).
+//! Parameters: `moves` (K, default 5), `recompute` (every that many frames `L_ns` is estimated
+//! afresh by bidirectional importance sampling with M candidates, paper 004 §7; default 0, never:
+//! above 0 the estimate is consistent, the claim holds for the default) and the common ones
+//! ([`super::params::SmcParams`]).
 
 use super::engine::Transition;
 use super::params::SmcParams;
@@ -24,7 +27,8 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     build: |p| {
         let p = parse::<SmcParams>("smc", p)?;
         let transition = Transition::Single { moves: p.moves };
-        Ok(Box::new(super::SmcEstimator(p.common().config("smc", Some(transition))?)))
+        let config = p.common().config("smc", Some(transition))?;
+        Ok(Box::new(super::SmcEstimator(super::engine::Config { recompute: p.recompute, ..config })))
     },
     params: ParamSpec::of::<SmcParams>(),
     checks: Checks::DEFAULT,

@@ -1,7 +1,10 @@
 //! `smc_bridge` (paper 004 Algorithm 2): P intermediate distributions
 //! `p~_{n-1}^(1-g) p~_n^g`, g = k/P (Eq. 11), one MH move each, incremental weights the product of
 //! Eq. 12 (annealed importance sampling per particle), `L_ns` by the standard ratio (Eq. 10):
-//! unbiased. Parameters: `bridges` (P, default 5) and the common ones.
+//! unbiased. Parameters: `bridges` (P, default 5), `recompute` (every that many frames `L_ns` is
+//! estimated afresh by bidirectional importance sampling with M candidates, paper 004 §7; default
+//! 0, never: above 0 the estimate is consistent, the claim holds for the default) and the common
+//! ones.
 
 use super::engine::Transition;
 use super::params::SmcBridgeParams;
@@ -22,7 +25,8 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     build: |p| {
         let p = parse::<SmcBridgeParams>("smc_bridge", p)?;
         let transition = Transition::Bridged { bridges: p.bridges, path: false };
-        Ok(Box::new(super::SmcEstimator(p.common().config("smc_bridge", Some(transition))?)))
+        let config = p.common().config("smc_bridge", Some(transition))?;
+        Ok(Box::new(super::SmcEstimator(super::engine::Config { recompute: p.recompute, ..config })))
     },
     params: ParamSpec::of::<SmcBridgeParams>(),
     checks: Checks::DEFAULT,

@@ -2,7 +2,9 @@
 //! `(1/P) sum_k sum_j W^k_j log(p~_n / p~_{n-1})(w^k_j)` (Eq. 15, the right Riemann sum of Eq. 13),
 //! accumulated over frames (Eq. 16) and exponentiated. The exponential of an estimated log (and
 //! the Riemann sum) makes it consistent, not unbiased: the claim is `consistent` and the test
-//! decides. Parameters: `bridges` (P, default 5) and the common ones.
+//! decides. Parameters: `bridges` (P, default 5), `recompute` (every that many frames `L_ns` is
+//! estimated afresh by bidirectional importance sampling with M candidates, paper 004 §7; default
+//! 0, never) and the common ones.
 
 use super::engine::Transition;
 use super::params::SmcBridgeParams;
@@ -23,7 +25,8 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     build: |p| {
         let p = parse::<SmcBridgeParams>("smc_path", p)?;
         let transition = Transition::Bridged { bridges: p.bridges, path: true };
-        Ok(Box::new(super::SmcEstimator(p.common().config("smc_path", Some(transition))?)))
+        let config = p.common().config("smc_path", Some(transition))?;
+        Ok(Box::new(super::SmcEstimator(super::engine::Config { recompute: p.recompute, ..config })))
     },
     params: ParamSpec::of::<SmcBridgeParams>(),
     checks: Checks::DEFAULT,

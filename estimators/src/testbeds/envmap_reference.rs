@@ -160,6 +160,55 @@ impl TexelTable {
         (d, l)
     }
 
+    /// The texels of the grid, `width x height`.
+    pub fn texels(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// The geometric factor `integral of f cos dw` of the grey Phong BRDF `brdf` (channel means
+    /// of `kd` and `ks`) at normal `n` and mirror direction `r`, over the part of texel `t` with
+    /// `phi` in `[pa, pb]` (inside the texel's own `phi` range): the diffuse factor in closed form
+    /// above the shading horizon, the lobe by Gauss-Legendre at the orders [`TexelTable::reflect`]
+    /// uses, texels crossed by the horizon split there. `None` when the texel lies below the
+    /// horizon. Nothing is skipped: the expected effective sample size needs every texel.
+    pub fn panel_factor(&self, t: usize, (pa, pb): (f64, f64), n: Vec3, r: Vec3, brdf: &Phong) -> Option<f64> {
+        let (c, rad) = (self.centre[t], self.radius[t]);
+        let dn = c.dot(n);
+        if dn < -rad.sin() || pb <= pa {
+            return None;
+        }
+        let (ta, tb, _, _) = self.edges(t);
+        let e = brdf.n;
+        let (kd, ks) = (brdf.kd.mean() / PI, brdf.ks.mean() * (e + 2.0) / TAU);
+        let ca = c.dot(r).clamp(-1.0, 1.0);
+        let (cr, sr) = (rad.cos(), rad.sin());
+        let cos_min = if ca >= cr { 1.0 } else { ca * cr + (1.0 - ca * ca).sqrt() * sr };
+        let lobe_bound = if ks > 0.0 && cos_min > 0.0 { cos_min.powf(e) } else { 0.0 };
+        let q = if lobe_bound > 1e-3 {
+            5
+        } else if lobe_bound > 1e-9 {
+            3
+        } else {
+            1
+        };
+        let (d, l) = if dn <= rad.sin() {
+            self.quad((ta, tb, pa, pb), n, r, e, 6, true, kd == 0.0)
+        } else {
+            let s2 = (tb - ta) / 2.0 - ((2.0 * tb).sin() - (2.0 * ta).sin()) / 4.0;
+            let s1 = (tb.sin().powi(2) - ta.sin().powi(2)) / 2.0;
+            let moment = Vec3::new(s2 * (pb.sin() - pa.sin()), s2 * (pa.cos() - pb.cos()), s1 * (pb - pa));
+            let l = if lobe_bound > 0.0 { self.quad((ta, tb, pa, pb), n, r, e, q, false, true).1 } else { 0.0 };
+            (moment.dot(n), l)
+        };
+        Some(kd * d + ks * l)
+    }
+
+    /// The `phi` edges of texel `t`.
+    pub fn phi_edges(&self, t: usize) -> (f64, f64) {
+        let (_, _, pa, pb) = self.edges(t);
+        (pa, pb)
+    }
+
     /// The references `L_ns` and `L_r` of shading point `(n, w_o)` with BRDF `brdf` under the
     /// map's texels scaled by `scale` and rotated by `rotation` about +z (equivalently, the shading
     /// point rotated by `-rotation`).

@@ -5,17 +5,25 @@
 //! 1.5 degrees a frame about +z for F = 10 frames; an infinite ground plane at z = -1 gives
 //! `V = 1` iff `w_z >= 0`.
 //!
-//! Integral `pixel * F + frame` is `L_r` (variants `specular`, `mixed`) or `L_ns` (variants
-//! `specular-lns`, `mixed-lns`) of that pixel in that frame; references are exact per texel
-//! ([`super::envmap_reference`]).
+//! Integral `pixel * F + frame` is `L_r` (variants `specular`, `mixed`, `moving`) or `L_ns`
+//! (variants `specular-lns`, `mixed-lns`, `moving-lns`) of that pixel in that frame; references
+//! are exact per texel ([`super::envmap_reference`]).
+//!
+//! The `moving` variants keep the `mixed` BRDF under a map closer to paper 004 §7's
+//! ([`crate::envmap::moving_sky::MovingSky`]): five narrow bright lobes off the rotation axis at
+//! elevations 8 to 62 degrees over a dim background brighter on one side, so the rotation moves
+//! the target's mass (under the default sky only the sun moves it). The expected share of pixels
+//! the SMC reweighting must resample is computed exactly in [`super::envmap_ess`].
 //!
 //! Parameters: `resolution` (32), `frames` (10), `rotation` (degrees per frame, 1.5), `sun` (peak
-//! sun radiance, 1e3: dynamic range > 1e4), `dawn_dusk` (0 or 1: a slow intensity change over the
-//! sequence, one map per frame), `env_width` (256), `env_height` (128, even).
+//! radiance of the sun, or of the `moving` map's key lobe, 1e3: dynamic range > 1e4), `dawn_dusk`
+//! (0 or 1: a slow intensity change over the sequence, one map per frame), `env_width` (256),
+//! `env_height` (128, even).
 
 use super::envmap_reference::{PixelReference, TexelTable};
 use crate::brdf::Phong;
-use crate::envmap::sky::Sky;
+use crate::envmap::moving_sky::MovingSky;
+use crate::envmap::sky::{Sky, SkyModel};
 use crate::envmap::{EnvFrame, EnvMap};
 use crate::error::ConfigError;
 use crate::math::{Rgb, Vec3};
@@ -33,12 +41,12 @@ const ENVMAP_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1500, 
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "envmap-sequence",
-    variants: &["specular", "mixed", "specular-lns", "mixed-lns"],
+    variants: &["specular", "mixed", "specular-lns", "mixed-lns", "moving", "moving-lns"],
     // Not `SURFACE`: its integrals are per-frame environment integrals reached through
     // `env_sequence()`, not the hemisphere probe the surface estimators need.
     provides: Needs::ENV_SEQUENCE,
     summary:
-        "Phong sphere under a rotating HDR sky, L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
+        "Phong sphere under a rotating HDR sky (`moving`: narrow bright lobes that move with it), L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
     build: |variant, params, _| Ok(Box::new(EnvmapSequence::new(variant, params)?)),
     compute_reference: None,
     params: ParamSpec::of::<EnvmapSequenceParams>(),
@@ -53,6 +61,8 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "mixed", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "specular-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "mixed-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "moving", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "moving-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
     ],
 };
 
@@ -66,7 +76,8 @@ pub struct EnvmapSequenceParams {
     pub frames: usize,
     /// Rotation of the map about +z per frame, in degrees (-360 to 360).
     pub rotation: f64,
-    /// Peak radiance of the sun lobe (0 to 1e12; the sky's dynamic range follows it).
+    /// Peak radiance of the sun lobe, or of the `moving` map's key lobe (0 to 1e12; the sky's
+    /// dynamic range follows it).
     pub sun: f64,
     /// 1: the sky's intensity changes slowly over the frames (dawn to dusk); 0: constant.
     pub dawn_dusk: f64,
@@ -127,7 +138,7 @@ pub struct EnvmapSequence {
     reference: Reference,
 }
 
-/// The BRDF and quantity of a variant (SPEC §3.7).
+/// The BRDF and quantity of a variant (SPEC §3.7); the `moving` ones have the `mixed` BRDF.
 pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError> {
     let phong = |kd: f64, ks: f64| Phong { kd: Rgb::splat(kd), ks: Rgb::splat(ks), n: 50.0 };
     match variant {
@@ -135,6 +146,8 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
         "mixed" => Ok((phong(0.5, 0.5), EnvQuantity::Reflected)),
         "specular-lns" => Ok((phong(0.0, 1.0), EnvQuantity::Unoccluded)),
         "mixed-lns" => Ok((phong(0.5, 0.5), EnvQuantity::Unoccluded)),
+        "moving" => Ok((phong(0.5, 0.5), EnvQuantity::Reflected)),
+        "moving-lns" => Ok((phong(0.5, 0.5), EnvQuantity::Unoccluded)),
         _ => {
             Err(ConfigError::unknown("variant", &format!("envmap-sequence/{variant}"), ENTRY.variants.iter().copied()))
         }
@@ -144,17 +157,22 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
 impl EnvmapSequence {
     /// Builds a variant and computes its exact reference (parallel over pixels).
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+        let mut bed = Self::without_reference(variant, params)?;
+        bed.reference = bed.compute_reference();
+        Ok(bed)
+    }
+
+    /// The scene alone, its reference left empty (for computations on the maps and the BRDF).
+    pub(super) fn without_reference(variant: &str, params: &Params) -> Result<Self, ConfigError> {
         let p = parse::<EnvmapSequenceParams>("envmap-sequence", params)?;
         let (size, frames, rotation, sun) = (p.resolution, p.frames, p.rotation.to_radians(), p.sun);
         let (dawn_dusk, ew, eh) = (p.dawn_dusk != 0.0, p.env_width, p.env_height);
         let (brdf, quantity) = variant_setup(variant)?;
-        let sky = Sky::default_with_sun(sun);
-        let maps = if dawn_dusk {
-            (0..frames)
-                .map(|n| EnvMap::tabulate(ew, eh, |w| sky.at_time((n as f64 + 0.5) / frames as f64).radiance(w)))
-                .collect::<Result<Vec<_>, _>>()?
+        let moving = variant.starts_with("moving");
+        let maps = if moving {
+            tabulate(&MovingSky::with_key(sun), frames, dawn_dusk, (ew, eh))?
         } else {
-            vec![EnvMap::tabulate(ew, eh, |w| sky.radiance(w))?]
+            tabulate(&Sky::default_with_sun(sun), frames, dawn_dusk, (ew, eh))?
         };
         let mut points = Vec::with_capacity(size * size);
         for py in 0..size {
@@ -165,7 +183,7 @@ impl EnvmapSequence {
                 points.push(ShadingPoint { position: p, normal: p, wo: Vec3::new(0.0, -1.0, 0.0), brdf });
             }
         }
-        let mut bed = EnvmapSequence {
+        Ok(EnvmapSequence {
             variant: variant.to_string(),
             size,
             frames,
@@ -173,11 +191,9 @@ impl EnvmapSequence {
             quantity,
             maps,
             points,
-            setup: format!("{p:?}|{brdf:?}"),
+            setup: format!("{p:?}|{brdf:?}|{}", if moving { "moving" } else { "sky" }),
             reference: empty(),
-        };
-        bed.reference = bed.compute_reference();
-        Ok(bed)
+        })
     }
 
     /// The exact references of every pixel and frame (both quantities), computed once per process
@@ -208,6 +224,22 @@ impl EnvmapSequence {
             refs.iter().map(|r| if self.quantity == EnvQuantity::Reflected { r.lr } else { r.lns }).collect::<Vec<_>>();
         let method = "per-texel exact solid angles; closed-form diffuse moments and Gauss-Legendre of the Phong lobe per texel, horizon-split panels".into();
         Reference { kind: ReferenceKind::Exact { method, bound }, std_err: vec![Rgb::ZERO; value.len()], value }
+    }
+}
+
+/// The maps of a sequence: one, or with `dawn_dusk` one per frame, frame n at time (n + 1/2) / F.
+fn tabulate<S: SkyModel>(
+    sky: &S,
+    frames: usize,
+    dawn_dusk: bool,
+    (ew, eh): (usize, usize),
+) -> Result<Vec<EnvMap>, ConfigError> {
+    if dawn_dusk {
+        (0..frames)
+            .map(|n| EnvMap::tabulate(ew, eh, |w| sky.at_time((n as f64 + 0.5) / frames as f64).radiance(w)))
+            .collect()
+    } else {
+        Ok(vec![EnvMap::tabulate(ew, eh, |w| sky.radiance(w))?])
     }
 }
 
@@ -272,129 +304,5 @@ impl EnvSequenceScene for EnvmapSequence {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::quadrature::gauss_legendre;
-    use std::f64::consts::{PI, TAU};
-
-    fn small(variant: &str, extra: Params) -> EnvmapSequence {
-        let mut p = extra.with("resolution", 3.0).with("frames", 2.0);
-        for (k, v) in [("env_width", 64.0), ("env_height", 32.0)] {
-            if !p.0.contains_key(k) {
-                p = p.with(k, v);
-            }
-        }
-        EnvmapSequence::new(variant, &p).unwrap()
-    }
-
-    /// Brute force: every texel split into 4x4 sub-panels of 8x8 Gauss-Legendre in (theta, phi)
-    /// with max(0, cos), which converges slowly only on horizon texels; compared at 1e-7
-    /// relative (the brute force's own accuracy), the reference's claim of 1e-10 is checked by
-    /// the refinement test below.
-    fn brute(bed: &EnvmapSequence, i: usize, sub: usize) -> (Rgb, Rgb) {
-        let (p, f) = (bed.points[i / bed.frames], i % bed.frames);
-        let env = bed.environment(f);
-        let g = env.map.grid();
-        let (x, w) = gauss_legendre(8);
-        let (dt, dp) = (PI / g.height as f64 / sub as f64, TAU / g.width as f64 / sub as f64);
-        let (mut lns, mut lr) = (Rgb::ZERO, Rgb::ZERO);
-        for a in 0..g.height * sub {
-            for b in 0..g.width * sub {
-                for (xi, wi) in x.iter().zip(&w) {
-                    let th = (a as f64 + 0.5 + 0.5 * xi) * dt;
-                    for (xj, wj) in x.iter().zip(&w) {
-                        let ph = (b as f64 + 0.5 + 0.5 * xj) * dp + env.rotation;
-                        let d = crate::samplers::spherical_direction(th.cos(), ph);
-                        let cos = d.dot(p.normal);
-                        if cos <= 0.0 {
-                            continue;
-                        }
-                        let v = env.radiance(d)
-                            * p.brdf.eval(d, p.wo, p.normal)
-                            * (cos * th.sin() * wi * wj * 0.25 * dt * dp);
-                        lns += v;
-                        if d.z >= 0.0 {
-                            lr += v;
-                        }
-                    }
-                }
-            }
-        }
-        (lns, lr)
-    }
-
-    #[test]
-    fn reference_matches_brute_force_quadrature() {
-        for variant in ["mixed", "specular"] {
-            let bed = small(variant, Params::new());
-            let refs = bed.pixel_references();
-            for i in [0, 5, 8, 17] {
-                let (lns, lr) = brute(&bed, i, 4);
-                for c in 0..3 {
-                    for (a, b) in [(lns[c], refs[i].lns[c]), (lr[c], refs[i].lr[c])] {
-                        assert!(
-                            (a - b).abs() <= 1e-7 * b.abs().max(1e-3),
-                            "{variant} integral {i} ch {c}: brute {a} vs reference {b}"
-                        );
-                    }
-                }
-                assert!(
-                    refs[i].bound <= 1.01e-7 * refs[i].lns.0.iter().fold(0.0f64, |m, &v| m.max(v)),
-                    "bound {}",
-                    refs[i].bound
-                );
-            }
-        }
-    }
-
-    /// The dawn-to-dusk option (SPEC §3.7): frame n shows the sky at time (n + 1/2) / F, the sky
-    /// scaled by 0.2 + 0.8 sin(pi t) and the sun by sin(pi t)^2; the exact references follow it.
-    #[test]
-    fn dawn_to_dusk_scales_the_sky_per_frame_and_references_follow() {
-        let p = Params::new()
-            .with("resolution", 3.0)
-            .with("frames", 3.0)
-            .with("env_width", 64.0)
-            .with("env_height", 32.0)
-            .with("dawn_dusk", 1.0);
-        let bed = EnvmapSequence::new("mixed", &p).unwrap();
-        // Straight down sees the ground only (no lobe, the sun is above the horizon), which the
-        // rotation about z leaves alone: frame 1 (noon, scale 1) over frame 0 (t = 1/6, scale 0.6).
-        let down = Vec3::new(0.0, 0.0, -1.0);
-        let (dusk, noon) = (bed.environment(0).radiance(down), bed.environment(1).radiance(down));
-        for c in 0..3 {
-            assert!((noon[c] / dusk[c] - 1.0 / 0.6).abs() < 1e-9, "channel {c}: {} / {}", noon[c], dusk[c]);
-        }
-        let refs = bed.pixel_references();
-        for i in [0, 1, 2, 13] {
-            let (lns, lr) = brute(&bed, i, 4);
-            for c in 0..3 {
-                assert!((lns[c] - refs[i].lns[c]).abs() <= 1e-7 * refs[i].lns[c].abs().max(1e-3), "integral {i}");
-                assert!((lr[c] - refs[i].lr[c]).abs() <= 1e-7 * refs[i].lr[c].abs().max(1e-3), "integral {i}");
-            }
-        }
-        // Noon is brighter than the first frame at every pixel (sky 1.67x, sun 4x).
-        for px in 0..9 {
-            assert!(refs[px * 3 + 1].lns.0[1] > refs[px * 3].lns.0[1], "pixel {px}");
-        }
-    }
-
-    /// The sky spans the dynamic range SPEC §3.7 and §10 ask for; references are positive.
-    #[test]
-    fn sky_has_the_required_dynamic_range_and_references_are_positive() {
-        let bed = small("mixed", Params::new().with("env_width", 256.0).with("env_height", 128.0));
-        assert!(bed.maps[0].dynamic_range() >= 1e4, "{}", bed.maps[0].dynamic_range());
-        let stiff = small("mixed", Params::new().with("sun", 1e5).with("env_width", 256.0).with("env_height", 128.0));
-        assert!(stiff.maps[0].dynamic_range() >= 1e6);
-        assert!(bed.reference.value.iter().all(|v| v.0.iter().all(|&c| c > 0.0 && c.is_finite())));
-        assert_eq!(bed.integrals(), 9 * 2);
-    }
-
-    #[test]
-    fn bad_parameters_are_refused_naming_the_field() {
-        let e = EnvmapSequence::new("shiny", &Params::new()).err().unwrap().to_string();
-        assert!(e.contains("envmap-sequence/shiny"), "{e}");
-        let e = EnvmapSequence::new("mixed", &Params::new().with("env_height", 31.0)).err().unwrap().to_string();
-        assert!(e.contains("env_height"), "{e}");
-    }
-}
+#[path = "envmap_sequence_tests.rs"]
+mod tests;

@@ -6,6 +6,7 @@ pub mod checker;
 pub mod checker_image;
 pub mod checker_image_reference;
 pub mod checker_reference;
+pub mod envmap_ess;
 pub mod envmap_reference;
 pub mod envmap_sequence;
 pub mod gradient_box;
