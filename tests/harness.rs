@@ -291,7 +291,8 @@ fn claims_declared_in_a_config_are_judged() {
     assert!(err.to_string().contains("slop") && err.exit_code() == 2, "{err}");
 }
 
-/// Target evaluations and cache operations are the last columns of summary.csv and a `counts`
+/// Target evaluations and cache operations are columns of summary.csv (before the display-clamped
+/// error, which ends it) and a `counts`
 /// section of summary.json, per estimate: paper 001's cache counts a read and a record per sample
 /// plus its refinements, the independent estimator neither.
 #[test]
@@ -300,7 +301,18 @@ fn summary_files_report_target_evaluations_and_cache_operations() {
     let out = run_into(dir.path(), sweep(&["is0_cv0", "is1_cv2"], 2), 2, false);
     let res = dir.path().join("results/itest");
     let csv = std::fs::read_to_string(res.join("summary.csv")).expect("read");
-    assert!(csv.lines().next().unwrap_or_default().ends_with(",free_flights,target_evals,cache_ops"), "{csv}");
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap_or_default()
+            .ends_with(",free_flights,target_evals,cache_ops,rmse_display,fom_display"),
+        "{csv}"
+    );
+    for row in &out.report.rows {
+        let shown = row.rmse_display.expect("display-clamped error kept");
+        assert!(shown > 0.0 && shown <= row.rmse + 1e-12, "clamping to [0, 1] never adds error here: {row:?}");
+        assert_eq!(row.fom_display, None, "no fetches on a surface, no FoM");
+    }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(res.join("summary.json")).expect("read")).expect("json");
     let counts = json["counts"].as_array().expect("a counts section");
