@@ -27,20 +27,21 @@ const BLOCK_BYTES: usize = 128;
 
 /// The block sums and the quantisation of the PDF coefficients (see the module documentation).
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct CellSampler {
-    blocks: PartialSumTree,
-    /// `log2` of the cells per block (a power of two; the whole grid when it is smaller): a cell's
-    /// block by a shift, not a division.
-    block_shift: u32,
-    cells: usize,
-    scale: f64,
-    /// Largest allowed `q`: keeps the total below 2^62.
-    cap: u64,
-    /// `cap` as a float (exact: a power of two over a power of two).
-    cap_f64: f64,
     /// The root of `blocks`, kept beside the other fields so a draw can start its random number
     /// before the tree's first line arrives.
     total: u64,
+    scale: f64,
+    /// `cap` as a float (exact: a power of two over a power of two).
+    cap_f64: f64,
+    /// Largest allowed `q`: keeps the total below 2^62.
+    cap: u64,
+    blocks: PartialSumTree,
+    cells: usize,
+    /// `log2` of the cells per block (a power of two; the whole grid when it is smaller): a cell's
+    /// block by a shift, not a division.
+    block_shift: u32,
 }
 
 impl CellSampler {

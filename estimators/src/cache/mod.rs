@@ -71,11 +71,16 @@ pub struct CacheSample {
 }
 
 /// An adaptive directional radiance cache (see the module documentation).
+///
+/// Field order is fixed (`repr(C)`, the same 336 bytes in double precision) so that what a vertex
+/// of paper 000 Fig. 2 reads (the sampler's scalars, the grid's resolution, pointers and the sum
+/// behind `G`) comes first and the polar sums, read only near the poles, come last.
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct RadianceCache<S: Scalar> {
+    tree: Option<CellSampler>,
     config: CacheConfig,
     grid: Grid<S>,
-    tree: Option<CellSampler>,
 }
 
 impl<S: Scalar> RadianceCache<S> {
