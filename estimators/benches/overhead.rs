@@ -12,8 +12,12 @@
 //! - `overhead_smc_frame/{bidirectional_is,smc}`: one frame of one pixel of `envmap-sequence`
 //!   `mixed` (paper 004, N = 16, a 10-frame sequence reported per frame).
 //!
-//! Run with `cargo bench -p estimators --bench overhead` (about 20 s).
+//! Times are the CPU time of the bench's thread ([`ThreadCpu`]), not wall time: on a shared machine
+//! the neighbours' load slows the run (and moves the memory-bound vertex more than the others)
+//! but is not counted. Run with `cargo bench -p estimators --bench overhead` (about 20 s of
+//! measurement).
 
+use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use estimators::budget::Budget;
 use estimators::cache::{CacheConfig, ControlVariate, Domain, St};
@@ -29,7 +33,67 @@ use estimators::testbeds::gradient_box::GradientBox;
 use rand::Rng;
 use std::time::Duration;
 
-fn short<M: criterion::measurement::Measurement>(group: &mut BenchmarkGroup<'_, M>) {
+/// Criterion's measurement in CPU nanoseconds of the calling thread
+/// (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`).
+struct ThreadCpu;
+
+fn thread_cpu_ns() -> u64 {
+    let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `ts` is a valid, writable timespec.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    assert_eq!(rc, 0, "clock_gettime");
+    ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64
+}
+
+impl Measurement for ThreadCpu {
+    type Intermediate = u64;
+    type Value = u64;
+    fn start(&self) -> u64 {
+        thread_cpu_ns()
+    }
+    fn end(&self, start: u64) -> u64 {
+        thread_cpu_ns() - start
+    }
+    fn add(&self, a: &u64, b: &u64) -> u64 {
+        a + b
+    }
+    fn zero(&self) -> u64 {
+        0
+    }
+    fn to_f64(&self, v: &u64) -> f64 {
+        *v as f64
+    }
+    fn formatter(&self) -> &dyn ValueFormatter {
+        &CpuNanos
+    }
+}
+
+/// Formats CPU nanoseconds (and throughputs as elements per CPU second).
+struct CpuNanos;
+
+impl ValueFormatter for CpuNanos {
+    fn scale_values(&self, typical: f64, values: &mut [f64]) -> &'static str {
+        let (factor, unit) = match typical {
+            t if t < 1e3 => (1.0, "ns cpu"),
+            t if t < 1e6 => (1e-3, "us cpu"),
+            _ => (1e-6, "ms cpu"),
+        };
+        values.iter_mut().for_each(|v| *v *= factor);
+        unit
+    }
+    fn scale_throughputs(&self, _typical: f64, throughput: &Throughput, values: &mut [f64]) -> &'static str {
+        let n = match *throughput {
+            Throughput::Elements(n) | Throughput::Bytes(n) | Throughput::BytesDecimal(n) => n as f64,
+        };
+        values.iter_mut().for_each(|v| *v = n * 1e3 / *v);
+        "elem/cpu us"
+    }
+    fn scale_for_machines(&self, _values: &mut [f64]) -> &'static str {
+        "ns"
+    }
+}
+
+fn short<M: Measurement>(group: &mut BenchmarkGroup<'_, M>) {
     group.warm_up_time(Duration::from_millis(500));
     group.measurement_time(Duration::from_secs(2));
 }
@@ -54,18 +118,22 @@ fn collisions(probes: &[MediumProbe<'_>], n: usize) -> Vec<(Vec3, Vec3)> {
     out
 }
 
-/// The octree `is1_cv2` grows over a 16x16 image at `spp` paths per pixel (pixels interleaved).
-fn grown(probes: &[MediumProbe<'_>], spp: usize) -> Octree<f64> {
+/// The octree `is1_cv2` grows over a 16x16 image at 1024 paths per pixel (pixels interleaved,
+/// default criterion 32): 512 leaves at depth 3. Its `max_depth` is 3, which changes nothing in
+/// that growth (no leaf reached the criterion at depth 3) but keeps the bench's own records from
+/// growing it further while it is timed.
+fn grown_1024spp(probes: &[MediumProbe<'_>]) -> Octree<f64> {
     let config =
-        CacheConfig { domain: Domain::Sphere, criterion: 32.0, max_depth: 5, counter_divisor: 32, importance: true };
+        CacheConfig { domain: Domain::Sphere, criterion: 32.0, max_depth: 3, counter_divisor: 32, importance: true };
     let mut tree = Octree::<f64>::new(Vec3::default(), 0.5, config);
     let (mut rng, mut vertices) = (stream(7, "bench grown octree"), Vec::new());
-    for _ in 0..spp {
+    for _ in 0..1024 {
         for probe in probes {
             let (s, cv, t) = (Sampling::Cache, ControlVariate::Bilinear, Transport::FreeFlight);
             walk::smc_path(&mut tree, probe, s, cv, t, &mut rng, &mut vertices);
         }
     }
+    assert_eq!((tree.stats().leaves, tree.stats().depth), (512, 3), "the 1024-spp structure");
     tree
 }
 
@@ -86,7 +154,7 @@ fn depth4() -> Octree<f64> {
     tree
 }
 
-fn media_vertex(c: &mut Criterion) {
+fn media_vertex(c: &mut Criterion<ThreadCpu>) {
     let bed = GradientBox::without_reference("albedo-0.8", &Params::new()).expect("builds");
     let tasks: Vec<Task<'_>> =
         (0..256).map(|i| Task::new(&bed, i, Budget::samples(u64::MAX).expect("budget"))).collect();
@@ -96,7 +164,7 @@ fn media_vertex(c: &mut Criterion) {
     let (albedo, phase) = (probe.albedo(), probe.phase());
     let mut group = c.benchmark_group("overhead_media_vertex");
     short(&mut group);
-    for (name, mut tree) in [("grown_1024spp", grown(&probes, 1024)), ("depth4", depth4())] {
+    for (name, mut tree) in [("grown_1024spp", grown_1024spp(&probes)), ("depth4", depth4())] {
         assert_eq!(octree::SPLIT_DIVISOR, 32);
         let (mut rng, mut k) = (stream(8, "bench vertex"), 0);
         group.bench_function(format!("{name}/is0_cv0"), |b| {
@@ -125,7 +193,7 @@ fn media_vertex(c: &mut Criterion) {
     group.finish();
 }
 
-fn surface_sample(c: &mut Criterion) {
+fn surface_sample(c: &mut Criterion<ThreadCpu>) {
     const SPP: u64 = 1024;
     let entry = registry::testbed("gradient-plane").expect("registered");
     let bed = (entry.build)("default", &Params::new(), &estimators::references::NoReferences).expect("bed");
@@ -146,7 +214,7 @@ fn surface_sample(c: &mut Criterion) {
     group.finish();
 }
 
-fn smc_frame(c: &mut Criterion) {
+fn smc_frame(c: &mut Criterion<ThreadCpu>) {
     const FRAMES: usize = 10;
     let entry = registry::testbed("envmap-sequence").expect("registered");
     let params = Params::new().with("resolution", 4.0).with("frames", FRAMES as f64);
@@ -171,5 +239,9 @@ fn smc_frame(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, media_vertex, surface_sample, smc_frame);
+criterion_group! {
+    name = benches;
+    config = Criterion::default().with_measurement(ThreadCpu);
+    targets = media_vertex, surface_sample, smc_frame
+}
 criterion_main!(benches);
