@@ -27,19 +27,21 @@ const BLOCK_BYTES: usize = 128;
 
 /// The block sums and the quantisation of the PDF coefficients (see the module documentation).
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct CellSampler {
-    blocks: PartialSumTree,
-    /// Cells per block (a power of two; the whole grid when it is smaller).
-    block: usize,
-    cells: usize,
-    scale: f64,
-    /// Largest allowed `q`: keeps the total below 2^62.
-    cap: u64,
-    /// `cap` as a float (exact: a power of two over a power of two).
-    cap_f64: f64,
     /// The root of `blocks`, kept beside the other fields so a draw can start its random number
     /// before the tree's first line arrives.
     total: u64,
+    scale: f64,
+    /// `cap` as a float (exact: a power of two over a power of two).
+    cap_f64: f64,
+    /// Largest allowed `q`: keeps the total below 2^62.
+    cap: u64,
+    blocks: PartialSumTree,
+    cells: usize,
+    /// `log2` of the cells per block (a power of two; the whole grid when it is smaller): a cell's
+    /// block by a shift, not a division.
+    block_shift: u32,
 }
 
 impl CellSampler {
@@ -52,7 +54,7 @@ impl CellSampler {
     pub fn new<S: Scalar>(coefficients: &[S]) -> Self {
         let mut s = CellSampler {
             blocks: PartialSumTree::new(1),
-            block: 1,
+            block_shift: 0,
             cells: 0,
             scale: 1.0,
             cap: 1,
@@ -91,9 +93,10 @@ impl CellSampler {
     pub fn rebuild<S: Scalar>(&mut self, coefficients: &[S]) {
         let n = coefficients.len();
         self.cells = n;
-        self.block = (BLOCK_BYTES / std::mem::size_of::<S>()).min(n.next_power_of_two());
+        let block = (BLOCK_BYTES / std::mem::size_of::<S>()).min(n.next_power_of_two());
+        self.block_shift = block.trailing_zeros();
         // A power-of-two block count, so the descent visits blocks in order.
-        let blocks = n.div_ceil(self.block).next_power_of_two();
+        let blocks = n.div_ceil(block).next_power_of_two();
         if self.blocks.leaves() != blocks {
             self.blocks = PartialSumTree::new(blocks);
         }
@@ -102,7 +105,7 @@ impl CellSampler {
         let max = coefficients.iter().map(|c| c.get()).fold(0.0f64, f64::max);
         self.scale = if max > 0.0 { self.target() as f64 / max } else { 1.0 };
         let mut sums = vec![0u64; blocks];
-        for (b, chunk) in coefficients.chunks(self.block).enumerate() {
+        for (b, chunk) in coefficients.chunks(block).enumerate() {
             sums[b] = chunk.iter().map(|c| self.weight(c.get())).sum();
         }
         self.blocks.rebuild(&sums);
@@ -116,10 +119,7 @@ impl CellSampler {
 
     /// The probability of drawing a cell whose coefficient is `coefficient`.
     pub fn probability(&self, coefficient: f64) -> f64 {
-        match self.total() {
-            0 => 0.0,
-            total => self.weight(coefficient) as f64 / total as f64,
-        }
+        self.probability_of_weight(self.weight(coefficient))
     }
 
     /// Updates one cell's coefficient from `old` to `new`; `false` when a rebuild is due instead
@@ -130,7 +130,7 @@ impl CellSampler {
         let Some(q) = self.quantise(new).filter(|_| self.total() >= self.target() >> Self::DRIFT_BITS) else {
             return false;
         };
-        let b = cell / self.block;
+        let b = cell >> self.block_shift;
         let old = self.weight(old);
         self.blocks.set(b, self.blocks.weight(b) - old + q);
         self.total = self.total - old + q;
@@ -141,24 +141,41 @@ impl CellSampler {
     /// built and updated with); `None` when every weight is zero. Consumes one `gen_range`.
     #[inline]
     pub fn sample<S: Scalar, R: Rng + ?Sized>(&self, coefficients: &[S], rng: &mut R) -> Option<usize> {
+        self.sample_weighted(coefficients, rng).map(|(cell, _)| cell)
+    }
+
+    /// [`CellSampler::sample`] with the drawn cell's weight `q`, which the scan has just computed
+    /// (so its probability, [`CellSampler::probability_of_weight`], needs no second quantisation).
+    #[inline]
+    pub fn sample_weighted<S: Scalar, R: Rng + ?Sized>(&self, coefficients: &[S], rng: &mut R) -> Option<(usize, u64)> {
         let total = self.total();
         if total == 0 {
             return None;
         }
         let (b, x) = self.blocks.find(rng.gen_range(0..total));
-        let start = b * self.block;
-        let cells = &coefficients[start..(start + self.block).min(self.cells)];
+        let start = b << self.block_shift;
+        let cells = &coefficients[start..(start + (1 << self.block_shift)).min(self.cells)];
         let sum = self.blocks.weight(b);
-        Some(start + if x < sum / 2 { self.scan_up(cells, x) } else { self.scan_down(cells, sum - x) })
+        let (i, q) = if x < sum / 2 { self.scan_up(cells, x) } else { self.scan_down(cells, sum - x) };
+        Some((start + i, q))
     }
 
-    /// The first cell `i` whose cumulative range `[prefix_i, prefix_i + q_i)` holds `x`.
+    /// The probability of drawing a cell of weight `q` (its [`CellSampler::probability`]).
     #[inline]
-    fn scan_up<S: Scalar>(&self, cells: &[S], mut x: u64) -> usize {
+    pub fn probability_of_weight(&self, q: u64) -> f64 {
+        match self.total() {
+            0 => 0.0,
+            total => q as f64 / total as f64,
+        }
+    }
+
+    /// The first cell `i` whose cumulative range `[prefix_i, prefix_i + q_i)` holds `x`, and its `q`.
+    #[inline]
+    fn scan_up<S: Scalar>(&self, cells: &[S], mut x: u64) -> (usize, u64) {
         for (i, c) in cells.iter().enumerate() {
             let q = self.weight(c.get());
             if x < q {
-                return i;
+                return (i, q);
             }
             x -= q;
         }
@@ -169,11 +186,11 @@ impl CellSampler {
     /// `suffix_{i+1} < r <= suffix_i` (equivalent to `prefix_i <= x < prefix_{i+1}`; a cell of
     /// weight zero has `suffix_i = suffix_{i+1}` and is never returned, as going up).
     #[inline]
-    fn scan_down<S: Scalar>(&self, cells: &[S], mut r: u64) -> usize {
+    fn scan_down<S: Scalar>(&self, cells: &[S], mut r: u64) -> (usize, u64) {
         for (i, c) in cells.iter().enumerate().rev() {
             let q = self.weight(c.get());
             if r <= q {
-                return i;
+                return (i, q);
             }
             r -= q;
         }
@@ -210,9 +227,11 @@ mod tests {
             assert_eq!(full.total(), sampler.total());
             let (mut a, mut b) = (stream(1, "cells"), stream(1, "cells"));
             for _ in 0..20_000 {
-                let cell = sampler.sample(&coefficients, &mut a).unwrap();
+                let (cell, q) = sampler.sample_weighted(&coefficients, &mut a).unwrap();
                 assert_eq!(Some(cell), full.sample(&mut b));
+                assert_eq!(q, full.weight(cell));
                 assert_eq!(sampler.probability(coefficients[cell].get()), full.probability(cell));
+                assert_eq!(sampler.probability_of_weight(q), full.probability(cell));
             }
         }
         for n in [1, 2, 8, 16, 32, 128, 2048] {

@@ -41,18 +41,20 @@ struct Cell<S: Scalar> {
     count: u32,
 }
 
-/// The cells of one directional cache.
+/// The cells of one directional cache (fields in a fixed order, the polar sums last: see
+/// [`super::RadianceCache`]).
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct Grid<S: Scalar> {
-    domain: Domain,
     ns: usize,
     nt: usize,
-    refinements: u32,
-    /// `log2(ns)` when `ns` is a power of two (always, for the domains' grids): rows by shifts.
-    ns_shift: Option<u32>,
     cells: Vec<Cell<S>>,
     pdf: Vec<S>,
     records: u64,
+    /// `log2(ns)` when `ns` is a power of two (always, for the domains' grids): rows by shifts.
+    ns_shift: Option<u32>,
+    refinements: u32,
+    domain: Domain,
     sums: [[NeumaierSum; 3]; 3],
 }
 

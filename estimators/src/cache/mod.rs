@@ -71,11 +71,16 @@ pub struct CacheSample {
 }
 
 /// An adaptive directional radiance cache (see the module documentation).
+///
+/// Field order is fixed (`repr(C)`, the same 336 bytes in double precision) so that what a vertex
+/// of paper 000 Fig. 2 reads (the sampler's scalars, the grid's resolution, pointers and the sum
+/// behind `G`) comes first and the polar sums, read only near the poles, come last.
 #[derive(Clone, Debug)]
+#[repr(C)]
 pub struct RadianceCache<S: Scalar> {
+    tree: Option<CellSampler>,
     config: CacheConfig,
     grid: Grid<S>,
-    tree: Option<CellSampler>,
 }
 
 impl<S: Scalar> RadianceCache<S> {
@@ -120,15 +125,17 @@ impl<S: Scalar> RadianceCache<S> {
 
     /// A direction drawn from the cache PDF (`is1`): a cell through the partial-sum tree, then
     /// uniformly inside the cell; uniform over the domain before the first refinement.
+    #[inline]
     pub fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> CacheSample {
         let Some(tree) = self.tree_active() else {
             return self.sample_uniform(rng);
         };
-        let cell = tree.sample(self.grid.pdf_slice(), rng).expect("an active tree has a positive total");
+        let (cell, q) = tree.sample_weighted(self.grid.pdf_slice(), rng).expect("an active tree has a positive total");
         let (i, j) = self.grid.cell_ij(cell);
         let (ns, nt) = self.grid.resolution();
         let st = St { s: (i as f64 + rng.gen::<f64>()) / ns as f64, t: (j as f64 + rng.gen::<f64>()) / nt as f64 };
-        CacheSample { st, cell, pdf: self.cell_density(tree, cell) }
+        // The drawn cell's weight from the scan: the density of `cell_density`, one quantisation fewer.
+        CacheSample { st, cell, pdf: tree.probability_of_weight(q) / self.domain().cell_solid_angle(ns, nt) }
     }
 
     fn cell_density(&self, tree: &CellSampler, cell: usize) -> f64 {
@@ -152,6 +159,7 @@ impl<S: Scalar> RadianceCache<S> {
     /// Adds the record of integrand sample `f` drawn in `cell`, with `g` the control variate the
     /// estimate used there: the RGB mean gets `f`, the PDF coefficient gets the mean over channels
     /// of `|f - g|` (paper 001 §4.2). Then refines if the criterion is met; returns whether it did.
+    #[inline]
     pub fn add_record(&mut self, cell: usize, f: Rgb, g: Rgb) -> bool {
         let d = f - g;
         let pdf_sample = (d[0].abs() + d[1].abs() + d[2].abs()) / 3.0;
@@ -186,6 +194,8 @@ impl<S: Scalar> RadianceCache<S> {
 
     /// Refines unconditionally (paper 001 Fig. 3 `cache.Refine()`): doubles both resolutions,
     /// divides the counters, rebuilds the sums and the tree, `O(N)`.
+    #[cold]
+    #[inline(never)]
     pub fn refine(&mut self) {
         self.grid.refine(self.config.counter_divisor);
         self.rebuild_tree();

@@ -50,6 +50,8 @@ pub struct Octree<S: Scalar> {
     half: f64,
     caches: Vec<RadianceCache<S>>,
     leaves: usize,
+    /// Leaf splits so far, counted (not derived from `leaves`: a path reads it twice).
+    splits: usize,
     cells: usize,
     depth: u32,
 }
@@ -67,6 +69,7 @@ impl<S: Scalar> Octree<S> {
             half,
             caches: vec![cache],
             leaves: 1,
+            splits: 0,
             cells,
             depth: 0,
         }
@@ -95,7 +98,7 @@ impl<S: Scalar> Octree<S> {
 
     /// Leaf splits so far (each turns one leaf into eight), `O(1)`.
     pub fn splits(&self) -> usize {
-        (self.leaves - 1) / 7
+        self.splits
     }
 
     /// The cache of leaf `leaf`.
@@ -163,6 +166,7 @@ impl<S: Scalar> Octree<S> {
         }
         self.nodes[i].children = u32::try_from(first).expect("fewer than 2^32 nodes");
         self.leaves += 7;
+        self.splits += 1;
         self.cells += 7 * self.caches[slot as usize].grid().cells();
         self.depth = self.depth.max(u32::from(depth));
     }
@@ -214,7 +218,8 @@ impl<S: Scalar> Octree<S> {
                 return Err(format!("node {i} points to children before it"));
             }
         }
-        if leaves != self.leaves || cells != self.cells || leaves != self.caches.len() {
+        if leaves != self.leaves || cells != self.cells || leaves != self.caches.len() || 7 * self.splits + 1 != leaves
+        {
             return Err(format!("counts {leaves}/{cells} vs maintained {}/{}", self.leaves, self.cells));
         }
         Ok(())
