@@ -110,7 +110,7 @@ impl Estimator for Pooled {
 }
 
 /// Per-pixel moments (channel 0) of `reps` image estimates.
-fn moments(bed: &dyn TestBed, est: &dyn Estimator, name: &str, spp: u64, reps: u64) -> Vec<Moments> {
+pub(super) fn moments(bed: &dyn TestBed, est: &dyn Estimator, name: &str, spp: u64, reps: u64) -> Vec<Moments> {
     let mut m = vec![Moments::default(); bed.integrals()];
     for rep in 0..reps {
         let key = StreamKey { seed: 13, testbed: bed.id(), estimator: name, budget: spp, rep, integral: 0 };
@@ -143,7 +143,7 @@ fn min_holm_exact(bed: &dyn TestBed, m: &[Moments]) -> f64 {
     holm_bonferroni(&ps).into_iter().fold(1.0, f64::min)
 }
 
-fn build(id: &str, params: Params) -> Box<dyn Estimator> {
+pub(super) fn build(id: &str, params: Params) -> Box<dyn Estimator> {
     (registry::estimator(id).unwrap().build)(&params).unwrap()
 }
 
@@ -151,10 +151,16 @@ fn build(id: &str, params: Params) -> Box<dyn Estimator> {
 fn pmc_ip_is_unbiased_on_exact_pixel_integrals_and_the_controls_are_flagged() {
     let bed = Synthetic::new(true);
     let reps = 4000;
+    let text = |name: &str, v: &str| {
+        let mut p = Params::new();
+        p.0.insert(name.into(), crate::params::ParamValue::Text(v.into()));
+        p
+    };
     for (id, params, spp) in [
         ("uniform_image", Params::new(), 10),
         ("pmc_ip", Params::new(), 10),
         ("pmc_ip", Params::new().with("initial", 4.0), 16),
+        ("pmc_ip", text("allocate", "std_dev").with("luminance_scale", 100.0), 10),
     ] {
         let m = moments(&bed, build(id, params.clone()).as_ref(), id, spp, reps);
         let p = min_holm_exact(&bed, &m);
