@@ -28,6 +28,9 @@
 //!   no sample lands, but noisier (its count varies).
 //!
 //! Options beyond the paper's defaults (each default is the behaviour above):
+//! - `combine` ([`Combine`], [`super::sub_images`]): how the sub-images are combined: `fixed`
+//!   (the shares above), `unweighted` (the paper's literal average, §4.4) or `inverse_variance`
+//!   (per-pixel weights from each sub-image's variance, committed before it is drawn);
 //! - `allocate` ([`Allocate`]): what the kernel weights follow, `variance` (§4.2:
 //!   `sigma_p^2 / tvi(L_p)`) or `std_dev` (`sigma_p / sqrt(tvi(L_p))`: the allocation that
 //!   minimises `Err = mean sigma_p^2 / (n_p tvi(L_p))` for a fixed total, by Lagrange
@@ -41,6 +44,8 @@
 //! kernel weights, 1 = uniform, mean over iterations) and `ht_share` (share of pixel-iterations
 //! estimated by Horvitz-Thompson).
 
+pub use super::sub_images::Combine;
+use super::sub_images::{neighbours, SubImageWeights};
 use crate::budget::BudgetKind;
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
@@ -83,6 +88,9 @@ pub struct PmcIpParams {
     pub eps: f64,
     /// Samples reserved for every pixel in every iteration (0 to 1024).
     pub min_samples: usize,
+    /// How the sub-images are combined (paper 003 §4.4): `fixed` (each its share of the planned
+    /// budget), `unweighted` (the paper's average) or `inverse_variance`.
+    pub combine: Combine,
     /// What the kernel weights follow (§4.2): `variance` (`sigma^2 / tvi(L)`) or `std_dev`
     /// (`sigma / sqrt(tvi(L))`).
     pub allocate: Allocate,
@@ -97,6 +105,7 @@ impl Default for PmcIpParams {
             iterations: 2,
             eps: 0.01,
             min_samples: 1,
+            combine: Combine::Fixed,
             allocate: Allocate::Variance,
             luminance_scale: 1.0,
         }
@@ -139,6 +148,8 @@ pub struct PmcIp {
     pub eps: f64,
     /// Samples reserved for every pixel in every iteration.
     pub min_samples: usize,
+    /// How the sub-images are combined.
+    pub combine: Combine,
     /// What the kernel weights follow.
     pub allocate: Allocate,
     /// cd/m^2 per unit of radiance in the tvi weighting.
@@ -179,13 +190,15 @@ impl PmcIp {
             iterations: p.iterations,
             eps: p.eps,
             min_samples: p.min_samples,
+            combine: p.combine,
             allocate: p.allocate,
             luminance_scale: p.luminance_scale,
         }
     }
 
     /// Parses `initial` (default 2), `iterations` (2), `eps` (0.01), `min_samples` (1),
-    /// `allocate` (`variance`) and `luminance_scale` (1) as [`PmcIpParams`] and builds.
+    /// `combine` (`fixed`), `allocate` (`variance`) and `luminance_scale` (1) as [`PmcIpParams`]
+    /// and builds.
     pub fn from_params(p: &Params) -> Result<Self, ConfigError> {
         Ok(PmcIp::new(&parse::<PmcIpParams>("pmc_ip", p)?))
     }
@@ -238,22 +251,32 @@ impl PmcIp {
         let s0 = self.initial.min(spp) as usize;
         let rest = total - s0 * pixels;
         let iterations = if rest > 0 { self.iterations.min(rest) } else { 0 };
+        let populations = (0..iterations).map(|t| rest / iterations + usize::from(t < rest % iterations)).collect();
+        let mut weights = SubImageWeights::new(self, pixels, s0, populations, total);
         let mut stats = vec![Moments::default(); pixels];
         let mut trace = Trace { estimate: vec![Rgb::ZERO; pixels], ..Trace::default() };
-        // The initial image: s0 uniform samples per pixel, weight s0 P / N.
-        let share = (s0 * pixels) as f64 / total as f64;
+        // The initial image: s0 uniform samples per pixel.
         for (p, probe) in probes.iter().enumerate() {
             let sum = sample_pixel(probe, s0, &mut stats[p], rng);
-            let sub = if s0 > 0 { sum / s0 as f64 } else { Rgb::ZERO };
-            trace.initial_image.push(sub);
-            trace.estimate[p] += sub * share;
+            trace.initial_image.push(if s0 > 0 { sum / s0 as f64 } else { Rgb::ZERO });
+        }
+        let layout = match (self.combine, probes.first()) {
+            (Combine::InverseVariance, Some(first)) => {
+                let (w, h) = first.resolution();
+                neighbours(&probes.iter().map(|p| p.pixel()).collect::<Vec<_>>(), w, h)
+            }
+            _ => Vec::new(),
+        };
+        let share = weights.initial(self, &stats, &layout);
+        for (p, sub) in trace.initial_image.iter().enumerate() {
+            trace.estimate[p] += *sub * share[p];
         }
         trace.counts.push(vec![s0; pixels]);
         for t in 0..iterations {
             let n = rest / iterations + usize::from(t < rest % iterations);
             let alpha = self.weights(&stats);
             let a = self.allocate(&alpha, n, rng);
-            let share = n as f64 / total as f64;
+            let share = weights.population(t, &alpha, &a);
             let mut kernel = Vec::with_capacity(pixels);
             for (p, probe) in probes.iter().enumerate() {
                 let sum = sample_pixel(probe, a.counts[p], &mut stats[p], rng);
@@ -263,7 +286,7 @@ impl PmcIp {
                     trace.horvitz_thompson += 1;
                     sum / a.expected[p]
                 };
-                trace.estimate[p] += sub * share;
+                trace.estimate[p] += sub * share[p];
                 kernel.push(a.expected[p] / n as f64);
             }
             trace.alpha.push(kernel);

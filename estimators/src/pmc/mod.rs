@@ -5,6 +5,7 @@ pub mod hi;
 pub mod ip;
 pub mod kernel;
 pub mod mis;
+pub mod sub_images;
 pub mod threshold_image;
 pub mod uniform_image;
 
