@@ -47,6 +47,7 @@ const EVERY_STORED: &str = "name = 'stored'\nreps = 2\nbudgets = [1]\n\
 [[testbeds]]\nid = 'gradient-box'\nvariant = 'thick'\n\
 [[testbeds]]\nid = 'checker-image'\nvariant = 'default'\n\
 [[testbeds]]\nid = 'checker-image'\nvariant = 'occluded'\n\
+[[testbeds]]\nid = 'checker-image'\nvariant = 'soft-shadow'\n\
 [[testbeds]]\nid = 'eq21-medium'\nvariant = 'multiple'\n\
 [[testbeds]]\nid = 'perlin-medium'\nvariant = 'multiple'\n\
 [[estimators]]\nid = 'is0_cv0'\n[[estimators]]\nid = 'uniform_image'\n[[estimators]]\nid = 'delta_tracking'\n";
@@ -63,7 +64,9 @@ fn a_copied_binary_finds_every_stored_reference_through_references() {
     let o = run(&bin, &work, &["run", "--config", "stored.toml", "--no-plots", "--references", REFERENCES]);
     assert!(o.status.success(), "{}", stderr(&o));
     let csv = std::fs::read_to_string(work.join("results/stored/summary.csv")).expect("summary");
-    for bed in ["albedo-0.8", "albedo-1", "albedo-0.5", "hg-0.1", "thick", "default", "occluded", "multiple"] {
+    for bed in
+        ["albedo-0.8", "albedo-1", "albedo-0.5", "hg-0.1", "thick", "default", "occluded", "soft-shadow", "multiple"]
+    {
         assert!(csv.contains(&format!(",{bed},")), "{bed} missing from {csv}");
     }
     // The same through --results: the references folder below a results root.

@@ -242,6 +242,14 @@ impl ImageProbe<'_> {
     pub fn note(&self, name: &'static str, value: f64) {
         self.task.note(name, value);
     }
+    /// The pixel's index in the image (row-major, the task's integral).
+    pub fn pixel(&self) -> usize {
+        self.task.integral
+    }
+    /// The image's size in pixels, `(width, height)` (geometry, free).
+    pub fn resolution(&self) -> (usize, usize) {
+        self.task.bed.resolution()
+    }
     /// Counts `n` target evaluations on this pixel ([`Task::count_target_evals`]).
     pub fn count_target_evals(&self, n: u64) {
         self.task.count_target_evals(n);

@@ -27,10 +27,25 @@
 //!   estimate `sum f / E[n_p]` with `E[n_p] = N alpha_p` exact under DMS: unbiased, and zero when
 //!   no sample lands, but noisier (its count varies).
 //!
+//! Options beyond the paper's defaults (each default is the behaviour above):
+//! - `combine` ([`Combine`], [`super::sub_images`]): how the sub-images are combined: `fixed`
+//!   (the shares above), `unweighted` (the paper's literal average, §4.4) or `inverse_variance`
+//!   (per-pixel weights from each sub-image's variance, committed before it is drawn);
+//! - `allocate` ([`Allocate`]): what the kernel weights follow, `variance` (§4.2:
+//!   `sigma_p^2 / tvi(L_p)`) or `std_dev` (`sigma_p / sqrt(tvi(L_p))`: the allocation that
+//!   minimises `Err = mean sigma_p^2 / (n_p tvi(L_p))` for a fixed total, by Lagrange
+//!   multipliers, when `sigma_p` is known; see [`super::ceiling`]);
+//! - `luminance_scale`: cd/m^2 per unit of radiance as the kernel's `tvi` sees it (§4.2 reads
+//!   luminance in cd/m^2, Ferwerda et al. 1996, and the paper does not give its scene units):
+//!   `L_p` and `sigma_p` are multiplied by it before weighting. The default 1 reads radiance as
+//!   cd/m^2, as the harness's `Err` does (SPEC §5).
+//!
 //! Each estimate notes `alpha_perplexity` (normalised perplexity `exp(H(alpha)) / P` of the
 //! kernel weights, 1 = uniform, mean over iterations) and `ht_share` (share of pixel-iterations
 //! estimated by Horvitz-Thompson).
 
+pub use super::sub_images::Combine;
+use super::sub_images::{neighbours, SubImageWeights};
 use crate::budget::BudgetKind;
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
@@ -73,12 +88,42 @@ pub struct PmcIpParams {
     pub eps: f64,
     /// Samples reserved for every pixel in every iteration (0 to 1024).
     pub min_samples: usize,
+    /// How the sub-images are combined (paper 003 §4.4): `fixed` (each its share of the planned
+    /// budget), `unweighted` (the paper's average) or `inverse_variance`.
+    pub combine: Combine,
+    /// What the kernel weights follow (§4.2): `variance` (`sigma^2 / tvi(L)`) or `std_dev`
+    /// (`sigma / sqrt(tvi(L))`).
+    pub allocate: Allocate,
+    /// cd/m^2 per unit of radiance in the kernel's tvi weighting (1e-6 to 1e6).
+    pub luminance_scale: f64,
 }
 
 impl Default for PmcIpParams {
     fn default() -> Self {
-        PmcIpParams { initial: 2, iterations: 2, eps: 0.01, min_samples: 1 }
+        PmcIpParams {
+            initial: 2,
+            iterations: 2,
+            eps: 0.01,
+            min_samples: 1,
+            combine: Combine::Fixed,
+            allocate: Allocate::Variance,
+            luminance_scale: 1.0,
+        }
     }
+}
+
+/// What PMC-IP's kernel weights follow (parameter `allocate` of `pmc_ip`, paper 003 §4.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+#[schemars(inline)]
+pub enum Allocate {
+    /// `alpha_p ∝ eps + sigma_p^2 / tvi(L_p)`: "proportional to the perceptually-weighted
+    /// variance at each pixel" (§4.2).
+    #[default]
+    Variance,
+    /// `alpha_p ∝ eps + sigma_p / sqrt(tvi(L_p))`: samples in proportion to the perceptually
+    /// weighted standard deviation, the allocation that minimises `Err` (§4.4) at a fixed total.
+    StdDev,
 }
 
 impl ParamSet for PmcIpParams {
@@ -87,6 +132,7 @@ impl ParamSet for PmcIpParams {
         check_count("iterations", self.iterations, 4096)?;
         check_range("eps", self.eps, 1e-12, 1e12)?;
         check_range("min_samples", self.min_samples as f64, 0.0, 1024.0)?;
+        check_range("luminance_scale", self.luminance_scale, 1e-6, 1e6)?;
         Ok(())
     }
 }
@@ -102,6 +148,12 @@ pub struct PmcIp {
     pub eps: f64,
     /// Samples reserved for every pixel in every iteration.
     pub min_samples: usize,
+    /// How the sub-images are combined.
+    pub combine: Combine,
+    /// What the kernel weights follow.
+    pub allocate: Allocate,
+    /// cd/m^2 per unit of radiance in the tvi weighting.
+    pub luminance_scale: f64,
 }
 
 /// The allocation of one population (§4.3).
@@ -133,30 +185,50 @@ pub struct Trace {
 impl PmcIp {
     /// Builds from its parameters.
     pub fn new(p: &PmcIpParams) -> Self {
-        PmcIp { initial: p.initial as u64, iterations: p.iterations, eps: p.eps, min_samples: p.min_samples }
+        PmcIp {
+            initial: p.initial as u64,
+            iterations: p.iterations,
+            eps: p.eps,
+            min_samples: p.min_samples,
+            combine: p.combine,
+            allocate: p.allocate,
+            luminance_scale: p.luminance_scale,
+        }
     }
 
-    /// Parses `initial` (default 2), `iterations` (2), `eps` (0.01), `min_samples` (1) as
-    /// [`PmcIpParams`] and builds.
+    /// Parses `initial` (default 2), `iterations` (2), `eps` (0.01), `min_samples` (1),
+    /// `combine` (`fixed`), `allocate` (`variance`) and `luminance_scale` (1) as [`PmcIpParams`]
+    /// and builds.
     pub fn from_params(p: &Params) -> Result<Self, ConfigError> {
         Ok(PmcIp::new(&parse::<PmcIpParams>("pmc_ip", p)?))
     }
 
-    /// The kernel weights of §4.2 from each pixel's luminance statistics:
-    /// `alpha_p ∝ eps + sigma_p^2 / tvi(L_p)` (a pixel with fewer than two samples counts as
-    /// variance 0). Every weight is positive and finite.
+    /// The kernel weights of §4.2 from each pixel's luminance statistics,
+    /// `alpha_p ∝` [`PmcIp::raw_weight`]. Every weight is positive and finite.
     pub fn weights(&self, stats: &[Moments]) -> Vec<f64> {
-        let raw: Vec<f64> = stats
-            .iter()
-            .map(|m| {
-                let var = if m.count() >= 2 { m.variance() } else { 0.0 };
-                let mean = if m.count() >= 1 { m.mean() } else { 0.0 };
-                let v = var / tvi(mean);
-                self.eps + if v.is_finite() && v > 0.0 { v } else { 0.0 }
-            })
-            .collect();
+        let raw: Vec<f64> = stats.iter().map(|m| self.raw_weight(m)).collect();
         let total: f64 = raw.iter().sum();
         raw.iter().map(|a| a / total).collect()
+    }
+
+    /// One pixel's kernel weight before normalisation (§4.2), from the luminance statistics of
+    /// its samples: `eps + s^2 sigma^2 / tvi(s L)` (`allocate = variance`) or
+    /// `eps + s sigma / sqrt(tvi(s L))` (`std_dev`), with `s` the luminance scale, `L` the mean
+    /// and `sigma^2` the sample variance (0 with fewer than two samples).
+    pub fn raw_weight(&self, m: &Moments) -> f64 {
+        let var = if m.count() >= 2 { m.variance() } else { 0.0 };
+        let mean = if m.count() >= 1 { m.mean() } else { 0.0 };
+        self.raw_weight_of(var, mean)
+    }
+
+    /// [`PmcIp::raw_weight`] of a pixel whose luminance has variance `var` and mean `mean`.
+    pub fn raw_weight_of(&self, var: f64, mean: f64) -> f64 {
+        let s = self.luminance_scale;
+        let v = match self.allocate {
+            Allocate::Variance => s * s * var / tvi(s * mean),
+            Allocate::StdDev => s * var.max(0.0).sqrt() / tvi(s * mean).sqrt(),
+        };
+        self.eps + if v.is_finite() && v > 0.0 { v } else { 0.0 }
     }
 
     /// Allocates a population of `n` samples over the pixels with weights `alpha`: `min_samples`
@@ -179,22 +251,32 @@ impl PmcIp {
         let s0 = self.initial.min(spp) as usize;
         let rest = total - s0 * pixels;
         let iterations = if rest > 0 { self.iterations.min(rest) } else { 0 };
+        let populations = (0..iterations).map(|t| rest / iterations + usize::from(t < rest % iterations)).collect();
+        let mut weights = SubImageWeights::new(self, pixels, s0, populations, total);
         let mut stats = vec![Moments::default(); pixels];
         let mut trace = Trace { estimate: vec![Rgb::ZERO; pixels], ..Trace::default() };
-        // The initial image: s0 uniform samples per pixel, weight s0 P / N.
-        let share = (s0 * pixels) as f64 / total as f64;
+        // The initial image: s0 uniform samples per pixel.
         for (p, probe) in probes.iter().enumerate() {
             let sum = sample_pixel(probe, s0, &mut stats[p], rng);
-            let sub = if s0 > 0 { sum / s0 as f64 } else { Rgb::ZERO };
-            trace.initial_image.push(sub);
-            trace.estimate[p] += sub * share;
+            trace.initial_image.push(if s0 > 0 { sum / s0 as f64 } else { Rgb::ZERO });
+        }
+        let layout = match (self.combine, probes.first()) {
+            (Combine::InverseVariance, Some(first)) => {
+                let (w, h) = first.resolution();
+                neighbours(&probes.iter().map(|p| p.pixel()).collect::<Vec<_>>(), w, h)
+            }
+            _ => Vec::new(),
+        };
+        let share = weights.initial(self, &stats, &layout);
+        for (p, sub) in trace.initial_image.iter().enumerate() {
+            trace.estimate[p] += *sub * share[p];
         }
         trace.counts.push(vec![s0; pixels]);
         for t in 0..iterations {
             let n = rest / iterations + usize::from(t < rest % iterations);
             let alpha = self.weights(&stats);
             let a = self.allocate(&alpha, n, rng);
-            let share = n as f64 / total as f64;
+            let share = weights.population(t, &alpha, &a);
             let mut kernel = Vec::with_capacity(pixels);
             for (p, probe) in probes.iter().enumerate() {
                 let sum = sample_pixel(probe, a.counts[p], &mut stats[p], rng);
@@ -204,7 +286,7 @@ impl PmcIp {
                     trace.horvitz_thompson += 1;
                     sum / a.expected[p]
                 };
-                trace.estimate[p] += sub * share;
+                trace.estimate[p] += sub * share[p];
                 kernel.push(a.expected[p] / n as f64);
             }
             trace.alpha.push(kernel);
@@ -274,6 +356,9 @@ impl Estimator for PmcIp {
     }
 }
 
+#[cfg(test)]
+#[path = "ip_options_tests.rs"]
+mod options_tests;
 #[cfg(test)]
 #[path = "ip_tests.rs"]
 mod tests;

@@ -110,7 +110,7 @@ impl Estimator for Pooled {
 }
 
 /// Per-pixel moments (channel 0) of `reps` image estimates.
-fn moments(bed: &dyn TestBed, est: &dyn Estimator, name: &str, spp: u64, reps: u64) -> Vec<Moments> {
+pub(super) fn moments(bed: &dyn TestBed, est: &dyn Estimator, name: &str, spp: u64, reps: u64) -> Vec<Moments> {
     let mut m = vec![Moments::default(); bed.integrals()];
     for rep in 0..reps {
         let key = StreamKey { seed: 13, testbed: bed.id(), estimator: name, budget: spp, rep, integral: 0 };
@@ -143,7 +143,7 @@ fn min_holm_exact(bed: &dyn TestBed, m: &[Moments]) -> f64 {
     holm_bonferroni(&ps).into_iter().fold(1.0, f64::min)
 }
 
-fn build(id: &str, params: Params) -> Box<dyn Estimator> {
+pub(super) fn build(id: &str, params: Params) -> Box<dyn Estimator> {
     (registry::estimator(id).unwrap().build)(&params).unwrap()
 }
 
@@ -151,10 +151,19 @@ fn build(id: &str, params: Params) -> Box<dyn Estimator> {
 fn pmc_ip_is_unbiased_on_exact_pixel_integrals_and_the_controls_are_flagged() {
     let bed = Synthetic::new(true);
     let reps = 4000;
+    let text = |name: &str, v: &str| {
+        let mut p = Params::new();
+        p.0.insert(name.into(), crate::params::ParamValue::Text(v.into()));
+        p
+    };
     for (id, params, spp) in [
         ("uniform_image", Params::new(), 10),
         ("pmc_ip", Params::new(), 10),
         ("pmc_ip", Params::new().with("initial", 4.0), 16),
+        ("pmc_ip", text("combine", "unweighted"), 10),
+        ("pmc_ip", text("combine", "inverse_variance"), 10),
+        ("pmc_ip", text("combine", "inverse_variance").with("iterations", 3.0), 10),
+        ("pmc_ip", text("allocate", "std_dev").with("luminance_scale", 100.0), 10),
     ] {
         let m = moments(&bed, build(id, params.clone()).as_ref(), id, spp, reps);
         let p = min_holm_exact(&bed, &m);
@@ -187,6 +196,13 @@ fn without_a_reserved_sample_pmc_ip_is_unbiased_but_heavy_tailed() {
     let p = min_holm_exact(&mild, &moments(&mild, build(id, params.clone()).as_ref(), id, 10, 4000));
     eprintln!("pmc_ip[min_samples=0], mild image: smallest Holm-adjusted p {p:.3e}");
     assert!(p > 1e-3, "flagged on the mild image: {p:e}");
+    // The same with inverse-variance weights, whose Horvitz-Thompson sub-images are weighted by
+    // expected counts (committed before the draw, never the realised ones).
+    let mut inverse = params.clone();
+    inverse.0.insert("combine".into(), crate::params::ParamValue::Text("inverse_variance".into()));
+    let p = min_holm_exact(&mild, &moments(&mild, build(id, inverse).as_ref(), id, 10, 4000));
+    eprintln!("pmc_ip[combine=inverse_variance,min_samples=0], mild image: smallest Holm-adjusted p {p:.3e}");
+    assert!(p > 1e-3, "inverse_variance flagged on the mild image: {p:e}");
     let extreme = Synthetic::new(true);
     let m = moments(&extreme, build(id, params).as_ref(), id, 10, 4000);
     let p = min_holm_exact(&extreme, &m);

@@ -145,7 +145,7 @@ fn a_light_1e6_times_brighter_than_the_other() {
 #[test]
 fn fully_shadowed_points_and_zero_integrands_give_exact_zeros() {
     let mut geo = CheckerGeometry::new("default").unwrap();
-    geo.occluder = Some(Occluder { min: [-50.0, -50.0], max: [50.0, 50.0], z: 0.6 });
+    geo.occluders = vec![Occluder { min: [-50.0, -50.0], max: [50.0, 50.0], z: 0.6 }];
     let bed = Points::new(geo.clone(), points(&geo));
     assert!(bed.reference.value.iter().all(|v| v[0] == 0.0));
     for id in IDS {

@@ -15,6 +15,10 @@
 //! - variant `occluded`: an opaque 1 x 1 square centred at (0.5, 0.2) at height 0.6 casting
 //!   partial shadows; it is a shadow caster only (primary rays see the floor), so both variants
 //!   shade the same points;
+//! - variant `soft-shadow` (paper 003 Fig. 8 and Table 2, the Plant: "complex soft shadows" on a
+//!   table, where "the cone function" helps "in partially shadowed regions"): diffuse direct
+//!   lighting with a wide penumbra over most of the image; see [`SOFT_SHADOW_LIGHT`] and
+//!   [`SOFT_SHADOW_LEAVES`] for the constants and why;
 //! - pinhole at (0, -3.2, 4.6) looking at (0, 0.1, 0), vertical field of view 44 degrees, square
 //!   image (default 48 x 48), pixel centres; the top rows see past the board.
 
@@ -33,7 +37,7 @@ use serde::{Deserialize, Serialize};
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "checker-direct",
-    variants: &["default", "occluded"],
+    variants: &["default", "occluded", "soft-shadow"],
     provides: Needs::SURFACE.and(Needs::AREA_LIGHTS),
     summary:
         "checkerboard of diffuse/glossy squares under two area lights, direct lighting (paper 003 Fig. 6, Table 2)",
@@ -45,6 +49,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "default", params: &[("resolution", 2.0)], role: CaseRole::Check },
         BedCase { variant: "default", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
         BedCase { variant: "occluded", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
+        BedCase { variant: "soft-shadow", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
     ],
 };
 
@@ -68,7 +73,8 @@ impl ParamSet for CheckerDirectParams {
     }
 }
 
-/// The axis-aligned opaque square of the `occluded` variant: `[x0, x1] x [y0, y1]` at height `z`.
+/// An axis-aligned opaque rectangle parallel to the floor (the square of `occluded`, a leaf of
+/// `soft-shadow`): `[x0, x1] x [y0, y1]` at height `z`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Occluder {
     /// Lower corner.
@@ -91,23 +97,69 @@ impl Occluder {
     }
 }
 
+/// The one light of `soft-shadow`: 1.2 x 1.2 centred at (0, 0.4) at height 2.4, radiance 30,
+/// facing down.
+///
+/// - One light, as over the Plant's table, so that a partly shadowed point sees a single visible
+///   patch of it: the cone component of PMC-HI (paper 003 Eq. 7, axis the weighted mean of the
+///   previous population's directions, §5.2) then points at that patch, not between two lights.
+/// - Centred over the middle of the visible board and high enough that every board point sees
+///   it at a moderate angle; its side against the leaves' heights sets the penumbra: a leaf at
+///   height `h` casts a penumbra of width `1.2 h / (2.4 - h)` on the floor, 0.86 at `h = 1`,
+///   wider than the leaves themselves, so most shadows have no umbra at all.
+/// - Radiance 30 puts the brightest unshadowed floor near 1 (the range of the other variants' diffuse
+///   squares, where `tvi` is in its mid branch).
+pub const SOFT_SHADOW_LIGHT: (f64, f64, f64, f64, f64, f64) = (0.0, 0.4, 2.4, 1.2, 1.2, 30.0);
+
+/// The leaves of `soft-shadow`: opaque squares `(centre x, centre y, side, height)`.
+///
+/// Five leaves of sides 0.6-0.7 at heights 0.8-1.3, spread over the board like the foliage of
+/// the Plant (paper 003 Fig. 8) above its table: their penumbrae (see [`SOFT_SHADOW_LIGHT`])
+/// overlap, so about four in five of the pixels that see the board see the light partly hidden
+/// (a test checks more than three in five), with visible fractions spread from near 0 to near 1.
+/// Like the square of `occluded` they are shadow casters only (primary rays see the floor).
+pub const SOFT_SHADOW_LEAVES: [(f64, f64, f64, f64); 5] =
+    [(-0.9, -0.6, 0.6, 1.0), (0.6, -0.8, 0.6, 0.8), (0.0, 0.3, 0.7, 1.3), (-0.8, 1.0, 0.6, 1.1), (0.9, 0.9, 0.6, 0.9)];
+
 /// The static geometry of the checker scene (shared with `checker-image`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CheckerGeometry {
-    /// The two lights (large dim first).
+    /// The lights (`default` and `occluded`: the large dim one first, then the small bright one).
     pub lights: Vec<RectLight>,
-    /// The occluder of the `occluded` variant.
-    pub occluder: Option<Occluder>,
+    /// The shadow casters: none (`default`), the square of `occluded`, the leaves of
+    /// `soft-shadow`.
+    pub occluders: Vec<Occluder>,
+    /// Whether the board alternates diffuse and glossy squares (`soft-shadow`: every square
+    /// diffuse).
+    pub glossy: bool,
     /// The camera.
     pub camera: Pinhole,
 }
 
 impl CheckerGeometry {
-    /// The geometry of a variant (`default` or `occluded`).
+    /// The geometry of a variant (`default`, `occluded` or `soft-shadow`).
     pub fn new(variant: &str) -> Result<Self, ConfigError> {
-        let occluder = match variant {
-            "default" => None,
-            "occluded" => Some(Occluder { min: [0.0, -0.3], max: [1.0, 0.7], z: 0.6 }),
+        let two_lights = || {
+            vec![
+                RectLight::centred(-1.0, 1.8, 2.0, 2.0, 1.0, Rgb::splat(3.0)),
+                RectLight::centred(1.0, 0.9, 1.2, 0.15, 0.15, Rgb::splat(400.0)),
+            ]
+        };
+        let (lights, occluders, glossy) = match variant {
+            "default" => (two_lights(), Vec::new(), true),
+            "occluded" => (two_lights(), vec![Occluder { min: [0.0, -0.3], max: [1.0, 0.7], z: 0.6 }], true),
+            "soft-shadow" => {
+                let (cx, cy, z, wx, wy, radiance) = SOFT_SHADOW_LIGHT;
+                let leaves = SOFT_SHADOW_LEAVES
+                    .iter()
+                    .map(|&(x, y, side, z)| Occluder {
+                        min: [x - 0.5 * side, y - 0.5 * side],
+                        max: [x + 0.5 * side, y + 0.5 * side],
+                        z,
+                    })
+                    .collect();
+                (vec![RectLight::centred(cx, cy, z, wx, wy, Rgb::splat(radiance))], leaves, false)
+            }
             _ => {
                 return Err(ConfigError::unknown(
                     "variant",
@@ -116,15 +168,21 @@ impl CheckerGeometry {
                 ))
             }
         };
-        let lights = vec![
-            RectLight::centred(-1.0, 1.8, 2.0, 2.0, 1.0, Rgb::splat(3.0)),
-            RectLight::centred(1.0, 0.9, 1.2, 0.15, 0.15, Rgb::splat(400.0)),
-        ];
         let camera = Pinhole::look_at(Vec3::new(0.0, -3.2, 4.6), Vec3::new(0.0, 0.1, 0.0), Vec3::Z, 44.0);
-        Ok(CheckerGeometry { lights, occluder, camera })
+        Ok(CheckerGeometry { lights, occluders, glossy, camera })
     }
 
-    /// The material at a floor point (black off the board).
+    /// The material at a floor point of this geometry: the checker of [`CheckerGeometry::material`],
+    /// or its diffuse squares everywhere when the board is not glossy (black off the board).
+    pub fn material_at(&self, x: f64, y: f64) -> Phong {
+        let m = Self::material(x, y);
+        if self.glossy || (m.ks[0] == 0.0 && m.kd[0] == 0.0) {
+            return m;
+        }
+        Phong { kd: Rgb::splat(0.7), ks: Rgb::ZERO, n: 1.0 }
+    }
+
+    /// The material of the checker at a floor point (black off the board).
     pub fn material(x: f64, y: f64) -> Phong {
         if !(-2.0..=2.0).contains(&x) || !(-2.0..=2.0).contains(&y) {
             return Phong { kd: Rgb::ZERO, ks: Rgb::ZERO, n: 1.0 };
@@ -147,13 +205,13 @@ impl CheckerGeometry {
         }
         let t = -self.camera.eye.z / d.z;
         let p = self.camera.eye + d * t;
-        Some(ShadingPoint { position: p, normal: Vec3::Z, wo: -d, brdf: Self::material(p.x, p.y) })
+        Some(ShadingPoint { position: p, normal: Vec3::Z, wo: -d, brdf: self.material_at(p.x, p.y) })
     }
 
-    /// Radiance arriving at floor point `p` from `w`: the nearest light hit unless the occluder
-    /// is crossed first (it lies below both lights).
+    /// Radiance arriving at floor point `p` from `w`: the nearest light hit unless an occluder
+    /// is crossed first (they lie below the lights).
     pub fn incident(&self, p: Vec3, w: Vec3) -> Rgb {
-        if self.occluder.is_some_and(|o| o.blocks(p, w)) {
+        if self.occluders.iter().any(|o| o.blocks(p, w)) {
             return Rgb::ZERO;
         }
         let mut best: Option<(f64, Rgb)> = None;

@@ -1,5 +1,6 @@
-//! `checker-image` (paper 003 §4.4, Table 1; SPEC §3.6): the `checker-direct` scene with pixel
-//! integrals over each pixel's footprint (box filter, paper 003 Eq. 2),
+//! `checker-image` (paper 003 §4.4, Table 1; SPEC §3.6): the `checker-direct` scene (each of its
+//! variants: `default`, `occluded`, `soft-shadow`) with pixel integrals over each pixel's
+//! footprint (box filter, paper 003 Eq. 2),
 //! `I_p = int_{pixel p} L(x(u, v)) du dv`, where `L(x)` is the direct lighting at the floor point
 //! seen through image position `(u, v)` (zero where the ray misses the board).
 //!
@@ -40,7 +41,7 @@ const IMAGE_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (256, 10
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "checker-image",
-    variants: &["default", "occluded"],
+    variants: &["default", "occluded", "soft-shadow"],
     provides: Needs::IMAGE_PLANE,
     summary: "checker scene, pixel-footprint integrals; a pixel sample = jittered position + MIS with 8 light samples (paper 003 Table 1)",
     build: |variant, params, refs| Ok(Box::new(CheckerImage::new(variant, params, refs)?)),
@@ -50,6 +51,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "default", params: &[], role: CaseRole::Check },
         BedCase { variant: "default", params: &[], role: IMAGE_PART },
         BedCase { variant: "occluded", params: &[], role: IMAGE_PART },
+        BedCase { variant: "soft-shadow", params: &[], role: IMAGE_PART },
     ],
 };
 

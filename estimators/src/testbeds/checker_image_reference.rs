@@ -11,6 +11,16 @@ use crate::references::{ReferenceKey, StoredReference};
 use crate::rng::StreamKey;
 use crate::stats::Moments;
 use crate::testbed::{ImagePlaneScene, Reference, ReferenceKind, TestBed};
+
+/// The variance of one pixel sample of every pixel (mean over the channels), from a reference
+/// made here: its standard error is that of the mean of all its samples, `sigma / sqrt(samples)`,
+/// and its command records `--samples`. `None` for any other kind of reference. (The input of the
+/// image-plane ceiling, [`crate::pmc::ceiling`].)
+pub fn sample_variances(reference: &Reference) -> Option<Vec<f64>> {
+    let ReferenceKind::Stored { command, .. } = &reference.kind else { return None };
+    let samples: f64 = command.split("--samples ").nth(1)?.split_whitespace().next()?.parse().ok()?;
+    Some(reference.std_err.iter().map(|se| se.0.iter().map(|s| s * s * samples).sum::<f64>() / 3.0).collect())
+}
 use rand::Rng;
 
 /// Independent batches per pixel (the standard error's degrees of freedom + 1).

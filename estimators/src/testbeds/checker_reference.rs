@@ -2,10 +2,11 @@
 //! `sum_k int_{A_k visible} L_k f(w(y), w_o) cos(theta_x) cos(theta_y) / |y - x|^2 dA(y)` (paper
 //! 003 Eq. 4-5 written over each light's area), by product Gauss-Legendre quadrature.
 //!
-//! - Visibility is handled exactly rather than by refinement: the occluder is an axis-aligned
-//!   square parallel to the lights, so the part of a light it hides from a floor point `x` is the
-//!   axis-aligned rectangle `x + (O - x) z_light / z_occluder`; the visible part of the light is
-//!   split into at most four rectangles whose edges are exactly the shadow edges, and each is
+//! - Visibility is handled exactly rather than by refinement: every occluder is an axis-aligned
+//!   rectangle parallel to the lights, so the part of a light it hides from a floor point `x` is
+//!   the axis-aligned rectangle `x + (O - x) z_light / z_occluder`; the visible part of the light
+//!   is split into rectangles whose edges are exactly the shadow edges (at most four around one
+//!   shadow; the lit cells of the grid of all shadow edges behind several), and each is
 //!   integrated as a smooth function.
 //! - Each rectangle is integrated adaptively: an order-8 product rule on a cell is compared with
 //!   the sum over its four quadrants; a cell is accepted when they differ by less than its share of
@@ -39,29 +40,85 @@ struct Rect {
     y1: f64,
 }
 
-/// The visible parts of `light` from `x` (at most four rectangles).
+/// The shadow of each occluder between `x` and `light` on the light's plane, clipped to the
+/// light (empty shadows left out).
+fn shadows(light: &RectLight, full: Rect, x: Vec3, geo: &CheckerGeometry) -> Vec<Rect> {
+    geo.occluders
+        .iter()
+        .filter(|o| o.z > x.z && o.z < light.z)
+        .filter_map(|o| {
+            let s = (light.z - x.z) / (o.z - x.z);
+            let sh = Rect {
+                x0: (x.x + (o.min[0] - x.x) * s).max(full.x0),
+                x1: (x.x + (o.max[0] - x.x) * s).min(full.x1),
+                y0: (x.y + (o.min[1] - x.y) * s).max(full.y0),
+                y1: (x.y + (o.max[1] - x.y) * s).min(full.y1),
+            };
+            (sh.x0 < sh.x1 && sh.y0 < sh.y1).then_some(sh)
+        })
+        .collect()
+}
+
+/// The visible parts of `light` from `x`: the whole light, the at most four rectangles around
+/// one shadow, or, behind several occluders, [`uncovered`] rectangles.
 fn visible_parts(light: &RectLight, x: Vec3, geo: &CheckerGeometry) -> Vec<Rect> {
     let full = Rect { x0: light.min[0], x1: light.max[0], y0: light.min[1], y1: light.max[1] };
-    let Some(o) = geo.occluder.filter(|o| o.z > x.z && o.z < light.z) else {
-        return vec![full];
-    };
-    let s = (light.z - x.z) / (o.z - x.z);
-    let sh = Rect {
-        x0: (x.x + (o.min[0] - x.x) * s).max(full.x0),
-        x1: (x.x + (o.max[0] - x.x) * s).min(full.x1),
-        y0: (x.y + (o.min[1] - x.y) * s).max(full.y0),
-        y1: (x.y + (o.max[1] - x.y) * s).min(full.y1),
-    };
-    if sh.x0 >= sh.x1 || sh.y0 >= sh.y1 {
-        return vec![full];
+    match shadows(light, full, x, geo).as_slice() {
+        [] => vec![full],
+        [sh] => {
+            let parts = [
+                Rect { x0: full.x0, x1: sh.x0, ..full },
+                Rect { x0: sh.x1, x1: full.x1, ..full },
+                Rect { x0: sh.x0, x1: sh.x1, y0: full.y0, y1: sh.y0 },
+                Rect { x0: sh.x0, x1: sh.x1, y0: sh.y1, y1: full.y1 },
+            ];
+            parts.into_iter().filter(|r| r.x1 > r.x0 && r.y1 > r.y0).collect()
+        }
+        several => uncovered(full, several),
     }
-    let parts = [
-        Rect { x0: full.x0, x1: sh.x0, ..full },
-        Rect { x0: sh.x1, x1: full.x1, ..full },
-        Rect { x0: sh.x0, x1: sh.x1, y0: full.y0, y1: sh.y0 },
-        Rect { x0: sh.x0, x1: sh.x1, y0: sh.y1, y1: full.y1 },
-    ];
-    parts.into_iter().filter(|r| r.x1 > r.x0 && r.y1 > r.y0).collect()
+}
+
+/// The part of `full` no shadow covers, as disjoint rectangles whose edges are shadow edges: the
+/// grid of every shadow edge splits `full` into cells each wholly lit or wholly hidden; the lit
+/// cells of a row are joined into runs, and runs of equal extent in consecutive rows into one
+/// rectangle.
+fn uncovered(full: Rect, shadows: &[Rect]) -> Vec<Rect> {
+    let edges = |lo: f64, hi: f64, of: &dyn Fn(&Rect) -> [f64; 2]| {
+        let mut e: Vec<f64> = vec![lo, hi];
+        e.extend(shadows.iter().flat_map(of));
+        e.sort_by(f64::total_cmp);
+        e.dedup();
+        e
+    };
+    let xs = edges(full.x0, full.x1, &|r: &Rect| [r.x0, r.x1]);
+    let ys = edges(full.y0, full.y1, &|r: &Rect| [r.y0, r.y1]);
+    let (mut open, mut done): (Vec<Rect>, Vec<Rect>) = (Vec::new(), Vec::new());
+    for band in ys.windows(2) {
+        let (y0, y1) = (band[0], band[1]);
+        let ym = 0.5 * (y0 + y1);
+        let mut runs: Vec<(f64, f64)> = Vec::new();
+        for cell in xs.windows(2) {
+            let xm = 0.5 * (cell[0] + cell[1]);
+            if shadows.iter().any(|s| s.x0 < xm && xm < s.x1 && s.y0 < ym && ym < s.y1) {
+                continue;
+            }
+            match runs.last_mut() {
+                Some(run) if run.1 == cell[0] => run.1 = cell[1],
+                _ => runs.push((cell[0], cell[1])),
+            }
+        }
+        let mut next = Vec::with_capacity(runs.len());
+        for (x0, x1) in runs {
+            match open.iter().position(|r| r.x0 == x0 && r.x1 == x1) {
+                Some(k) => next.push(Rect { y1, ..open.swap_remove(k) }),
+                None => next.push(Rect { x0, x1, y0, y1 }),
+            }
+        }
+        done.append(&mut open);
+        open = next;
+    }
+    done.append(&mut open);
+    done
 }
 
 /// The area integrand at light point `(u, v)` (grey: one channel).

@@ -122,3 +122,81 @@ fn small_light_never_hides_the_large_one_and_every_pixel_sees_the_floor() {
     let zeros = bed.reference().value.iter().filter(|v| v[0] == 0.0).count();
     assert!(zeros > 0 && zeros < 128, "{zeros}");
 }
+
+/// `soft-shadow` (the Plant-like variant): most pixels that see the board see the light partly
+/// hidden, and the quadrature behind several leaves agrees with the ray-cast brute force.
+#[test]
+fn soft_shadow_puts_most_of_the_board_in_penumbra_and_its_reference_splits_exactly() {
+    let bed = CheckerDirect::new("soft-shadow", &Params::new().with("resolution", 24.0)).unwrap();
+    let geo = bed.geometry();
+    assert_eq!(geo.lights.len(), 1);
+    let free = CheckerGeometry { occluders: Vec::new(), ..geo.clone() };
+    let mut board = 0;
+    let mut penumbra = Vec::new();
+    let mut behind_several = Vec::new();
+    for i in 0..bed.integrals() {
+        let p = bed.shading(i);
+        assert_eq!(p.brdf.ks[0], 0.0, "every square is diffuse");
+        let unoccluded = direct_lighting(&free, &p, REL_TOL).0;
+        if unoccluded == 0.0 {
+            continue;
+        }
+        board += 1;
+        let ratio = bed.reference().value[i][0] / unoccluded;
+        if ratio > 0.02 && ratio < 0.98 {
+            penumbra.push(i);
+            if shadows(&geo.lights[0], full(&geo.lights[0]), p.position, geo).len() >= 2 {
+                behind_several.push(i);
+            }
+        }
+    }
+    let share = penumbra.len() as f64 / board as f64;
+    eprintln!(
+        "soft-shadow: {} of {board} board pixels in penumbra ({share:.2}), {} behind several leaves",
+        penumbra.len(),
+        behind_several.len()
+    );
+    assert!(share > 0.6, "penumbra share {share}");
+    assert!(behind_several.len() >= 4, "{behind_several:?}");
+    for &i in behind_several.iter().step_by(behind_several.len() / 4).take(4) {
+        let p = bed.shading(i);
+        let r = bed.reference().value[i][0];
+        // The ray-cast brute force converges only at O(h) at the shadow edges, so it is held to
+        // a share of the unoccluded value (deep in the penumbra the lit area is small).
+        let b = brute(geo, &p, 384, 384);
+        let unoccluded = direct_lighting(&free, &p, REL_TOL).0;
+        eprintln!(
+            "soft-shadow pixel {i}: quadrature {r:.9e}, ray-cast brute force {b:.9e}, unoccluded {unoccluded:.6e}"
+        );
+        assert!((r - b).abs() <= 1e-3 * unoccluded, "pixel {i}: {r} vs {b}");
+    }
+}
+
+fn full(light: &RectLight) -> Rect {
+    Rect { x0: light.min[0], x1: light.max[0], y0: light.min[1], y1: light.max[1] }
+}
+
+/// The rectangles [`uncovered`] returns tile the part of the light no shadow covers: a point off
+/// every edge lies in exactly one of them when no shadow holds it, in none otherwise.
+#[test]
+fn uncovered_rectangles_tile_the_lit_part_of_the_light() {
+    let light = Rect { x0: -1.0, x1: 1.0, y0: -0.5, y1: 1.5 };
+    let shadows = [
+        Rect { x0: -1.0, x1: -0.2, y0: 0.1, y1: 0.9 },
+        Rect { x0: -0.5, x1: 0.4, y0: 0.6, y1: 1.5 },
+        Rect { x0: 0.3, x1: 0.8, y0: -0.3, y1: 0.2 },
+        Rect { x0: 0.35, x1: 0.6, y0: 0.0, y1: 0.1 },
+    ];
+    let parts = uncovered(light, &shadows);
+    let inside = |r: &Rect, u: f64, v: f64| r.x0 < u && u < r.x1 && r.y0 < v && v < r.y1;
+    let mut rng = crate::rng::stream(3, "uncovered");
+    for _ in 0..20_000 {
+        use rand::Rng;
+        let (u, v) = (rng.gen_range(-1.0..1.0), rng.gen_range(-0.5..1.5));
+        let lit = !shadows.iter().any(|s| inside(s, u, v));
+        let holders = parts.iter().filter(|r| inside(r, u, v)).count();
+        assert_eq!(holders, usize::from(lit), "({u}, {v}): lit {lit}, in {holders} parts");
+    }
+    let area: f64 = parts.iter().map(|r| (r.x1 - r.x0) * (r.y1 - r.y0)).sum();
+    assert!(area > 0.0 && area < 4.0 && parts.len() < 20, "{} parts, area {area}", parts.len());
+}
