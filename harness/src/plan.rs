@@ -89,6 +89,7 @@ impl Plan {
     /// Validates and builds everything (computing exact references), looking names up in
     /// `registry`.
     pub fn prepare(sweep: Sweep, registry: &Registry) -> Result<Plan> {
+        let _phase = crate::phases::enter(crate::phases::Phase::Build);
         sweep.validate()?;
         let mut beds = Vec::new();
         for spec in &sweep.testbeds {
