@@ -150,18 +150,8 @@ pub fn transmittance_method() -> String {
 /// values are the same bits.
 pub fn transmittance_reference_of(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Reference, ConfigError> {
     let key = bed.reference_key();
-    if let Some(stored) = refs.stored(&key)? {
-        let r = stored.reference;
-        if matches!(&r.kind, ReferenceKind::Exact { method, .. } if *method == transmittance_method()) {
-            r.check(bed.integrals()).map_err(|e| {
-                ConfigError::invalid(
-                    format!("{} reference", key.describe()),
-                    key.file_name(),
-                    format!("malformed ({e})"),
-                )
-            })?;
-            return Ok(r);
-        }
+    if let Some(r) = crate::references::stored_exact(refs, &key, &transmittance_method(), bed.integrals())? {
+        return Ok(r);
     }
     static COMPUTED: crate::memo::Memo<Reference> = crate::memo::Memo::new();
     Ok(COMPUTED.get_or_compute(key.describe(), || transmittance_reference(bed)))

@@ -20,6 +20,7 @@ use crate::envmap::{EnvFrame, EnvMap};
 use crate::error::ConfigError;
 use crate::math::{Rgb, Vec3};
 use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
+use crate::references::{ReferenceKey, ReferenceSource};
 use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::testbed::{EnvQuantity, EnvSequenceScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
 use rayon::prelude::*;
@@ -39,7 +40,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     provides: Needs::ENV_SEQUENCE,
     summary:
         "Phong sphere under a rotating HDR sky, L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
-    build: |variant, params, _| Ok(Box::new(EnvmapSequence::new(variant, params)?)),
+    build: |variant, params, refs| Ok(Box::new(EnvmapSequence::with_references(variant, params, refs)?)),
     compute_reference: None,
     params: ParamSpec::of::<EnvmapSequenceParams>(),
     cases: &[
@@ -110,6 +111,9 @@ impl ParamSet for EnvmapSequenceParams {
     }
 }
 
+/// How the exact references are computed (a stored reference of another method is not read).
+const METHOD: &str = "per-texel exact solid angles; closed-form diffuse moments and Gauss-Legendre of the Phong lobe per texel, horizon-split panels";
+
 /// Half-width of the orthographic image (inside the unit disc's inscribed square).
 const HALF_WIDTH: f64 = 0.7;
 
@@ -125,6 +129,8 @@ pub struct EnvmapSequence {
     /// Everything the exact pixel references depend on (parameters and BRDF), for the memo.
     setup: String,
     reference: Reference,
+    /// What a stored reference of it is found by (variant and every parameter).
+    key: ReferenceKey,
 }
 
 /// The BRDF and quantity of a variant (SPEC §3.7).
@@ -144,7 +150,22 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
 impl EnvmapSequence {
     /// Builds a variant and computes its exact reference (parallel over pixels).
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+        Self::with_references(variant, params, &crate::references::NoReferences)
+    }
+
+    /// Builds a variant with its exact reference: the one stored in `refs` under its key when it
+    /// was made by the current quadrature ([`crate::references::stored_exact`]: the quadrature
+    /// over every texel takes seconds per setup at every run), else computed.
+    pub fn with_references(variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let p = parse::<EnvmapSequenceParams>("envmap-sequence", params)?;
+        let json =
+            serde_json::to_value(&p).map_err(|e| ConfigError::invalid("envmap-sequence", variant, e.to_string()))?;
+        let key = ReferenceKey {
+            testbed: ENTRY.id.into(),
+            variant: variant.into(),
+            params: json.as_object().cloned().unwrap_or_default(),
+            default: p == EnvmapSequenceParams::default(),
+        };
         let (size, frames, rotation, sun) = (p.resolution, p.frames, p.rotation.to_radians(), p.sun);
         let (dawn_dusk, ew, eh) = (p.dawn_dusk != 0.0, p.env_width, p.env_height);
         let (brdf, quantity) = variant_setup(variant)?;
@@ -175,8 +196,12 @@ impl EnvmapSequence {
             points,
             setup: format!("{p:?}|{brdf:?}"),
             reference: empty(),
+            key,
         };
-        bed.reference = bed.compute_reference();
+        bed.reference = match crate::references::stored_exact(refs, &bed.key, METHOD, bed.points.len() * frames)? {
+            Some(r) => r,
+            None => bed.compute_reference(),
+        };
         Ok(bed)
     }
 
@@ -206,7 +231,7 @@ impl EnvmapSequence {
         let bound = refs.iter().map(|r| r.bound).fold(0.0, f64::max);
         let value =
             refs.iter().map(|r| if self.quantity == EnvQuantity::Reflected { r.lr } else { r.lns }).collect::<Vec<_>>();
-        let method = "per-texel exact solid angles; closed-form diffuse moments and Gauss-Legendre of the Phong lobe per texel, horizon-split panels".into();
+        let method = METHOD.into();
         Reference { kind: ReferenceKind::Exact { method, bound }, std_err: vec![Rgb::ZERO; value.len()], value }
     }
 }
@@ -234,6 +259,9 @@ impl TestBed for EnvmapSequence {
     }
     fn reference(&self) -> &Reference {
         &self.reference
+    }
+    fn reference_key(&self) -> Option<ReferenceKey> {
+        Some(self.key.clone())
     }
     fn geometry(&self, i: usize) -> Vec<(&'static str, f64)> {
         let p = &self.points[i / self.frames];
@@ -272,129 +300,5 @@ impl EnvSequenceScene for EnvmapSequence {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::quadrature::gauss_legendre;
-    use std::f64::consts::{PI, TAU};
-
-    fn small(variant: &str, extra: Params) -> EnvmapSequence {
-        let mut p = extra.with("resolution", 3.0).with("frames", 2.0);
-        for (k, v) in [("env_width", 64.0), ("env_height", 32.0)] {
-            if !p.0.contains_key(k) {
-                p = p.with(k, v);
-            }
-        }
-        EnvmapSequence::new(variant, &p).unwrap()
-    }
-
-    /// Brute force: every texel split into 4x4 sub-panels of 8x8 Gauss-Legendre in (theta, phi)
-    /// with max(0, cos), which converges slowly only on horizon texels; compared at 1e-7
-    /// relative (the brute force's own accuracy), the reference's claim of 1e-10 is checked by
-    /// the refinement test below.
-    fn brute(bed: &EnvmapSequence, i: usize, sub: usize) -> (Rgb, Rgb) {
-        let (p, f) = (bed.points[i / bed.frames], i % bed.frames);
-        let env = bed.environment(f);
-        let g = env.map.grid();
-        let (x, w) = gauss_legendre(8);
-        let (dt, dp) = (PI / g.height as f64 / sub as f64, TAU / g.width as f64 / sub as f64);
-        let (mut lns, mut lr) = (Rgb::ZERO, Rgb::ZERO);
-        for a in 0..g.height * sub {
-            for b in 0..g.width * sub {
-                for (xi, wi) in x.iter().zip(&w) {
-                    let th = (a as f64 + 0.5 + 0.5 * xi) * dt;
-                    for (xj, wj) in x.iter().zip(&w) {
-                        let ph = (b as f64 + 0.5 + 0.5 * xj) * dp + env.rotation;
-                        let d = crate::samplers::spherical_direction(th.cos(), ph);
-                        let cos = d.dot(p.normal);
-                        if cos <= 0.0 {
-                            continue;
-                        }
-                        let v = env.radiance(d)
-                            * p.brdf.eval(d, p.wo, p.normal)
-                            * (cos * th.sin() * wi * wj * 0.25 * dt * dp);
-                        lns += v;
-                        if d.z >= 0.0 {
-                            lr += v;
-                        }
-                    }
-                }
-            }
-        }
-        (lns, lr)
-    }
-
-    #[test]
-    fn reference_matches_brute_force_quadrature() {
-        for variant in ["mixed", "specular"] {
-            let bed = small(variant, Params::new());
-            let refs = bed.pixel_references();
-            for i in [0, 5, 8, 17] {
-                let (lns, lr) = brute(&bed, i, 4);
-                for c in 0..3 {
-                    for (a, b) in [(lns[c], refs[i].lns[c]), (lr[c], refs[i].lr[c])] {
-                        assert!(
-                            (a - b).abs() <= 1e-7 * b.abs().max(1e-3),
-                            "{variant} integral {i} ch {c}: brute {a} vs reference {b}"
-                        );
-                    }
-                }
-                assert!(
-                    refs[i].bound <= 1.01e-7 * refs[i].lns.0.iter().fold(0.0f64, |m, &v| m.max(v)),
-                    "bound {}",
-                    refs[i].bound
-                );
-            }
-        }
-    }
-
-    /// The dawn-to-dusk option (SPEC §3.7): frame n shows the sky at time (n + 1/2) / F, the sky
-    /// scaled by 0.2 + 0.8 sin(pi t) and the sun by sin(pi t)^2; the exact references follow it.
-    #[test]
-    fn dawn_to_dusk_scales_the_sky_per_frame_and_references_follow() {
-        let p = Params::new()
-            .with("resolution", 3.0)
-            .with("frames", 3.0)
-            .with("env_width", 64.0)
-            .with("env_height", 32.0)
-            .with("dawn_dusk", 1.0);
-        let bed = EnvmapSequence::new("mixed", &p).unwrap();
-        // Straight down sees the ground only (no lobe, the sun is above the horizon), which the
-        // rotation about z leaves alone: frame 1 (noon, scale 1) over frame 0 (t = 1/6, scale 0.6).
-        let down = Vec3::new(0.0, 0.0, -1.0);
-        let (dusk, noon) = (bed.environment(0).radiance(down), bed.environment(1).radiance(down));
-        for c in 0..3 {
-            assert!((noon[c] / dusk[c] - 1.0 / 0.6).abs() < 1e-9, "channel {c}: {} / {}", noon[c], dusk[c]);
-        }
-        let refs = bed.pixel_references();
-        for i in [0, 1, 2, 13] {
-            let (lns, lr) = brute(&bed, i, 4);
-            for c in 0..3 {
-                assert!((lns[c] - refs[i].lns[c]).abs() <= 1e-7 * refs[i].lns[c].abs().max(1e-3), "integral {i}");
-                assert!((lr[c] - refs[i].lr[c]).abs() <= 1e-7 * refs[i].lr[c].abs().max(1e-3), "integral {i}");
-            }
-        }
-        // Noon is brighter than the first frame at every pixel (sky 1.67x, sun 4x).
-        for px in 0..9 {
-            assert!(refs[px * 3 + 1].lns.0[1] > refs[px * 3].lns.0[1], "pixel {px}");
-        }
-    }
-
-    /// The sky spans the dynamic range SPEC §3.7 and §10 ask for; references are positive.
-    #[test]
-    fn sky_has_the_required_dynamic_range_and_references_are_positive() {
-        let bed = small("mixed", Params::new().with("env_width", 256.0).with("env_height", 128.0));
-        assert!(bed.maps[0].dynamic_range() >= 1e4, "{}", bed.maps[0].dynamic_range());
-        let stiff = small("mixed", Params::new().with("sun", 1e5).with("env_width", 256.0).with("env_height", 128.0));
-        assert!(stiff.maps[0].dynamic_range() >= 1e6);
-        assert!(bed.reference.value.iter().all(|v| v.0.iter().all(|&c| c > 0.0 && c.is_finite())));
-        assert_eq!(bed.integrals(), 9 * 2);
-    }
-
-    #[test]
-    fn bad_parameters_are_refused_naming_the_field() {
-        let e = EnvmapSequence::new("shiny", &Params::new()).err().unwrap().to_string();
-        assert!(e.contains("envmap-sequence/shiny"), "{e}");
-        let e = EnvmapSequence::new("mixed", &Params::new().with("env_height", 31.0)).err().unwrap().to_string();
-        assert!(e.contains("env_height"), "{e}");
-    }
-}
+#[path = "envmap_sequence_tests.rs"]
+mod tests;
