@@ -185,3 +185,31 @@ impl Plan {
         Ok(Plan { sweep, beds, estimators, pairs, skipped })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{Mode, SweepFile};
+
+    fn sweep(estimators: &str) -> Sweep {
+        let text = format!(
+            "name='v'\nreps=2\nbudgets=[4]\n[[testbeds]]\nid='eq21-medium'\nvariant='single-scatter'\nparams={{resolution=2}}\n{estimators}"
+        );
+        toml::from_str::<SweepFile>(&text).unwrap().apply(None, Mode::Quick).unwrap()
+    }
+
+    /// A pair's validation is remembered per configuration: an invalid one is refused every time
+    /// it is planned, with the same error, and another configuration of the same estimator is
+    /// judged on its own.
+    #[test]
+    fn validation_is_remembered_per_configuration() {
+        let registry = Registry::builtin();
+        let bad = sweep("[[estimators]]\nid='delta_tracking'\nparams={sigma_samp=0.01}\n");
+        let first = Plan::prepare(bad.clone(), &registry).err().expect("no majorant").to_string();
+        assert!(first.contains("majorant"), "{first}");
+        let again = Plan::prepare(bad, &registry).err().expect("still refused").to_string();
+        assert_eq!(first, again);
+        let good = sweep("[[estimators]]\nid='delta_tracking'\n");
+        assert_eq!(Plan::prepare(good, &registry).expect("a majorant").pairs.len(), 1);
+    }
+}
