@@ -168,6 +168,27 @@ pub fn load(source: &dyn ReferenceSource, key: &ReferenceKey, integrals: usize) 
     Ok(stored.reference)
 }
 
+/// The stored exact reference of `key` in `source` when there is one made by `method` (a
+/// quadrature worth storing: it is then read instead of computed at every build; a stored one of
+/// another method is ignored, so a change of the quadrature never reads stale values); checked
+/// against the `integrals` of the test bed.
+pub fn stored_exact(
+    source: &dyn ReferenceSource,
+    key: &ReferenceKey,
+    method: &str,
+    integrals: usize,
+) -> Result<Option<Reference>, ConfigError> {
+    let Some(stored) = source.stored(key)? else { return Ok(None) };
+    let r = stored.reference;
+    if !matches!(&r.kind, crate::testbed::ReferenceKind::Exact { method: m, .. } if m == method) {
+        return Ok(None);
+    }
+    r.check(integrals).map_err(|e| {
+        ConfigError::invalid(format!("{} reference", key.describe()), key.file_name(), format!("malformed ({e})"))
+    })?;
+    Ok(Some(r))
+}
+
 /// The repository's stored references (`results/references`), for the library's own tests.
 #[cfg(test)]
 pub(crate) mod repository {

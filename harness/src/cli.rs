@@ -284,6 +284,7 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
 
 fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     let mode = args.mode();
+    crate::phases::track();
     let file = args.config.as_deref().map(SweepFile::read).transpose()?;
     // Build every plan first: any bad name or value stops here, before a file is written.
     let mut plans = Vec::new();
@@ -307,7 +308,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
             plans.push((Some(def), sweep));
         }
     }
-    let mut prepared = Vec::new();
+    let (mut prepared, mut times) = (Vec::new(), Vec::new());
     for (def, mut sweep) in plans {
         if let Some(s) = args.seed {
             sweep.seed = s;
@@ -316,6 +317,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
             sweep.reps = r as usize;
         }
         prepared.push((def, execute::prepare(sweep, registry)?));
+        times.push(crate::phases::take());
     }
     let progress = Progress::new(args.progress);
     let opts = ExecOptions {
@@ -329,14 +331,15 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     };
     // Everything every experiment of the call will read is checked before the first one writes.
     let mut checked = Vec::new();
-    for (def, plan) in &prepared {
+    for ((def, plan), t) in prepared.iter().zip(&mut times) {
         checked.push(match args.shard {
             Some(shard) => Checked::Shard(crate::shard::preflight(plan, shard, &args.results)?),
             None => Checked::Run(execute::preflight(plan, *def, &opts)?),
         });
+        t.add(&crate::phases::take());
     }
     let started = Instant::now();
-    for ((def, plan), checked) in prepared.iter().zip(checked) {
+    for (((def, plan), checked), t) in prepared.iter().zip(checked).zip(&mut times) {
         let t0 = Instant::now();
         if let Checked::Shard(pre) = checked {
             let threads = args.threads.map(|t| t as usize);
@@ -357,10 +360,16 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         let Checked::Run(pre) = checked else { continue };
         let out = execute::execute_checked(plan, *def, &opts, pre)?;
         progress.finish();
+        t.add(&crate::phases::take());
         crate::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
         println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
+        println!("time: {}", t.line());
     }
     println!("\ntotal wall time {:.1} s", started.elapsed().as_secs_f64());
+    if args.shard.is_none() {
+        let names: Vec<&str> = prepared.iter().map(|(_, p)| p.sweep.experiment.as_str()).collect();
+        print!("{}", crate::phases::table(&names, &times));
+    }
     Ok(())
 }
 

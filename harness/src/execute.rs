@@ -114,6 +114,7 @@ pub fn finish(
     opts: &ExecOptions<'_>,
     started: Instant,
 ) -> Result<Outcome> {
+    let analysis = crate::phases::enter(crate::phases::Phase::Analysis);
     let sweep = &plan.sweep;
     let results_dir = opts.results_root.join(&sweep.experiment);
     let plots_dir = opts.plots_root.join(&sweep.experiment);
@@ -208,6 +209,8 @@ pub fn finish(
         extra_plots = post(plan, run, &mut report, &results, opts.plots.then_some(plots_dir.as_path()), opts.registry)?;
     }
     report.meta.wall_seconds = started.elapsed().as_secs_f64();
+    drop(analysis);
+    let _output = crate::phases::enter(crate::phases::Phase::Output);
     output::write_summary_csv(&results, &report.rows)?;
     output::write_integrals_csv(&results, &integrals)?;
     output::write_summary_json(&results, &report)?;

@@ -83,6 +83,7 @@ pub mod listing;
 pub mod merge;
 pub mod metrics;
 pub mod output;
+pub mod phases;
 pub mod plan;
 pub mod plot;
 pub mod progress;

@@ -8,9 +8,11 @@ use crate::registry::Registry;
 use estimators::budget::BudgetKind;
 use estimators::error::ConfigError;
 use estimators::estimator::Estimator;
-use estimators::registry::EstimatorEntry;
+use estimators::registry::{EstimatorEntry, TestBedEntry};
 use estimators::testbed::{Needs, TestBed};
 use serde::{Deserialize, Serialize};
+use std::collections::HashMap;
+use std::sync::{Mutex, OnceLock};
 
 /// A built test bed.
 pub struct PreparedBed {
@@ -72,6 +74,25 @@ pub struct Plan {
     pub skipped: Vec<Skipped>,
 }
 
+/// `Estimator::validate` of a pair, once per process and configuration: it depends on the
+/// estimator's and the test bed's registry entries and resolved parameters and the variant only,
+/// and on the media it integrates exact moments of up to 16 rays (a Perlin ray's quadrature takes
+/// a tenth of a second), while a run plans the same pairs again and again (the preflight and the
+/// run of every part of `unbiasedness`, each with its pilot, and a sweep re-planned per test bed
+/// and estimator when one pair is invalid).
+fn validate(bed_entry: &'static TestBedEntry, b: &PreparedBed, e: &PreparedEstimator) -> Result<()> {
+    type Validated = Mutex<HashMap<String, std::result::Result<(), ConfigError>>>;
+    static VALIDATED: OnceLock<Validated> = OnceLock::new();
+    let key = format!("{:p}|{}|{:p}|{}|{}", e.entry, e.params_json, bed_entry, b.variant, b.params_json);
+    let memo = VALIDATED.get_or_init(Default::default);
+    if let Some(r) = memo.lock().unwrap_or_else(|p| p.into_inner()).get(&key) {
+        return r.clone().map_err(Into::into);
+    }
+    let r = e.estimator.validate(b.bed.as_ref());
+    memo.lock().unwrap_or_else(|p| p.into_inner()).insert(key, r.clone());
+    r.map_err(Into::into)
+}
+
 impl Plan {
     /// The summary row of a cell of this plan (SPEC §8), with the estimator's id, both parameter
     /// sets and the efficiency in the sweep's `renderer` cost regime.
@@ -89,6 +110,7 @@ impl Plan {
     /// Validates and builds everything (computing exact references), looking names up in
     /// `registry`.
     pub fn prepare(sweep: Sweep, registry: &Registry) -> Result<Plan> {
+        let _phase = crate::phases::enter(crate::phases::Phase::Build);
         sweep.validate()?;
         let mut beds = Vec::new();
         for spec in &sweep.testbeds {
@@ -127,7 +149,7 @@ impl Plan {
                 match reason {
                     None => {
                         // An invalid configuration (not merely an unsupported pair) is bad input.
-                        e.estimator.validate(b.bed.as_ref())?;
+                        validate(registry.test_bed(&b.spec.id)?, b, e)?;
                         pairs.push((bi, ei))
                     }
                     Some(reason) => skipped.push(Skipped {
@@ -161,5 +183,33 @@ impl Plan {
             }
         }
         Ok(Plan { sweep, beds, estimators, pairs, skipped })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{Mode, SweepFile};
+
+    fn sweep(estimators: &str) -> Sweep {
+        let text = format!(
+            "name='v'\nreps=2\nbudgets=[4]\n[[testbeds]]\nid='eq21-medium'\nvariant='single-scatter'\nparams={{resolution=2}}\n{estimators}"
+        );
+        toml::from_str::<SweepFile>(&text).unwrap().apply(None, Mode::Quick).unwrap()
+    }
+
+    /// A pair's validation is remembered per configuration: an invalid one is refused every time
+    /// it is planned, with the same error, and another configuration of the same estimator is
+    /// judged on its own.
+    #[test]
+    fn validation_is_remembered_per_configuration() {
+        let registry = Registry::builtin();
+        let bad = sweep("[[estimators]]\nid='delta_tracking'\nparams={sigma_samp=0.01}\n");
+        let first = Plan::prepare(bad.clone(), &registry).err().expect("no majorant").to_string();
+        assert!(first.contains("majorant"), "{first}");
+        let again = Plan::prepare(bad, &registry).err().expect("still refused").to_string();
+        assert_eq!(first, again);
+        let good = sweep("[[estimators]]\nid='delta_tracking'\n");
+        assert_eq!(Plan::prepare(good, &registry).expect("a majorant").pairs.len(), 1);
     }
 }

@@ -324,6 +324,7 @@ pub fn run(plan: &Plan, opts: &RunOptions<'_>) -> Result<RunResults> {
 /// budget) run together, interleaved ([`run_group_with`]); each is stored as soon as its group has
 /// finished, and the observer hears of a group's cells (in plan order) when the group is done.
 pub fn run_preloaded(plan: &Plan, opts: &RunOptions<'_>, stored: Vec<Option<CellResult>>) -> Result<RunResults> {
+    let _phase = crate::phases::enter(crate::phases::Phase::Cells);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(opts.threads.unwrap_or(0))
         .build()

@@ -148,13 +148,14 @@ pub fn clip_sphere(origin: Vec3, dir: Vec3) -> Option<(f64, f64)> {
 
 impl MediumBed {
     /// Builds a variant (validates parameters; computes exact references, or looks the stored one
-    /// of `multiple` up in `refs`, and the stored quadrature of `single-scatter` when there is one).
+    /// of `multiple` up in `refs`, and the stored quadrature of `single-scatter` and of the
+    /// transmittance variants when there is one).
     pub fn new(field: Field, variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let mut bed = Self::without_reference(field, variant, params)?;
         bed.reference = match variant {
             "multiple" => crate::references::load(refs, &bed.reference_key(), bed.integrals())?,
             "single-scatter" => scatter_reference::reference(&bed, refs)?,
-            _ => reference::transmittance_reference(&bed),
+            _ => reference::transmittance_reference_of(&bed, refs)?,
         };
         Ok(bed)
     }

@@ -9,8 +9,10 @@
 //!   ([`super::independent_reference`], which shares no code with the tracking estimators).
 
 use super::{clip_sphere, density, Field, MediumBed};
+use crate::error::ConfigError;
 use crate::math::{Rgb, Vec3};
 use crate::quadrature::{gauss_kronrod_multi, Quadrature};
+use crate::references::ReferenceSource;
 use crate::testbed::{MediumQuantity, Reference, ReferenceKind, TestBed};
 
 /// Absolute tolerance on the optical depth (relative error of T <= 1e-12 with margin).
@@ -134,6 +136,27 @@ fn with_clamp_kinks(breaks: &[f64], u: impl Fn(f64) -> f64) -> Vec<f64> {
     out
 }
 
+/// The method of [`transmittance_reference`], as its references record it (a stored reference made
+/// by another method is not used).
+pub fn transmittance_method() -> String {
+    format!("optical depth by adaptive Gauss-Kronrod (absolute tolerance {TAU_TOL:e}), T = exp(-tau)")
+}
+
+/// The exact transmittance reference of `bed` (`central-ray`, `transmittance`): the stored one of
+/// its key when `refs` has one made by the current [`transmittance_method`] (the Perlin field's
+/// quadrature takes tens of CPU seconds at resolution 16), else computed once per process and
+/// key (an experiment builds the same bed for its pilot and its main plan, and again per part).
+/// A stored reference is the computed one written out with round-trip floats, so either way the
+/// values are the same bits.
+pub fn transmittance_reference_of(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Reference, ConfigError> {
+    let key = bed.reference_key();
+    if let Some(r) = crate::references::stored_exact(refs, &key, &transmittance_method(), bed.integrals())? {
+        return Ok(r);
+    }
+    static COMPUTED: crate::memo::Memo<Reference> = crate::memo::Memo::new();
+    Ok(COMPUTED.get_or_compute(key.describe(), || transmittance_reference(bed)))
+}
+
 /// Exact transmittance references of the `central-ray` and `transmittance` variants, computed in
 /// parallel over integrals; the bound is `weight T |d tau|` (first order) per integral.
 pub fn transmittance_reference(bed: &MediumBed) -> Reference {
@@ -152,9 +175,8 @@ pub fn transmittance_reference(bed: &MediumBed) -> Reference {
         (weight * t, weight.0.iter().fold(0.0f64, |m, w| m.max(w.abs())) * t * err)
     });
     let bound = results.iter().fold(0.0f64, |m, r| m.max(r.1));
-    let method = format!("optical depth by adaptive Gauss-Kronrod (absolute tolerance {TAU_TOL:e}), T = exp(-tau)");
     Reference {
-        kind: ReferenceKind::Exact { method, bound },
+        kind: ReferenceKind::Exact { method: transmittance_method(), bound },
         value: results.iter().map(|r| r.0).collect(),
         std_err: vec![Rgb::ZERO; n],
     }
@@ -228,6 +250,31 @@ mod tests {
                 let _ = field;
                 assert!(q.error <= 1e-12, "{field:?} s {s}: optical depth error bound {:e}", q.error);
             }
+        }
+    }
+
+    /// The stored transmittance references of the repository are what the quadrature computes,
+    /// bit for bit, and a build reads them; a stored one of another method is not used.
+    #[test]
+    fn stored_transmittance_references_are_the_computed_ones() {
+        use crate::references::{repository::Repository, InMemory, NoReferences, ReferenceSource, StoredReference};
+        for (variant, params) in [("central-ray", ("points", 8.0)), ("transmittance", ("resolution", 4.0))] {
+            let p = Params::new().with(params.0, params.1);
+            let bare = MediumBed::without_reference(Field::Perlin, variant, &p).unwrap();
+            let stored = Repository.stored(&bare.reference_key()).unwrap().expect("stored in results/references");
+            let computed = transmittance_reference(&bare);
+            assert_eq!(stored.reference, computed, "{variant}");
+            assert_eq!(MediumBed::new(Field::Perlin, variant, &p, &NoReferences).unwrap().reference, computed);
+            // Another method's values are ignored (here: a stored reference with halved values).
+            let mut other: StoredReference = stored.clone();
+            other.reference.value.iter_mut().for_each(|v| *v = *v * 0.5);
+            let read = MediumBed::new(Field::Perlin, variant, &p, &InMemory(vec![other.clone()])).unwrap();
+            assert_eq!(read.reference.value, other.reference.value, "the stored values are read");
+            if let ReferenceKind::Exact { method, .. } = &mut other.reference.kind {
+                method.push_str(" (older)");
+            }
+            let fresh = MediumBed::new(Field::Perlin, variant, &p, &InMemory(vec![other])).unwrap();
+            assert_eq!(fresh.reference, computed, "a stored reference of another method is not used");
         }
     }
 }

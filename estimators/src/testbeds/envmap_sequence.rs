@@ -28,6 +28,7 @@ use crate::envmap::{EnvFrame, EnvMap};
 use crate::error::ConfigError;
 use crate::math::{Rgb, Vec3};
 use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
+use crate::references::{ReferenceKey, ReferenceSource};
 use crate::registry::{BedCase, CaseRole, TestBedEntry};
 use crate::testbed::{EnvQuantity, EnvSequenceScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
 use rayon::prelude::*;
@@ -47,7 +48,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     provides: Needs::ENV_SEQUENCE,
     summary:
         "Phong sphere under a rotating HDR sky (`moving`: narrow bright lobes that move with it), L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
-    build: |variant, params, _| Ok(Box::new(EnvmapSequence::new(variant, params)?)),
+    build: |variant, params, refs| Ok(Box::new(EnvmapSequence::with_references(variant, params, refs)?)),
     compute_reference: None,
     params: ParamSpec::of::<EnvmapSequenceParams>(),
     cases: &[
@@ -121,6 +122,9 @@ impl ParamSet for EnvmapSequenceParams {
     }
 }
 
+/// How the exact references are computed (a stored reference of another method is not read).
+const METHOD: &str = "per-texel exact solid angles; closed-form diffuse moments and Gauss-Legendre of the Phong lobe per texel, horizon-split panels";
+
 /// Half-width of the orthographic image (inside the unit disc's inscribed square).
 const HALF_WIDTH: f64 = 0.7;
 
@@ -136,6 +140,8 @@ pub struct EnvmapSequence {
     /// Everything the exact pixel references depend on (parameters and BRDF), for the memo.
     setup: String,
     reference: Reference,
+    /// What a stored reference of it is found by (variant and every parameter).
+    key: ReferenceKey,
 }
 
 /// The BRDF and quantity of a variant (SPEC §3.7); the `moving` ones have the `mixed` BRDF.
@@ -157,14 +163,32 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
 impl EnvmapSequence {
     /// Builds a variant and computes its exact reference (parallel over pixels).
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
+        Self::with_references(variant, params, &crate::references::NoReferences)
+    }
+
+    /// Builds a variant with its exact reference: the one stored in `refs` under its key when it
+    /// was made by the current quadrature ([`crate::references::stored_exact`]: the quadrature
+    /// over every texel takes seconds per setup at every run), else computed.
+    pub fn with_references(variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let mut bed = Self::without_reference(variant, params)?;
-        bed.reference = bed.compute_reference();
+        bed.reference = match crate::references::stored_exact(refs, &bed.key, METHOD, bed.points.len() * bed.frames)? {
+            Some(r) => r,
+            None => bed.compute_reference(),
+        };
         Ok(bed)
     }
 
     /// The scene alone, its reference left empty (for computations on the maps and the BRDF).
     pub(super) fn without_reference(variant: &str, params: &Params) -> Result<Self, ConfigError> {
         let p = parse::<EnvmapSequenceParams>("envmap-sequence", params)?;
+        let json =
+            serde_json::to_value(&p).map_err(|e| ConfigError::invalid("envmap-sequence", variant, e.to_string()))?;
+        let key = ReferenceKey {
+            testbed: ENTRY.id.into(),
+            variant: variant.into(),
+            params: json.as_object().cloned().unwrap_or_default(),
+            default: p == EnvmapSequenceParams::default(),
+        };
         let (size, frames, rotation, sun) = (p.resolution, p.frames, p.rotation.to_radians(), p.sun);
         let (dawn_dusk, ew, eh) = (p.dawn_dusk != 0.0, p.env_width, p.env_height);
         let (brdf, quantity) = variant_setup(variant)?;
@@ -193,6 +217,7 @@ impl EnvmapSequence {
             points,
             setup: format!("{p:?}|{brdf:?}|{}", if moving { "moving" } else { "sky" }),
             reference: empty(),
+            key,
         })
     }
 
@@ -222,7 +247,7 @@ impl EnvmapSequence {
         let bound = refs.iter().map(|r| r.bound).fold(0.0, f64::max);
         let value =
             refs.iter().map(|r| if self.quantity == EnvQuantity::Reflected { r.lr } else { r.lns }).collect::<Vec<_>>();
-        let method = "per-texel exact solid angles; closed-form diffuse moments and Gauss-Legendre of the Phong lobe per texel, horizon-split panels".into();
+        let method = METHOD.into();
         Reference { kind: ReferenceKind::Exact { method, bound }, std_err: vec![Rgb::ZERO; value.len()], value }
     }
 }
@@ -266,6 +291,9 @@ impl TestBed for EnvmapSequence {
     }
     fn reference(&self) -> &Reference {
         &self.reference
+    }
+    fn reference_key(&self) -> Option<ReferenceKey> {
+        Some(self.key.clone())
     }
     fn geometry(&self, i: usize) -> Vec<(&'static str, f64)> {
         let p = &self.points[i / self.frames];

@@ -1,4 +1,5 @@
-//! Tests of the `envmap-sequence` scene and its exact per-texel reference.
+//! Tests of [`super`]: the scene and its exact per-texel reference against brute-force
+//! quadrature, parameters, stored references.
 
 use super::*;
 use crate::quadrature::gauss_legendre;
@@ -145,4 +146,30 @@ fn bad_parameters_are_refused_naming_the_field() {
     assert!(e.contains("envmap-sequence/shiny"), "{e}");
     let e = EnvmapSequence::new("mixed", &Params::new().with("env_height", 31.0)).err().unwrap().to_string();
     assert!(e.contains("env_height"), "{e}");
+}
+
+/// A stored reference of the bed's key made by the current method is read instead of computed;
+/// one of another method is ignored.
+#[test]
+fn a_stored_reference_is_read_when_made_by_the_same_method() {
+    use crate::references::{InMemory, StoredReference};
+    let bed = small("mixed", Params::new());
+    let key = bed.reference_key().expect("a key");
+    let mut stored = StoredReference {
+        testbed: key.testbed.clone(),
+        variant: key.variant.clone(),
+        params: key.params.clone(),
+        command: key.command(),
+        resolution: bed.resolution(),
+        reference: bed.reference().clone(),
+    };
+    stored.reference.value.iter_mut().for_each(|v| *v = *v * 2.0);
+    let p = Params::new().with("resolution", 3.0).with("frames", 2.0).with("env_width", 64.0).with("env_height", 32.0);
+    let read = EnvmapSequence::with_references("mixed", &p, &InMemory(vec![stored.clone()])).unwrap();
+    assert_eq!(read.reference().value, stored.reference.value);
+    stored.reference.kind = ReferenceKind::Exact { method: "an older quadrature".into(), bound: 0.0 };
+    let fresh = EnvmapSequence::with_references("mixed", &p, &InMemory(vec![stored])).unwrap();
+    assert_eq!(fresh.reference(), bed.reference());
+    let other = EnvmapSequence::with_references("specular", &p, &InMemory(Vec::new())).unwrap();
+    assert_ne!(other.reference_key(), Some(key), "the key names the variant");
 }

@@ -256,6 +256,7 @@ fn guarded(f: impl FnOnce() -> std::result::Result<(), String>) -> std::result::
 
 /// Writes `fig` as `<stem>.svg` and `<stem>.png` in `dir`.
 pub fn write_heatmap(dir: &Path, stem: &str, fig: &HeatFigure) -> Result<Vec<PathBuf>> {
+    let _phase = crate::phases::enter(crate::phases::Phase::Output);
     std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
     ensure_font(dir)?;
     let size = layout(fig).1;

@@ -120,6 +120,7 @@ fn render<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, maps: 
 
 /// Writes the maps as `<stem>.svg` and `<stem>.png` in `dir`.
 pub fn write_maps(dir: &Path, stem: &str, title: &str, maps: &[Map]) -> Result<Vec<PathBuf>> {
+    let _phase = crate::phases::enter(crate::phases::Phase::Output);
     std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
     ensure_font(dir)?;
     let dims = size(maps);

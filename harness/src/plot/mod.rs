@@ -170,6 +170,7 @@ pub fn write_plots(report: &RunReport, dir: &Path) -> Result<Vec<PathBuf>> {
 
 /// Writes one figure as `<stem>.svg` and `<stem>.png` in `dir` (for experiments' own plots).
 pub fn write_figure(dir: &Path, stem: &str, fig: &Figure) -> Result<Vec<PathBuf>> {
+    let _phase = crate::phases::enter(crate::phases::Phase::Output);
     std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
     ensure_font(dir)?;
     let (svg, png) = (dir.join(format!("{stem}.svg")), dir.join(format!("{stem}.png")));
