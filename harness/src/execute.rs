@@ -129,16 +129,7 @@ pub fn finish(
         let (bed, est) = (&plan.beds[*bi], &plan.estimators[*ei]);
         let reference = bed.bed.reference();
         rows.push(plan.summary_row(*bi, *ei, cell));
-        for (name, sum) in &cell.diagnostics {
-            diagnostics.push(Diagnostic {
-                testbed: cell.key.testbed.clone(),
-                variant: cell.key.variant.clone(),
-                estimator: cell.key.estimator.clone(),
-                budget: cell.key.budget.amount,
-                name: name.clone(),
-                mean: sum / cell.estimates.max(1) as f64,
-            });
-        }
+        diagnostics.extend(Diagnostic::of_cell(cell));
         if Some(cell.key.budget.amount) == last_budget {
             let group = analysis::Gate::group_of(est.estimator.as_ref(), bed.bed.as_ref());
             let gate = previous_budget_gate(run, *bi, *ei, cell).map(|g| g.with_group(group));

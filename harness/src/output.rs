@@ -202,6 +202,20 @@ pub struct Diagnostic {
     pub mean: f64,
 }
 
+impl Diagnostic {
+    /// The means per estimate of a cell's diagnostics (SPEC §8 `diagnostics`).
+    pub fn of_cell(cell: &crate::cell::CellResult) -> impl Iterator<Item = Diagnostic> + '_ {
+        cell.diagnostics.iter().map(move |(name, sum)| Diagnostic {
+            testbed: cell.key.testbed.clone(),
+            variant: cell.key.variant.clone(),
+            estimator: cell.key.estimator.clone(),
+            budget: cell.key.budget.amount,
+            name: name.clone(),
+            mean: sum / cell.estimates.max(1) as f64,
+        })
+    }
+}
+
 /// One row of `integrals.csv` (SPEC §8) with the test bed's geometry columns appended.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IntegralRow {

@@ -313,6 +313,15 @@ pub fn preload(plan: &Plan, cell_dir: Option<&Path>) -> Result<Vec<Option<CellRe
     Ok(out)
 }
 
+/// Runs `plan`'s cells on `threads` threads with progress on a terminal, reading back and storing
+/// cells in `cell_dir`: the further sweeps an experiment's analysis runs into its results folder.
+pub fn run_stored(plan: &Plan, cell_dir: PathBuf, threads: usize) -> Result<RunResults> {
+    let progress = crate::progress::Progress::default();
+    let r = run(plan, &RunOptions { threads: Some(threads), cell_dir: Some(cell_dir), observer: &progress });
+    progress.finish();
+    r
+}
+
 /// Runs every cell of the plan, reading back stored cells (checked first, [`preload`]) and
 /// storing new ones.
 pub fn run(plan: &Plan, opts: &RunOptions<'_>) -> Result<RunResults> {

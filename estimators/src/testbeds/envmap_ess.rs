@@ -205,7 +205,7 @@ mod tests {
     /// pixels, 6 frames); seconds in a release build:
     /// `cargo test --release -p estimators expected_share_table -- --ignored --nocapture`.
     #[test]
-    #[ignore]
+    #[ignore = "prints a table for the docs; about 2 min in a release build"]
     fn expected_share_table() {
         for variant in ["mixed", "moving"] {
             for rotation in [0.5, 1.5, 5.0, 15.0] {

@@ -9,6 +9,8 @@
 use super::{ensure_font, write_png_with, PLOT_SIZE};
 use crate::error::{HarnessError, Result};
 use crate::output::write_atomic;
+use plotters::coord::ranged1d::ValueFormatter;
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -101,51 +103,48 @@ fn render<DB: DrawingBackend>(
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
     let n = fig.points.len().max(1);
-    let labels: Vec<String> = fig.points.iter().map(|p| p.label.clone()).collect();
+    let mut builder = ChartBuilder::on(root);
+    builder.margin(16).caption(&fig.title, ("sans-serif", 18)).x_label_area_size(50).y_label_area_size(80);
+    let x_range = -0.5..(n as f64 - 0.5);
+    if log {
+        let mut chart = builder.build_cartesian_2d(x_range, (lo..hi).log_scale()).map_err(e)?;
+        draw_chart(&mut chart, fig).map_err(e)?;
+    } else {
+        let mut chart = builder.build_cartesian_2d(x_range, lo..hi).map_err(e)?;
+        draw_chart(&mut chart, fig).map_err(e)?;
+    }
+    root.present().map_err(e)
+}
+
+/// The mesh (one x label per setting), the paper's line and the points, on either y axis.
+fn draw_chart<DB: DrawingBackend, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
+    fig: &ClaimSweepFigure,
+) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+where
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
+    let n = fig.points.len().max(1);
     let x_fmt = |x: &f64| {
         let i = x.round();
         if (x - i).abs() < 1e-6 && i >= 0.0 {
-            labels.get(i as usize).cloned().unwrap_or_default()
+            fig.points.get(i as usize).map(|p| p.label.clone()).unwrap_or_default()
         } else {
             String::new()
         }
     };
-    let mut builder = ChartBuilder::on(root);
-    builder.margin(16).caption(&fig.title, ("sans-serif", 18)).x_label_area_size(50).y_label_area_size(80);
-    let x_range = -0.5..(n as f64 - 0.5);
-    let paper_line = |y: f64| vec![(-0.5, y), (n as f64 - 0.5, y)];
-    if log {
-        let mut chart = builder.build_cartesian_2d(x_range, (lo..hi).log_scale()).map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_labels(n)
-            .x_label_formatter(&x_fmt)
-            .x_desc(&fig.x_desc)
-            .y_desc(&fig.y_desc)
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(e)?;
-        if let Some(p) = fig.paper {
-            chart.draw_series(LineSeries::new(paper_line(p), PAPER.stroke_width(2))).map_err(e)?;
-        }
-        draw_points(&mut chart, fig).map_err(e)?;
-    } else {
-        let mut chart = builder.build_cartesian_2d(x_range, lo..hi).map_err(e)?;
-        chart
-            .configure_mesh()
-            .x_labels(n)
-            .x_label_formatter(&x_fmt)
-            .x_desc(&fig.x_desc)
-            .y_desc(&fig.y_desc)
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(e)?;
-        if let Some(p) = fig.paper {
-            chart.draw_series(LineSeries::new(paper_line(p), PAPER.stroke_width(2))).map_err(e)?;
-        }
-        draw_points(&mut chart, fig).map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_labels(n)
+        .x_label_formatter(&x_fmt)
+        .x_desc(&fig.x_desc)
+        .y_desc(&fig.y_desc)
+        .label_style(("sans-serif", 14))
+        .draw()?;
+    if let Some(p) = fig.paper {
+        chart.draw_series(LineSeries::new(vec![(-0.5, p), (n as f64 - 0.5, p)], PAPER.stroke_width(2)))?;
     }
-    root.present().map_err(e)
+    draw_points(chart, fig)
 }
 
 fn draw_points<DB: DrawingBackend, X, Y>(

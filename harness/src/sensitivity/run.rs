@@ -10,9 +10,8 @@ use crate::error::{HarnessError, Result};
 use crate::folder::OutputDir;
 use crate::output::{Claim, Diagnostic, RunReport};
 use crate::plan::Plan;
-use crate::progress::Progress;
 use crate::registry::{Experiment, Registry, Sweeps};
-use crate::runner::{self, RunOptions, RunResults};
+use crate::runner::{self, RunResults};
 use std::path::{Path, PathBuf};
 
 /// The sweep the experiment runs first (the first part at its default setting); the other
@@ -68,31 +67,10 @@ pub fn preflight(file: &SensitivityFile, registry: &Registry, first: &Sweep, cel
     Ok(())
 }
 
-fn run_plan(p: &Plan, results: &OutputDir, threads: usize) -> Result<RunResults> {
-    let progress = Progress::default();
-    let opts = RunOptions { threads: Some(threads), cell_dir: Some(results.join("cells")), observer: &progress };
-    let r = runner::run(p, &opts);
-    progress.finish();
-    r
-}
-
 /// The report of one setting's cells, as the claims read it: rows, fits, speed-ups, diagnostics.
 pub fn setting_report(plan: &Plan, run: &RunResults, like: &RunReport) -> RunReport {
     let rows: Vec<_> = run.cells.iter().map(|(bi, ei, cell)| plan.summary_row(*bi, *ei, cell)).collect();
-    let diagnostics = run
-        .cells
-        .iter()
-        .flat_map(|(_, _, cell)| {
-            cell.diagnostics.iter().map(move |(name, sum)| Diagnostic {
-                testbed: cell.key.testbed.clone(),
-                variant: cell.key.variant.clone(),
-                estimator: cell.key.estimator.clone(),
-                budget: cell.key.budget.amount,
-                name: name.clone(),
-                mean: sum / cell.estimates.max(1) as f64,
-            })
-        })
-        .collect();
+    let diagnostics = run.cells.iter().flat_map(|(_, _, cell)| Diagnostic::of_cell(cell)).collect();
     let fits = analysis::fits(&rows);
     let model = &plan.sweep.cost_model;
     let speedups =
@@ -148,7 +126,7 @@ pub fn post(
             setting_report(plan, run, report)
         } else {
             let p = Plan::prepare(sweep.clone(), registry)?;
-            let r = run_plan(&p, results, threads)?;
+            let r = runner::run_stored(&p, results.join("cells"), threads)?;
             setting_report(&p, &r, report)
         };
         let judged = claim.judge(&sub);

@@ -14,9 +14,8 @@ use crate::error::Result;
 use crate::folder::OutputDir;
 use crate::output::RunReport;
 use crate::plan::Plan;
-use crate::progress::Progress;
 use crate::registry::Registry;
-use crate::runner::{self, RunOptions, RunResults};
+use crate::runner::{self, RunResults};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -149,15 +148,6 @@ pub fn preflight(registry: &Registry, first: &Sweep, cells: &Path) -> Result<()>
     Ok(())
 }
 
-/// Runs `plan`'s cells (stored ones read back) with progress on a terminal.
-fn run_plan(p: &Plan, results: &OutputDir, threads: usize) -> Result<RunResults> {
-    let progress = Progress::default();
-    let opts = RunOptions { threads: Some(threads), cell_dir: Some(results.join("cells")), observer: &progress };
-    let r = runner::run(p, &opts);
-    progress.finish();
-    r
-}
-
 /// Runs the pilots, the other parts and writes the table (see the module docs).
 pub fn post(
     plan: &Plan,
@@ -168,7 +158,8 @@ pub fn post(
     registry: &Registry,
 ) -> Result<Vec<PathBuf>> {
     let threads = report.meta.threads;
-    let first_pilot = run_plan(&Plan::prepare(pilot_of(&plan.sweep), registry)?, results, threads)?;
+    let first_pilot =
+        runner::run_stored(&Plan::prepare(pilot_of(&plan.sweep), registry)?, results.join("cells"), threads)?;
     let mut rows = rows_of(plan, run, &first_pilot, report, registry);
     let first_bed = plan.sweep.testbeds.first().map(|t| t.id.clone()).unwrap_or_default();
     let mut notes = vec![format!("part {first_bed}... ({} reps)", plan.sweep.reps)];
@@ -177,8 +168,9 @@ pub fn post(
         let (plans, invalid) = prepare_valid(sweep, registry)?;
         rows.extend(invalid);
         for p in plans {
-            let pilot = run_plan(&Plan::prepare(pilot_of(&p.sweep), registry)?, results, threads)?;
-            let r = run_plan(&p, results, threads)?;
+            let pilot =
+                runner::run_stored(&Plan::prepare(pilot_of(&p.sweep), registry)?, results.join("cells"), threads)?;
+            let r = runner::run_stored(&p, results.join("cells"), threads)?;
             for (bi, ei, cell) in &r.cells {
                 report.rows.push(p.summary_row(*bi, *ei, cell));
             }
