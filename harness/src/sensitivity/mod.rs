@@ -74,9 +74,11 @@ pub struct PartMode {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Ceiling {
-    /// The speed-up of a `speedup` claim's estimator over its baseline if its own overhead were
-    /// free: the ratio of variance x rays per estimate at the largest budget (the work ratio), the
-    /// limit of the renderer regime as rays get costly.
+    /// The speed-up of a claim's estimator over its baseline if its own overhead were free: the
+    /// ratio of error x rays per estimate (the work ratio), the limit of the renderer regime as
+    /// rays get costly. For `speedup` claims the error is the variance, at the largest budget; for
+    /// `ratio` claims on an efficiency it is the error that efficiency divides by (MSE for
+    /// `efficiency_mse`, paper 003's `Err` for `p_eff`), at the claim's budget.
     WorkRatio,
 }
 

@@ -91,15 +91,36 @@ pub fn setting_report(plan: &Plan, run: &RunResults, like: &RunReport) -> RunRep
 }
 
 /// The ceiling of `claim` on one setting's report.
-fn ceiling(kind: Ceiling, claim: &crate::claim_spec::ClaimSpec, sweep: &Sweep, report: &RunReport) -> Option<f64> {
+pub(super) fn ceiling(
+    kind: Ceiling,
+    claim: &crate::claim_spec::ClaimSpec,
+    sweep_baseline: Option<&str>,
+    report: &RunReport,
+) -> Option<f64> {
+    use crate::claim_spec::ClaimSpec;
+    use crate::claims::RatioMetric;
+    use crate::metrics::SummaryRow;
     match kind {
         Ceiling::WorkRatio => {
-            let crate::claim_spec::ClaimSpec::Speedup { estimator, baseline, .. } = claim else { return None };
-            let base = baseline.as_deref().or(sweep.baseline.as_deref())?;
-            let last = report.rows.iter().map(|r| r.budget).max()?;
+            // The error measure the claim's efficiency divides by, and the budget it is read at.
+            let (estimator, base, error, budget): (&str, &str, fn(&SummaryRow) -> f64, Option<u64>) = match claim {
+                ClaimSpec::Speedup { estimator, baseline, .. } => {
+                    (estimator, baseline.as_deref().or(sweep_baseline)?, |r| r.variance, None)
+                }
+                ClaimSpec::Ratio { estimator, baseline, metric, budget, .. } => {
+                    let error: fn(&SummaryRow) -> f64 = match metric {
+                        RatioMetric::EfficiencyMse => |r| r.mse,
+                        RatioMetric::PEff => |r| r.p_err,
+                        _ => return None,
+                    };
+                    (estimator, baseline, error, *budget)
+                }
+                _ => return None,
+            };
+            let last = budget.or_else(|| report.rows.iter().map(|r| r.budget).max())?;
             let at = |name: &str| report.rows.iter().find(|r| r.estimator == name && r.budget == last);
             let (m, b) = (at(estimator)?, at(base)?);
-            let work = |r: &crate::metrics::SummaryRow| r.variance * r.rays.max(f64::MIN_POSITIVE);
+            let work = |r: &SummaryRow| error(r) * r.rays.max(f64::MIN_POSITIVE);
             let v = work(b) / work(m);
             v.is_finite().then_some(v)
         }
@@ -130,7 +151,7 @@ pub fn post(
             setting_report(&p, &r, report)
         };
         let judged = claim.judge(&sub);
-        let ceiling = part.ceiling.and_then(|k| ceiling(k, &claim, &sweep, &sub));
+        let ceiling = part.ceiling.and_then(|k| ceiling(k, &claim, sweep.baseline.as_deref(), &sub));
         rows.push(SettingRow::new(part, value, &judged, ceiling));
     }
     let mut written = Vec::new();

@@ -118,3 +118,38 @@ fn the_outcome_is_decided_in_order() {
     q.unsupportable = Some("the paper's own numbers give 3x".into());
     assert_eq!(classify(&q, &[&a, &b]).kind(), "unsupportable as written");
 }
+
+#[test]
+fn the_work_ratio_ceiling_divides_error_times_rays_by_the_claims_own_error() {
+    use super::run::ceiling;
+    let mut report = crate::plot::tests::synthetic_report();
+    let template = report.rows[0].clone();
+    report.rows.clear();
+    // (name, budget, variance, MSE, Err, rays)
+    for (name, budget, var, mse, err, rays) in [
+        ("a", 16, 1.0, 1.5, 3.0, 16.0),
+        ("b", 16, 2.0, 6.0, 9.0, 32.0),
+        ("a", 64, 0.5, 0.5, 1.0, 64.0),
+        ("b", 64, 4.0, 4.0, 8.0, 64.0),
+    ] {
+        let mut r = template.clone();
+        (r.estimator, r.budget, r.variance, r.mse, r.p_err, r.rays) = (name.into(), budget, var, mse, err, rays);
+        report.rows.push(r);
+    }
+    let spec = |text: &str| -> ClaimSpec {
+        toml::from_str(&format!("testbed = 'gradient-plane/default'\ntext = 't'\nestimator = 'a'\n{text}"))
+            .expect("claim")
+    };
+    // speedup: variance x rays at the largest budget, baseline from the sweep.
+    let c = ceiling(Ceiling::WorkRatio, &spec("kind = 'speedup'\nvalue = 2.0"), Some("b"), &report);
+    assert_eq!(c, Some(8.0));
+    // ratio on efficiency_mse at the claim's budget: MSE x rays.
+    let r = "kind = 'ratio'\nbaseline = 'b'\nbudget = 16\n";
+    let c = ceiling(Ceiling::WorkRatio, &spec(&format!("{r}metric = 'efficiency_mse'")), None, &report);
+    assert_eq!(c, Some(6.0 * 32.0 / (1.5 * 16.0)));
+    // ratio on p_eff: paper 003's Err x rays.
+    let c = ceiling(Ceiling::WorkRatio, &spec(&format!("{r}metric = 'p_eff'")), None, &report);
+    assert_eq!(c, Some(9.0 * 32.0 / (3.0 * 16.0)));
+    // an error ratio has no work ratio.
+    assert_eq!(ceiling(Ceiling::WorkRatio, &spec(&format!("{r}metric = 'rmse'")), None, &report), None);
+}
