@@ -205,6 +205,7 @@ pub fn finish(
     output::write_summary_csv(&results, &report.rows)?;
     output::write_integrals_csv(&results, &integrals)?;
     output::write_summary_json(&results, &report)?;
+    crate::report::write_tables(&results, &report)?;
     results.commit(&run_id, None)?;
     if opts.plots {
         draw_with(&report, &plots_dir, &results_dir, extra_plots)?;
@@ -247,7 +248,9 @@ fn draw_with(report: &RunReport, plots_dir: &Path, results_dir: &Path, extra: Ve
     for f in &files {
         plots.record(f)?;
     }
-    let md = crate::report::render_report(report, &files, plots_dir, results_dir);
+    // The summary shows every figure in the folder (an experiment's own figures too).
+    let listed = crate::report::digest::list_files(plots_dir);
+    let md = crate::report::render_report(report, &listed, plots_dir, results_dir);
     plots.write("report.md", md.as_bytes())?;
     plots.commit(&crate::folder::run_id(&report.meta.experiment), Some(&report.meta.run_id))
 }
