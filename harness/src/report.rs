@@ -2,7 +2,8 @@
 //! result files, the paper's claims beside ours, convergence fits, speed-ups, the tests' verdict
 //! counts with the rows that need attention, what did not run, one line per (test bed, variant),
 //! and every plot. The long tables (every test row, every claim, every cell) are CSV files in the
-//! results folder ([`tables`]) that the summary links to.
+//! results folder ([`tables`]) that the summary links to; `index.html` beside it ([`crate::html`])
+//! shows the same run in a browser.
 
 pub mod digest;
 mod format;
@@ -83,7 +84,10 @@ fn more(out: &mut String, shown: usize, total: usize, what: &str, link: &str) {
 pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, results_dir: &Path) -> String {
     let m = &report.meta;
     let mut out = format!("# mcbench report: {}\n\n", m.experiment);
-    out.push_str("A summary of the run; every row of the long tables is in the result files.\n\n");
+    out.push_str(
+        "A summary of the run. [index.html](index.html) shows it in a browser with every figure (and per-pixel \
+         error maps of image test beds); every row of the long tables is in the result files.\n\n",
+    );
     let _ = writeln!(out, "- **mode**: {} ({} repetitions)", m.mode, m.reps);
     let _ = writeln!(out, "- **seed**: {}", m.seed);
     let _ = writeln!(out, "- **commit**: {} (mcbench {})", m.git_commit, m.version);

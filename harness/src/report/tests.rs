@@ -17,6 +17,7 @@ fn report_summarises_every_table_and_shows_every_plot() {
     let md = std::fs::read_to_string(&path).unwrap();
     for h in [
         "# mcbench report: surface-smc",
+        "[index.html](index.html)",
         "## Paper claims",
         "Verdicts: 1 held (of 1)",
         "[summary.json](../results/summary.json)",
