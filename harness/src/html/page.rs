@@ -103,7 +103,12 @@ fn meta(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
     let _ = writeln!(b, "<dt>results folder</dt><dd>{}</dd>", link(ctx, ctx.results_dir, &folder));
     b.push_str("</dl>\n");
     if !m.notes.is_empty() {
-        let _ = writeln!(b, "<details><summary>{} notes (references, corrections)</summary><ul>", m.notes.len());
+        let n = m.notes.len();
+        let _ = writeln!(
+            b,
+            "<details><summary>{n} note{} (references, corrections)</summary><ul>",
+            if n == 1 { "" } else { "s" }
+        );
         m.notes.iter().for_each(|n| {
             let _ = writeln!(b, "<li>{}</li>", esc(n));
         });
