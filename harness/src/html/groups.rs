@@ -11,19 +11,34 @@ use crate::report::digest::{self, FigureFiles};
 use crate::report::{count, opt, relative_path, sig};
 use std::fmt::Write as _;
 
+/// Figures wider than this (in SVG pixels) take a whole row of the page.
+const WIDE: f64 = 1000.0;
+
+/// The width in pixels an SVG file declares on its root element, read from its first bytes.
+fn svg_width(path: &std::path::Path) -> Option<f64> {
+    use std::io::Read as _;
+    let mut head = [0u8; 512];
+    let n = std::fs::File::open(path).and_then(|mut f| f.read(&mut head)).ok()?;
+    let text = String::from_utf8_lossy(&head[..n]);
+    let svg = &text[text.find("<svg")?..];
+    let value = svg[svg.find(" width=\"")? + 8..].split('"').next()?;
+    value.trim_end_matches("px").parse().ok()
+}
+
+/// One figure, its image linking to the SVG (figures wider than [`WIDE`] pixels take a whole row).
 fn figure(f: &FigureFiles, ctx: &Context<'_>) -> String {
-    let src = url(&relative_path(ctx.plots_dir, f.shown()));
-    let mut links = Vec::new();
-    for (p, kind) in [(&f.svg, "SVG"), (&f.png, "PNG")] {
-        if let Some(p) = p {
-            links.push(format!("<a href=\"{}\">{kind}</a>", url(&relative_path(ctx.plots_dir, p))));
-        }
-    }
+    let href = |p: &std::path::Path| url(&relative_path(ctx.plots_dir, p));
+    let links: Vec<String> = [(&f.svg, "SVG"), (&f.png, "PNG")]
+        .into_iter()
+        .filter_map(|(p, kind)| p.as_ref().map(|p| format!("<a href=\"{}\">{kind}</a>", href(p))))
+        .collect();
+    let wide = f.svg.as_deref().and_then(svg_width).is_some_and(|w| w > WIDE);
     format!(
-        "<figure><img src=\"{src}\" alt=\"{}\"><figcaption>{} &nbsp; {}</figcaption></figure>\n",
-        esc(&f.stem),
-        esc(&f.stem),
-        links.join(" ")
+        "<figure{}><a href=\"{src}\"><img src=\"{src}\" alt=\"{stem}\"></a><figcaption>{stem} &nbsp; {}</figcaption></figure>\n",
+        if wide { " class=\"wide\"" } else { "" },
+        links.join(" "),
+        src = href(f.shown()),
+        stem = esc(&f.stem),
     )
 }
 
@@ -100,4 +115,21 @@ fn cells(b: &mut String, report: &RunReport, testbed: &str, variant: &str) {
         ["estimator", "rmse", "bias ± se", "variance", "samples", "fetches", "CPU s per estimate", "efficiency"];
     b.push_str(&table(&header, table_rows));
     b.push_str("</details>\n");
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_declared_svg_width_is_read() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let path = dir.path().join("f.svg");
+        std::fs::write(&path, "<?xml version=\"1.0\"?>\n<svg width=\"1396\" height=\"636\" viewBox=\"0 0 1396 636\">")
+            .expect("svg");
+        assert_eq!(svg_width(&path), Some(1396.0));
+        std::fs::write(&path, "<svg viewBox=\"0 0 10 10\">").expect("svg");
+        assert_eq!(svg_width(&path), None);
+        assert_eq!(svg_width(&dir.path().join("missing.svg")), None);
+    }
 }

@@ -162,6 +162,7 @@ dl.meta dt { font-weight: 600; }
 dl.meta dd { margin: 0; }
 .figs { display: grid; grid-template-columns: repeat(auto-fill, minmax(440px, 1fr)); gap: 12px; }
 figure { margin: 0; background: #fff; border: 1px solid #d9dee6; padding: 6px; }
+figure.wide { grid-column: 1 / -1; }
 figure img { width: 100%; height: auto; display: block; }
 figcaption { font-size: 12px; color: #4f5766; margin-top: 3px; }
 img.px { image-rendering: pixelated; border: 1px solid #b9c0cb; display: block; }

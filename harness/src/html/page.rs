@@ -1,7 +1,7 @@
 //! An experiment's `index.html`: the run's metadata, the claims with their verdicts and intervals,
 //! fits and speed-ups, the tests summarised (verdict counts, the rows against their claim and the
 //! inconclusive ones), every figure of the plots folder with a section per test bed
-//! ([`super::groups`]), what did not run, and links to every result file.
+//! (its figures, per-pixel maps and cells), what did not run, and links to every result file.
 
 use super::markup::{badge, count_badges, esc, page, table, url, verdict_class, Cell};
 use super::pixel_maps::PixelGroup;
