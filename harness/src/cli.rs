@@ -369,6 +369,9 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     if args.shard.is_none() {
         let names: Vec<&str> = prepared.iter().map(|(_, p)| p.sweep.experiment.as_str()).collect();
         print!("{}", crate::phases::table(&names, &times));
+        if !args.no_plots {
+            println!("HTML report (open in a browser): {}", args.plots.join("index.html").display());
+        }
     }
     Ok(())
 }
@@ -426,7 +429,7 @@ fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, _reg
     crate::folder::check_output_dir("--plots", &dir)?;
     let _lock = crate::folder::FolderLock::acquire(&dir, wait, &[])?;
     execute::draw(&report, &dir, results_dir)?;
-    println!("plots and report.md written to {}", dir.display());
+    println!("plots, report.md and index.html written to {}", dir.display());
     Ok(())
 }
 

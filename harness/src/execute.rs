@@ -205,9 +205,10 @@ pub fn finish(
     output::write_summary_csv(&results, &report.rows)?;
     output::write_integrals_csv(&results, &integrals)?;
     output::write_summary_json(&results, &report)?;
+    crate::report::write_tables(&results, &report)?;
     results.commit(&run_id, None)?;
     if opts.plots {
-        draw_with(&report, &plots_dir, &results_dir, extra_plots)?;
+        draw_with(&report, &plots_dir, &results_dir, extra_plots, &integrals)?;
     }
     Ok(Outcome { report, results_dir, plots_dir })
 }
@@ -235,21 +236,35 @@ fn previous_budget_gate(run: &RunResults, bi: usize, ei: usize, cell: &CellResul
     Some(analysis::Gate::from_cell(&other.2, source, scale))
 }
 
-/// Draws the plots and the report of a finished run into `plots_dir` and commits them.
+/// Draws the plots, `report.md` and `index.html` of a finished run into `plots_dir` (the per-pixel
+/// maps from the results folder's `integrals.csv`), commits them, and rewrites the plots root's
+/// `index.html`.
 pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path) -> Result<()> {
-    draw_with(report, plots_dir, results_dir, Vec::new())
+    let integrals = crate::html::read_integrals(results_dir)?;
+    draw_with(report, plots_dir, results_dir, Vec::new(), &integrals)
 }
 
-fn draw_with(report: &RunReport, plots_dir: &Path, results_dir: &Path, extra: Vec<PathBuf>) -> Result<()> {
+fn draw_with(
+    report: &RunReport,
+    plots_dir: &Path,
+    results_dir: &Path,
+    extra: Vec<PathBuf>,
+    integrals: &[IntegralRow],
+) -> Result<()> {
     let plots = OutputDir::new(plots_dir);
     let mut files = crate::plot::write_plots(report, plots_dir)?;
     files.extend(extra);
     for f in &files {
         plots.record(f)?;
     }
-    let md = crate::report::render_report(report, &files, plots_dir, results_dir);
+    // The summary and the page show every figure in the folder (an experiment's own figures too).
+    let listed = crate::report::digest::list_files(plots_dir);
+    let md = crate::report::render_report(report, &listed, plots_dir, results_dir);
     plots.write("report.md", md.as_bytes())?;
-    plots.commit(&crate::folder::run_id(&report.meta.experiment), Some(&report.meta.run_id))
+    crate::html::write_page(report, &plots, results_dir, integrals)?;
+    plots.commit(&crate::folder::run_id(&report.meta.experiment), Some(&report.meta.run_id))?;
+    let root = plots_dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    crate::html::write_root_index(root).map(|_| ())
 }
 
 fn integral_rows(cell: &CellResult, prepared: &PreparedBed, est: &PreparedEstimator) -> Vec<IntegralRow> {

@@ -8,9 +8,10 @@
 //! resume, shards and merge.
 //!
 //! Pipeline: [`config`] -> [`plan`] -> [`runner`] -> [`metrics`] / [`analysis`] -> [`output`] /
-//! [`plot`] / [`report`]; [`execute`] ties them together, [`cli`] is the command line, [`shard`]
-//! and [`merge`] split a sweep over machines and join it again, [`conformance`] is the check every
-//! plug-in goes through. Names are looked up in a [`Registry`], a value you build in `main`.
+//! [`plot`] / [`report`] / [`html`]; [`execute`] ties them together, [`cli`] is the command line,
+//! [`shard`] and [`merge`] split a sweep over machines and join it again, [`conformance`] is the
+//! check every plug-in goes through. Names are looked up in a [`Registry`], a value you build in
+//! `main`.
 //!
 //! ## Quick start: your own estimator, from your own crate
 //!
@@ -77,6 +78,7 @@ pub mod error;
 pub mod execute;
 pub mod folder;
 pub mod guarded;
+pub mod html;
 pub mod interleave;
 pub mod limits;
 pub mod listing;

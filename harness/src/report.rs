@@ -1,101 +1,40 @@
-//! The run's `report.md` (SPEC §8): metadata, the paper's claims beside ours, convergence fits,
-//! speed-ups, unbiasedness tests, what did not run, the summary rows and every plot.
+//! The run's `report.md` (SPEC §8), a summary of at most about 100 KB: metadata and links to the
+//! result files, the paper's claims beside ours, convergence fits, speed-ups, the tests' verdict
+//! counts with the rows that need attention, what did not run, one line per (test bed, variant),
+//! and every plot. The long tables (every test row, every claim, every cell) are CSV files in the
+//! results folder ([`tables`]) that the summary links to; `index.html` beside it ([`crate::html`])
+//! shows the same run in a browser.
+
+pub mod digest;
+mod format;
+pub mod tables;
+
+pub use format::{count, interval, markdown_table, md_target, opt, relative_path, shorten, sig};
+pub use tables::write_tables;
 
 use crate::error::Result;
-use crate::metrics::SummaryRow;
-use crate::output::{write_atomic, Diagnostic, RunReport};
-use crate::plot::{budget_axis_label, label_of, plot_stem, PlotKind};
+use crate::output::{write_atomic, Claim, RunReport};
+use crate::plot::{budget_axis_label, label_of};
+use digest::FigureFiles;
 use std::fmt::Write as _;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
-/// Formats `x` with `digits` significant digits: fixed notation for magnitudes in
-/// [1e-3, 10^(digits + 1)), scientific (`1.235e-5`) otherwise; `-` for NaN, `inf` / `-inf`.
-pub fn sig(x: f64, digits: usize) -> String {
-    if x.is_nan() {
-        return "-".to_string();
-    }
-    if x.is_infinite() {
-        return if x > 0.0 { "inf" } else { "-inf" }.to_string();
-    }
-    if x == 0.0 {
-        return "0".to_string();
-    }
-    let d = digits.max(1);
-    let sci = format!("{:.*e}", d - 1, x);
-    let exp: i32 = sci.rsplit('e').next().and_then(|e| e.parse().ok()).unwrap_or(0);
-    if exp < -3 || exp > d as i32 {
-        sci
-    } else {
-        format!("{:.*}", (d as i32 - 1 - exp).max(0) as usize, x)
-    }
-}
-
-/// `sig(x, 4)` for a present value, `-` for a missing one.
-fn opt(x: Option<f64>) -> String {
-    x.map(|v| sig(v, 4)).unwrap_or_else(|| "-".to_string())
-}
-
-/// A cost: whole numbers as integers, others with 4 significant digits.
-fn count(x: f64) -> String {
-    if x.fract() == 0.0 && x.abs() < 1e12 {
-        format!("{}", x as i64)
-    } else {
-        sig(x, 4)
-    }
-}
-
-fn cell(text: &str) -> String {
-    text.replace('|', "\\|").replace(['\n', '\r'], " ")
-}
-
-/// A GitHub-flavoured markdown table with padded columns (readable as plain text too). Rows
-/// shorter than the header are padded with empty cells; `|` in cells is escaped.
-pub fn markdown_table(header: &[&str], rows: &[Vec<String>]) -> String {
-    let ncol = header.len().max(rows.iter().map(Vec::len).max().unwrap_or(0));
-    let grid: Vec<Vec<String>> = std::iter::once(header.iter().map(|h| cell(h)).collect::<Vec<_>>())
-        .chain(rows.iter().map(|r| r.iter().map(|c| cell(c)).collect()))
-        .map(|mut r| {
-            r.resize(ncol, String::new());
-            r
-        })
-        .collect();
-    let widths: Vec<usize> =
-        (0..ncol).map(|c| grid.iter().map(|r| r[c].chars().count()).max().unwrap_or(0).max(3)).collect();
-    let line = |r: &[String]| {
-        let cells: Vec<String> =
-            r.iter().zip(&widths).map(|(c, w)| format!("{c}{}", " ".repeat(w - c.chars().count()))).collect();
-        format!("| {} |\n", cells.join(" | "))
-    };
-    let mut out = line(&grid[0]);
-    out.push_str(&format!("|{}|\n", widths.iter().map(|w| "-".repeat(w + 2)).collect::<Vec<_>>().join("|")));
-    for r in &grid[1..] {
-        out.push_str(&line(r));
-    }
-    out
-}
-
-/// `to` relative to the folder `from`, with `/` separators (for links in markdown).
-fn relative(from: &Path, to: &Path) -> String {
-    let rel = match to.strip_prefix(from) {
-        Ok(r) => r.to_path_buf(),
-        Err(_) => {
-            let abs = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
-            let (f, t) = (abs(from), abs(to));
-            let (fc, tc): (Vec<Component>, Vec<Component>) = (f.components().collect(), t.components().collect());
-            let common = fc.iter().zip(&tc).take_while(|(a, b)| a == b).count();
-            let mut r = PathBuf::new();
-            (common..fc.len()).for_each(|_| r.push(".."));
-            tc[common..].iter().for_each(|c| r.push(c));
-            r
-        }
-    };
-    let s = rel.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect::<Vec<_>>().join("/");
-    if s.contains([' ', '(', ')', '<', '>']) {
-        format!("<{s}>")
-    } else {
-        s
-    }
-}
+/// Claims listed in full up to this many; beyond it, the ones that need attention.
+const CLAIM_ROWS: usize = 40;
+/// Longest note of a claim or reason of a test row in the summary (the CSV files hold all).
+const NOTE_CHARS: usize = 240;
+/// Notes of the run's metadata listed.
+const NOTE_LINES: usize = 12;
+/// Rows of the fits and speed-up tables.
+const FIT_ROWS: usize = 60;
+/// Test rows against their claim listed.
+const FAILING_ROWS: usize = 40;
+/// Inconclusive test rows listed.
+const INCONCLUSIVE_ROWS: usize = 15;
+/// Reasons of skipped pairs listed.
+const SKIP_REASONS: usize = 15;
+/// (test bed, variant) lines of the results table.
+const GROUP_ROWS: usize = 80;
 
 fn name(report: &RunReport, id: &str) -> String {
     match label_of(report, id) {
@@ -104,12 +43,28 @@ fn name(report: &RunReport, id: &str) -> String {
     }
 }
 
-fn yes_no(b: bool) -> String {
-    if b { "yes" } else { "no" }.to_string()
+/// `name` in the results folder as a markdown link relative to the plots folder, or, when the run
+/// did not write it (an older results folder), `summary.json`, which holds every table; plain text
+/// when neither is there.
+fn table_link(plots_dir: &Path, results_dir: &Path, name: &str) -> String {
+    match [name, "summary.json"].into_iter().map(|n| results_dir.join(n)).find(|p| p.is_file()) {
+        Some(file) => {
+            let shown = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            format!("[{shown}]({})", md_target(plots_dir, &file))
+        }
+        None => format!("`{name}` (not in the results folder)"),
+    }
 }
 
-fn section(out: &mut String, title: &str, header: &[&str], rows: Vec<Vec<String>>, empty: &str) {
+fn counts_line(counts: &[(String, usize)]) -> String {
+    counts.iter().map(|(w, n)| format!("{n} {w}")).collect::<Vec<_>>().join(", ")
+}
+
+fn heading(out: &mut String, title: &str) {
     let _ = write!(out, "\n## {title}\n\n");
+}
+
+fn table_or(out: &mut String, header: &[&str], rows: Vec<Vec<String>>, empty: &str) {
     if rows.is_empty() {
         let _ = writeln!(out, "{empty}");
     } else {
@@ -117,51 +72,99 @@ fn section(out: &mut String, title: &str, header: &[&str], rows: Vec<Vec<String>
     }
 }
 
-/// The text of `report.md` (see [`write_report`]): metadata, then the tables of paper claims,
-/// fits, speed-ups, unbiasedness tests, skipped pairs and unavailable estimators, then per
-/// (test bed, variant) the summary rows, the estimators' diagnostics and the plots.
+fn more(out: &mut String, shown: usize, total: usize, what: &str, link: &str) {
+    if total > shown {
+        let _ = write!(out, "\n{} more {what}: {link}.\n", total - shown);
+    }
+}
+
+/// The text of `report.md` (see [`write_report`]): `plots` are the figure files to show (the
+/// plots folder's SVG and PNG files), linked relative to `plots_dir`; `results_dir` holds the
+/// result files it links to.
 pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, results_dir: &Path) -> String {
     let m = &report.meta;
     let mut out = format!("# mcbench report: {}\n\n", m.experiment);
+    out.push_str(
+        "A summary of the run. [index.html](index.html) shows it in a browser with every figure (and per-pixel \
+         error maps of image test beds); every row of the long tables is in the result files.\n\n",
+    );
     let _ = writeln!(out, "- **mode**: {} ({} repetitions)", m.mode, m.reps);
     let _ = writeln!(out, "- **seed**: {}", m.seed);
     let _ = writeln!(out, "- **commit**: {} (mcbench {})", m.git_commit, m.version);
     let _ = writeln!(out, "- **threads**: {}; **cpu**: {}", m.threads, m.cpu);
-    let _ = writeln!(out, "- **wall time**: {} s", sig(m.wall_seconds, 4));
-    let files: Vec<String> = ["summary.csv", "summary.json", "integrals.csv"]
+    let cpu = digest::estimator_cpu_seconds(&report.rows);
+    let _ = writeln!(
+        out,
+        "- **wall time**: {} s; **CPU time in the estimators**: {} s",
+        sig(m.wall_seconds, 4),
+        sig(cpu, 4)
+    );
+    let files: Vec<String> = digest::result_files(results_dir)
         .iter()
-        .filter(|f| results_dir.join(f).is_file())
-        .map(|f| format!("[{f}]({})", relative(plots_dir, &results_dir.join(f))))
+        .filter_map(|(p, _)| p.file_name().map(|n| format!("[{}]({})", n.to_string_lossy(), md_target(plots_dir, p))))
         .collect();
     if !files.is_empty() {
         let _ = writeln!(out, "- **result files**: {}", files.join(", "));
     }
     let _ = writeln!(out, "- **notes**:{}", if m.notes.is_empty() { " none" } else { "" });
-    m.notes.iter().for_each(|n| {
-        let _ = writeln!(out, "  - {n}");
+    m.notes.iter().take(NOTE_LINES).for_each(|n| {
+        let _ = writeln!(out, "  - {}", shorten(n, NOTE_CHARS));
     });
+    if m.notes.len() > NOTE_LINES {
+        let _ = writeln!(out, "  - ... {} more in summary.json (`meta.notes`)", m.notes.len() - NOTE_LINES);
+    }
+    claims_section(&mut out, report, plots_dir, results_dir);
+    fits_section(&mut out, report);
+    speedups_section(&mut out, report);
+    tests_section(&mut out, report, plots_dir, results_dir);
+    skipped_section(&mut out, report, plots_dir, results_dir);
+    results_section(&mut out, report, plots_dir, results_dir);
+    plots_section(&mut out, report, &digest::pair_figures(plots), plots_dir);
+    out
+}
 
-    let claims = report.paper.iter().map(|c| {
-        let interval = c.interval.map(|[lo, hi]| format!("[{}, {}]", sig(lo, 4), sig(hi, 4))).unwrap_or_default();
-        let note = if c.reason.is_empty() { c.note.clone() } else { format!("{}. {}", c.reason, c.note) };
-        vec![
-            c.testbed.clone(),
-            c.claim.clone(),
-            opt(c.paper_value),
-            opt(c.our_value),
-            interval,
-            c.pair.clone(),
-            c.regime.clone(),
-            c.verdict().to_string(),
-            note,
-        ]
-    });
+fn claim_row(c: &Claim) -> Vec<String> {
+    let note = if c.reason.is_empty() { c.note.clone() } else { format!("{}. {}", c.reason, c.note) };
+    vec![
+        c.testbed.clone(),
+        c.claim.clone(),
+        opt(c.paper_value),
+        opt(c.our_value),
+        interval(c.interval),
+        c.pair.clone(),
+        c.regime.clone(),
+        c.verdict().to_string(),
+        shorten(&note, NOTE_CHARS),
+    ]
+}
+
+fn claims_section(out: &mut String, report: &RunReport, plots_dir: &Path, results_dir: &Path) {
+    heading(out, "Paper claims");
+    let claims = &report.paper;
+    if claims.is_empty() {
+        out.push_str("No paper claims for this experiment.\n");
+        return;
+    }
+    let link = table_link(plots_dir, results_dir, tables::CLAIMS_CSV);
+    let counts = counts_line(&digest::claim_counts(claims));
+    let _ = write!(out, "Verdicts: {counts} (of {}). Every claim with its whole note: {link}.\n\n", claims.len());
+    let shown: Vec<&Claim> = if claims.len() <= CLAIM_ROWS {
+        claims.iter().collect()
+    } else {
+        let _ = write!(out, "The claims that did not hold or are inconclusive (up to {CLAIM_ROWS}):\n\n");
+        claims.iter().filter(|c| digest::claim_needs_attention(c)).take(CLAIM_ROWS).collect()
+    };
     let header =
         ["testbed", "claim", "paper value", "our value", "95% interval", "pair", "cost regime", "verdict", "note"];
-    section(&mut out, "Paper claims", &header, claims.collect(), "No paper claims for this experiment.");
+    table_or(out, &header, shown.iter().map(|c| claim_row(c)).collect(), "None.");
+    more(out, shown.len(), claims.len(), "claims", &link);
+}
 
-    let fits = report.fits.iter().map(|f| {
+fn fits_section(out: &mut String, report: &RunReport) {
+    heading(out, "Convergence fits");
+    let fits = report.fits.iter().take(FIT_ROWS).map(|f| {
         let budgets: Vec<String> = f.budgets.iter().map(u64::to_string).collect();
+        let right = f.slope_right.is_finite();
         vec![
             f.testbed.clone(),
             f.variant.clone(),
@@ -170,12 +173,8 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
             format!("[{:.3}, {:.3}]", f.slope_ci_low, f.slope_ci_high),
             format!("{:.4}", f.r2),
             budgets.join(", "),
-            if f.slope_right.is_finite() { format!("{:.3}", f.slope_right) } else { "-".into() },
-            if f.slope_right.is_finite() {
-                format!("[{:.3}, {:.3}]", f.slope_right_ci_low, f.slope_right_ci_high)
-            } else {
-                "-".into()
-            },
+            if right { format!("{:.3}", f.slope_right) } else { "-".into() },
+            if right { format!("[{:.3}, {:.3}]", f.slope_right_ci_low, f.slope_right_ci_high) } else { "-".into() },
             if f.method.is_empty() { "ols".into() } else { f.method.clone() },
         ]
     });
@@ -191,26 +190,25 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
         "right-end 95% CI",
         "fit",
     ];
-    section(&mut out, "Convergence fits", &header, fits.collect(), "No fits (a fit needs 3 budgets with RMSE > 0).");
+    table_or(out, &header, fits.collect(), "No fits (a fit needs 3 budgets with RMSE > 0).");
+    more(out, FIT_ROWS, report.fits.len(), "fits", "summary.json (`fits`)");
+}
 
-    let speedups = report.speedups.iter().map(|s| {
-        let (sr, ov, su) = (sig(s.sample_ratio, 4), sig(s.overhead, 4), sig(s.speedup, 4));
+fn speedups_section(out: &mut String, report: &RunReport) {
+    heading(out, "Speed-ups");
+    let rows = report.speedups.iter().take(FIT_ROWS).map(|s| {
         vec![
             s.testbed.clone(),
             s.variant.clone(),
             name(report, &s.estimator),
             s.baseline.clone(),
             s.budget.to_string(),
-            sr,
-            ov,
-            su,
+            sig(s.sample_ratio, 4),
+            sig(s.overhead, 4),
+            sig(s.speedup, 4),
             format!("[{}, {}]", sig(s.speedup_ci_low, 4), sig(s.speedup_ci_high, 4)),
-            sig(s.overhead_renderer, 4),
             sig(s.speedup_renderer, 4),
-            sig(s.speedup_ray_limit, 4),
             sig(s.break_even_ray_ns, 4),
-            sig(s.overhead_wall, 4),
-            sig(s.speedup_wall, 4),
         ]
     });
     let header = [
@@ -223,183 +221,168 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
         "overhead (CPU)",
         "speed-up (CPU)",
         "95% CI",
-        "overhead (renderer)",
         "speed-up (renderer)",
-        "limit (costly rays)",
         "break-even ray ns",
-        "overhead (wall)",
-        "speed-up (wall)",
     ];
-    section(&mut out, "Speed-ups", &header, speedups.collect(), "No speed-ups computed.");
+    table_or(out, &header, rows.collect(), "No speed-ups computed.");
+    more(out, FIT_ROWS, report.speedups.len(), "speed-ups", "summary.json (`speedups`)");
+}
 
-    let tests = report.tests.iter().map(|t| {
-        vec![
-            format!("{} / {}", t.testbed, t.variant),
-            name(report, &t.estimator),
-            t.test.clone(),
-            t.budget.to_string(),
-            sig(t.statistic, 4),
-            if t.p_value.is_nan() { "-".to_string() } else { format!("{:.2e}", t.p_value) },
-            t.verdict.clone(),
-            sig(t.detectable_rel_bias, 3),
-            t.claim.clone(),
-            yes_no(t.agrees),
-        ]
+/// The rows of a table of test rows.
+pub(crate) fn test_rows(report: &RunReport, rows: &[&crate::analysis::TestRow]) -> Vec<Vec<String>> {
+    rows.iter()
+        .map(|t| {
+            vec![
+                format!("{} / {}", t.testbed, t.variant),
+                name(report, &t.estimator),
+                t.test.clone(),
+                t.budget.to_string(),
+                sig(t.statistic, 4),
+                if t.p_value.is_nan() { "-".to_string() } else { format!("{:.2e}", t.p_value) },
+                t.verdict.clone(),
+                sig(t.detectable_rel_bias, 3),
+                t.claim.clone(),
+                shorten(&t.reason, NOTE_CHARS),
+            ]
+        })
+        .collect()
+}
+
+/// The header of [`test_rows`].
+pub(crate) const TEST_ROW_HEADER: [&str; 10] = [
+    "testbed",
+    "estimator",
+    "test",
+    "budget",
+    "statistic",
+    "p-value",
+    "verdict",
+    "detectable rel. bias",
+    "claim",
+    "reason",
+];
+
+fn tests_section(out: &mut String, report: &RunReport, plots_dir: &Path, results_dir: &Path) {
+    heading(out, "Unbiasedness tests");
+    if report.tests.is_empty() {
+        out.push_str("No tests in this run.\n");
+        return;
+    }
+    let link = table_link(plots_dir, results_dir, tables::TESTS_CSV);
+    let (failing, inconclusive) = digest::attention(&report.tests);
+    let decided = digest::deciding(&report.tests);
+    let counts = digest::tally(decided.iter().map(|t| t.verdict.as_str()), &digest::TEST_VERDICTS);
+    let _ = write!(
+        out,
+        "Deciding rows (the `combined` test where there is one): {}; {} against the estimator's claim. Every row: {link}.\n\n",
+        counts_line(&counts),
+        failing.len()
+    );
+    let rows = digest::test_counts(&report.tests).into_iter().map(|c| {
+        let n = |v: &str| c.verdicts.iter().find(|(w, _)| w == v).map_or(0, |(_, n)| *n);
+        let other: usize =
+            c.verdicts.iter().filter(|(w, _)| !digest::TEST_VERDICTS.contains(&w.as_str())).map(|(_, n)| n).sum();
+        let cells = [n("pass"), n("biased"), n("inconclusive"), other, c.agrees, c.total];
+        std::iter::once(c.test.clone()).chain(cells.iter().map(usize::to_string)).collect()
     });
-    let header = [
-        "testbed",
-        "estimator",
-        "test",
-        "budget",
-        "statistic",
-        "p-value",
-        "verdict",
-        "detectable rel. bias",
-        "claim",
-        "agrees",
-    ];
-    section(&mut out, "Unbiasedness tests", &header, tests.collect(), "No tests in this run.");
+    let header = ["test", "pass", "biased", "inconclusive", "other", "agrees with the claim", "rows"];
+    out.push_str(&markdown_table(&header, &rows.collect::<Vec<_>>()));
+    let _ = write!(out, "\n### Against the claim ({})\n\n", failing.len());
+    let shown: Vec<_> = failing.iter().copied().take(FAILING_ROWS).collect();
+    table_or(out, &TEST_ROW_HEADER, test_rows(report, &shown), "None.");
+    more(out, shown.len(), failing.len(), "rows against the claim", &link);
+    let _ = write!(out, "\n### Inconclusive ({})\n\n", inconclusive.len());
+    let shown: Vec<_> = inconclusive.iter().copied().take(INCONCLUSIVE_ROWS).collect();
+    table_or(out, &TEST_ROW_HEADER, test_rows(report, &shown), "None.");
+    more(out, shown.len(), inconclusive.len(), "inconclusive rows", &link);
+}
 
-    let skipped = report
-        .skipped
-        .iter()
-        .map(|s| vec![s.testbed.clone(), s.variant.clone(), s.estimator.clone(), s.reason.clone()]);
-    let header = ["testbed", "variant", "estimator", "reason"];
-    section(&mut out, "Skipped pairs", &header, skipped.collect(), "None.");
+fn skipped_section(out: &mut String, report: &RunReport, plots_dir: &Path, results_dir: &Path) {
+    heading(out, "Skipped pairs");
+    let reasons = digest::tally(report.skipped.iter().map(|s| s.reason.as_str()), &[]);
+    let mut reasons = reasons;
+    reasons.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+    if !report.skipped.is_empty() {
+        let _ = write!(out, "{} pairs did not run, by reason:\n\n", report.skipped.len());
+    }
+    let rows = reasons.iter().take(SKIP_REASONS).map(|(r, n)| {
+        let first = report.skipped.iter().find(|s| &s.reason == r).expect("a pair with this reason");
+        vec![r.clone(), n.to_string(), format!("{} on {} / {}", first.estimator, first.testbed, first.variant)]
+    });
+    table_or(out, &["reason", "pairs", "for example"], rows.collect(), "None.");
+    more(out, SKIP_REASONS, reasons.len(), "reasons", &table_link(plots_dir, results_dir, "summary.json"));
+    heading(out, "Unavailable estimators");
     let unavailable = report.unavailable.iter().map(|u| vec![u.clone(), "not registered in this build".to_string()]);
-    section(&mut out, "Unavailable estimators", &["estimator", "reason"], unavailable.collect(), "None.");
-
-    let mut used = vec![false; plots.len()];
-    out.push_str("\n## Results\n");
-    let mut groups: Vec<(&str, &str)> = Vec::new();
-    let keys = report.rows.iter().map(|r| (&r.testbed, &r.variant));
-    for (t, v) in keys.chain(report.diagnostics.iter().map(|d| (&d.testbed, &d.variant))) {
-        if !groups.contains(&(t.as_str(), v.as_str())) {
-            groups.push((t, v));
-        }
-    }
-    if groups.is_empty() {
-        out.push_str("\nNo result rows.\n");
-    }
-    for (testbed, variant) in groups {
-        let rows: Vec<&SummaryRow> =
-            report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
-        results_table(&mut out, report, testbed, variant, &rows);
-        diagnostics_table(&mut out, report, testbed, variant);
-        let stems = PlotKind::ALL.iter().map(|k| plot_stem(testbed, variant, *k));
-        for stem in stems.chain([crate::plot::ray_cost::stem(testbed, variant)]) {
-            let png = format!("{stem}.png");
-            if let Some(i) = plots.iter().position(|p| p.file_name().is_some_and(|n| n.to_string_lossy() == png)) {
-                used[i] = true;
-                embed(&mut out, &plots[i], plots, &mut used, plots_dir);
-            }
-        }
-    }
-    let rest: Vec<usize> = (0..plots.len()).filter(|&i| !used[i] && is_ext(&plots[i], "png")).collect();
-    let rest_svg: Vec<usize> = (0..plots.len()).filter(|&i| !used[i] && is_ext(&plots[i], "svg")).collect();
-    if !rest.is_empty() || !rest_svg.is_empty() {
-        out.push_str("\n## Other plots\n");
-        for i in rest.into_iter().chain(rest_svg) {
-            if !used[i] {
-                used[i] = true;
-                embed(&mut out, &plots[i], plots, &mut used, plots_dir);
-            }
-        }
-    }
-    out
+    table_or(out, &["estimator", "reason"], unavailable.collect(), "None.");
 }
 
-fn is_ext(p: &Path, ext: &str) -> bool {
-    p.extension().is_some_and(|e| e.eq_ignore_ascii_case(ext))
+fn results_section(out: &mut String, report: &RunReport, plots_dir: &Path, results_dir: &Path) {
+    heading(out, "Results");
+    let groups = digest::groups(report);
+    let link = table_link(plots_dir, results_dir, "summary.csv");
+    let _ = write!(
+        out,
+        "One line per test bed and variant; every cell (estimator x budget) is a row of {link}, the estimators' \
+         diagnostics per cell are in summary.json (`diagnostics`).\n\n"
+    );
+    let rows = groups.iter().take(GROUP_ROWS).map(|(t, v)| {
+        let rows: Vec<_> = report.rows.iter().filter(|r| &r.testbed == t && &r.variant == v).collect();
+        let mut estimators: Vec<&str> = rows.iter().map(|r| r.estimator.as_str()).collect();
+        estimators.dedup();
+        let mut budgets: Vec<u64> = rows.iter().map(|r| r.budget).collect();
+        budgets.sort_unstable();
+        budgets.dedup();
+        let last = budgets.last().copied();
+        let best = rows
+            .iter()
+            .filter(|r| Some(r.budget) == last && r.rmse.is_finite())
+            .min_by(|a, b| a.rmse.total_cmp(&b.rmse))
+            .map(|r| format!("{} ({})", sig(r.rmse, 4), name(report, &r.estimator)))
+            .unwrap_or_else(|| "-".into());
+        let kind = rows.first().map(|r| budget_axis_label(&r.budget_kind)).unwrap_or_default();
+        let span = match (budgets.first(), last) {
+            (Some(a), Some(b)) if *a != b => format!("{a} .. {b} ({} budgets)", budgets.len()),
+            (Some(a), _) => a.to_string(),
+            _ => "-".into(),
+        };
+        let distinct = estimators.iter().collect::<std::collections::BTreeSet<_>>().len();
+        vec![format!("{t} / {v}"), distinct.to_string(), kind, span, rows.len().to_string(), best]
+    });
+    let header = ["testbed / variant", "estimators", "budget", "budgets", "cells", "lowest RMSE at the largest budget"];
+    table_or(out, &header, rows.collect(), "No result rows.");
+    more(out, GROUP_ROWS, groups.len(), "test beds and variants", &link);
 }
 
-/// Embeds one plot, with a link to its SVG twin when there is one.
-fn embed(out: &mut String, plot: &Path, plots: &[PathBuf], used: &mut [bool], plots_dir: &Path) {
-    let alt = plot.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let _ = write!(out, "\n![{alt}]({})", relative(plots_dir, plot));
-    if is_ext(plot, "png") {
-        if let Some(j) = plots.iter().position(|q| is_ext(q, "svg") && q.with_extension("png") == plot) {
-            used[j] = true;
-            let _ = write!(out, "\n([SVG]({}))", relative(plots_dir, &plots[j]));
-        }
+fn embed(out: &mut String, f: &FigureFiles, plots_dir: &Path) {
+    let shown = f.png.as_deref().unwrap_or(f.shown());
+    let _ = write!(out, "\n![{}]({})", f.stem, md_target(plots_dir, shown));
+    if let (Some(svg), Some(_)) = (&f.svg, &f.png) {
+        let _ = write!(out, "\n([SVG]({}))", md_target(plots_dir, svg));
     }
     out.push('\n');
 }
 
-/// The estimators' diagnostics of one group, one column per diagnostic name.
-fn diagnostics_table(out: &mut String, report: &RunReport, testbed: &str, variant: &str) {
-    let diags: Vec<&Diagnostic> =
-        report.diagnostics.iter().filter(|d| d.testbed == testbed && d.variant == variant).collect();
-    let (mut names, mut keys): (Vec<&str>, Vec<(&str, u64)>) = (Vec::new(), Vec::new());
-    for d in &diags {
-        if !names.contains(&d.name.as_str()) {
-            names.push(&d.name);
-        }
-        if !keys.contains(&(d.estimator.as_str(), d.budget)) {
-            keys.push((&d.estimator, d.budget));
-        }
+fn plots_section(out: &mut String, report: &RunReport, figures: &[FigureFiles], plots_dir: &Path) {
+    let groups = digest::groups(report);
+    let (by_group, rest) = digest::figures_by_group(figures, &groups);
+    heading(out, "Plots");
+    if figures.is_empty() {
+        out.push_str("No plots.\n");
     }
-    if diags.is_empty() {
-        return;
+    for ((t, v), figs) in groups.iter().zip(&by_group).filter(|(_, f)| !f.is_empty()) {
+        let _ = writeln!(out, "### {t} / {v}");
+        figs.iter().for_each(|f| embed(out, f, plots_dir));
+        out.push('\n');
     }
-    let header: Vec<&str> = ["estimator", "budget"].into_iter().chain(names.iter().copied()).collect();
-    let rows: Vec<Vec<String>> = keys
-        .iter()
-        .map(|&(e, b)| {
-            let values = names.iter().map(|n| {
-                let d = diags.iter().find(|d| d.estimator == e && d.budget == b && d.name == *n);
-                d.map(|d| count(d.mean)).unwrap_or_else(|| "-".to_string())
-            });
-            [name(report, e), b.to_string()].into_iter().chain(values).collect()
-        })
-        .collect();
-    out.push_str("\nEstimator diagnostics (mean per estimate):\n\n");
-    out.push_str(&markdown_table(&header, &rows));
+    if !rest.is_empty() {
+        let title = if by_group.iter().any(|f| !f.is_empty()) { "### Other plots\n" } else { "" };
+        out.push_str(title);
+        rest.iter().for_each(|f| embed(out, f, plots_dir));
+    }
 }
 
-fn results_table(out: &mut String, report: &RunReport, testbed: &str, variant: &str, rows: &[&SummaryRow]) {
-    let kind = rows.first().map(|r| r.budget_kind.as_str()).unwrap_or("samples");
-    let _ = write!(out, "\n### {testbed} / {variant}\n\n");
-    if rows.is_empty() {
-        out.push_str("No result rows.\n");
-        return;
-    }
-    let _ = write!(out, "Budget: {}.\n\n", budget_axis_label(kind));
-    let fetches = rows.iter().any(|r| r.fetches > 0.0);
-    let mut header = vec!["estimator", "budget", "rmse", "variance", "bias ± se", "samples"];
-    if fetches {
-        header.push("fetches");
-    }
-    header.extend(["seconds (wall)", "seconds (CPU)", "efficiency"]);
-    if fetches {
-        header.push("FoM");
-    }
-    let table: Vec<Vec<String>> = rows
-        .iter()
-        .map(|r| {
-            let mut v = vec![
-                name(report, &r.estimator),
-                r.budget.to_string(),
-                sig(r.rmse, 4),
-                sig(r.variance, 4),
-                format!("{} ± {}", sig(r.bias, 4), sig(r.bias_se, 4)),
-                count(r.samples),
-            ];
-            if fetches {
-                v.push(count(r.fetches));
-            }
-            v.extend([sig(r.seconds, 4), sig(r.cpu_seconds, 4), opt(r.efficiency)]);
-            if fetches {
-                v.push(opt(r.fom));
-            }
-            v
-        })
-        .collect();
-    out.push_str(&markdown_table(&header, &table));
-}
-
-/// Writes `plots_dir/report.md` (atomically) showing every table of the run and every plot in
-/// `plots` (linked relative to `plots_dir`); `results_dir` holds the result files it links to.
+/// Writes `plots_dir/report.md` (atomically): the summary of the run with every plot in `plots`
+/// (linked relative to `plots_dir`); `results_dir` holds the result files it links to.
 pub fn write_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, results_dir: &Path) -> Result<PathBuf> {
     let path = plots_dir.join("report.md");
     write_atomic(&path, render_report(report, plots, plots_dir, results_dir).as_bytes())?;
@@ -407,99 +390,4 @@ pub fn write_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, res
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::plot::{tests::synthetic_report, write_plots};
-
-    #[test]
-    fn sig_formats() {
-        assert_eq!(sig(0.012345678, 4), "0.01235");
-        assert_eq!(sig(1.23456e-5, 4), "1.235e-5");
-        assert_eq!(sig(9.99996, 4), "10.00");
-        assert_eq!(sig(12345.0, 4), "12345");
-        assert_eq!(sig(1.5e8, 4), "1.500e8");
-        assert_eq!(sig(-2.0, 3), "-2.00");
-        assert_eq!(sig(0.0, 4), "0");
-        assert_eq!(sig(f64::NAN, 4), "-");
-    }
-
-    #[test]
-    fn tables_are_aligned_and_escaped() {
-        let t = markdown_table(&["a", "long header"], &[vec!["x|y".into()], vec!["1".into(), "2".into()]]);
-        let lines: Vec<&str> = t.lines().collect();
-        assert_eq!(lines.len(), 4);
-        assert!(lines.iter().all(|l| l.chars().count() == lines[0].chars().count()), "{t}");
-        assert!(t.contains("x\\|y"));
-        assert!(lines[1].starts_with("|---"));
-    }
-
-    #[test]
-    fn report_shows_every_table_and_plot() {
-        let report = synthetic_report();
-        let dir = tempfile::TempDir::new().unwrap();
-        let (plots_dir, results_dir) = (dir.path().join("plots"), dir.path().join("results"));
-        std::fs::create_dir_all(&results_dir).unwrap();
-        std::fs::write(results_dir.join("summary.csv"), "x").unwrap();
-        let plots = write_plots(&report, &plots_dir).unwrap();
-        let path = write_report(&report, &plots, &plots_dir, &results_dir).unwrap();
-        assert_eq!(path, plots_dir.join("report.md"));
-        let md = std::fs::read_to_string(&path).unwrap();
-        for h in [
-            "# mcbench report: surface-smc",
-            "## Paper claims",
-            "paper value",
-            "## Convergence fits",
-            "95% CI",
-            "## Speed-ups",
-            "sample ratio",
-            "## Unbiasedness tests",
-            "detectable rel. bias",
-            "## Skipped pairs",
-            "needs a medium",
-            "## Unavailable estimators",
-            "brdf_is1_cv2",
-            "Estimator diagnostics (mean per estimate)",
-            "| cache_bytes |",
-            "| 4096        |",
-            "## Results",
-            "bias ± se",
-            "3.10e-7",
-            "[summary.csv](../results/summary.csv)",
-        ] {
-            assert!(md.contains(h), "missing {h:?} in\n{md}");
-        }
-        for kind in PlotKind::ALL {
-            let stem = plot_stem("gradient-plane", "default", kind);
-            assert!(md.contains(&format!("![{stem}]({stem}.png)")), "missing plot {stem}");
-            assert!(md.contains(&format!("([SVG]({stem}.svg))")));
-        }
-        assert!(!md.contains("## Other plots"));
-    }
-
-    #[test]
-    fn empty_or_nan_reports_do_not_panic() {
-        let dir = tempfile::TempDir::new().unwrap();
-        let mut report = synthetic_report();
-        report.rows.clear();
-        report.fits.clear();
-        report.paper[0].held = None;
-        report.paper[0].our_value = None;
-        let md = render_report(&report, &[], dir.path(), dir.path());
-        assert!(md.contains("No result rows.") && md.contains("not measured"));
-
-        let mut report = synthetic_report();
-        for r in &mut report.rows {
-            (r.rmse, r.variance, r.bias, r.seconds, r.efficiency) = (f64::NAN, f64::NAN, f64::INFINITY, 0.0, None);
-        }
-        report.tests[0].p_value = f64::NAN;
-        report.speedups.clear();
-        let plots = write_plots(&report, dir.path()).unwrap();
-        assert!(plots.is_empty());
-        let path = write_report(&report, &plots, dir.path(), dir.path()).unwrap();
-        let md = std::fs::read_to_string(path).unwrap();
-        assert!(md.contains("inf ± ") && md.contains("| - "));
-        // An extra plot not named after a group still gets embedded.
-        let md = render_report(&report, &[dir.path().join("extra.png")], dir.path(), dir.path());
-        assert!(md.contains("## Other plots") && md.contains("![extra](extra.png)"));
-    }
-}
+mod tests;

@@ -3,7 +3,8 @@
 experiment by experiment, time-derived values aside:
 - every CSV file of an experiment (summary.csv, integrals.csv and the experiments' own tables),
   with the columns named in harness/src/metrics.rs TIMING_COLUMNS (and the other time-derived
-  names below) removed, cell by cell;
+  names below) removed, cell by cell; tests.csv and claims.csv are left to the next point (they
+  are summary.json's `tests` and `paper` as tables, and a time-derived claim's value may move);
 - every claim's verdict and value in summary.json (`paper`), and the tests' verdicts and p-values.
 Claims and table columns that are time-derived are listed apart: they move with machine load.
 Prints one line per experiment and exits 1 if anything that is not time-derived differs.
@@ -19,6 +20,9 @@ TIMING = {"seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff", 
           "efficiency_renderer", "wall_seconds", "overhead", "speedup", "run_id", "overhead_wall", "speedup_wall",
           "cpu_seconds_total", "speedup_ci_low", "speedup_ci_high", "overhead_renderer", "speedup_renderer",
           "speedup_renderer_ci_low", "speedup_renderer_ci_high", "break_even_ray_ns", "git_commit", "notes"}
+
+# Tables that repeat summary.json's `tests` and `paper` (compared there, time-derived claims apart).
+COPIES = {"tests.csv", "claims.csv"}
 
 
 def timed(name):
@@ -63,7 +67,7 @@ def main(a, b):
             print(f"{exp}: missing in {b}")
             bad += 1
             continue
-        files = sorted({p.name for p in da.glob("*.csv")} | {p.name for p in db.glob("*.csv")})
+        files = sorted(({p.name for p in da.glob("*.csv")} | {p.name for p in db.glob("*.csv")}) - COPIES)
         for f in files:
             if not (da / f).exists() or not (db / f).exists():
                 notes.append(f"{f} only in one")
