@@ -44,6 +44,8 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         target_evals: 0.0,
         cache_ops: 0.0,
         rmse_display: None,
+        rmse_lo: None,
+        rmse_hi: None,
         fom_display: None,
         rep_blocks: Default::default(),
     }
