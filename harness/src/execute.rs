@@ -9,6 +9,7 @@ use crate::folder::{check_output_dir, FolderLock, OutputDir};
 use crate::metrics::SummaryRow;
 use crate::output::{self, Diagnostic, IntegralRow, Meta, RunReport};
 use crate::plan::{Plan, PreparedBed, PreparedEstimator};
+use crate::plot::DisplayNames;
 use crate::registry::{Experiment, Registry};
 use crate::runner::{self, Observer, RunOptions, RunResults};
 use estimators::budget::BudgetKind;
@@ -207,7 +208,7 @@ pub fn finish(
     output::write_summary_json(&results, &report)?;
     results.commit(&run_id, None)?;
     if opts.plots {
-        draw_with(&report, &plots_dir, &results_dir, extra_plots)?;
+        draw_with(&report, &plots_dir, &results_dir, extra_plots, opts.registry.display_names())?;
     }
     Ok(Outcome { report, results_dir, plots_dir })
 }
@@ -235,14 +236,21 @@ fn previous_budget_gate(run: &RunResults, bi: usize, ei: usize, cell: &CellResul
     Some(analysis::Gate::from_cell(&other.2, source, scale))
 }
 
-/// Draws the plots and the report of a finished run into `plots_dir` and commits them.
-pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path) -> Result<()> {
-    draw_with(report, plots_dir, results_dir, Vec::new())
+/// Draws the plots and the report of a finished run into `plots_dir` and commits them; `names`
+/// names estimators and test beds in legends and titles.
+pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path, names: &DisplayNames) -> Result<()> {
+    draw_with(report, plots_dir, results_dir, Vec::new(), names)
 }
 
-fn draw_with(report: &RunReport, plots_dir: &Path, results_dir: &Path, extra: Vec<PathBuf>) -> Result<()> {
+fn draw_with(
+    report: &RunReport,
+    plots_dir: &Path,
+    results_dir: &Path,
+    extra: Vec<PathBuf>,
+    names: &DisplayNames,
+) -> Result<()> {
     let plots = OutputDir::new(plots_dir);
-    let mut files = crate::plot::write_plots(report, plots_dir)?;
+    let mut files = crate::plot::write_plots_named(report, plots_dir, names)?;
     files.extend(extra);
     for f in &files {
         plots.record(f)?;
