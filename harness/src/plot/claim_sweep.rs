@@ -104,11 +104,14 @@ fn render<DB: DrawingBackend>(
     builder.margin(10).x_label_area_size(46).y_label_area_size(72);
     let x_range = -0.5..(n as f64 - 0.5);
     if log {
-        let mut chart = builder.build_cartesian_2d(x_range, (lo..hi).log_scale()).map_err(e)?;
-        draw_chart(&mut chart, fig).map_err(e)?;
+        // The log axis labels its ticks like the line figures' ([`super::ticks`]).
+        let (bold, light) = super::ticks::log_ticks(&(lo..hi), f64::from(SIZE.1 - 20 - 46), true);
+        let y = (lo..hi).log_scale().with_key_points(bold).with_light_points(light);
+        let mut chart = builder.build_cartesian_2d(x_range, y).map_err(e)?;
+        draw_chart(&mut chart, fig, Some(&|v: &f64| super::ticks::tick(*v))).map_err(e)?;
     } else {
         let mut chart = builder.build_cartesian_2d(x_range, lo..hi).map_err(e)?;
-        draw_chart(&mut chart, fig).map_err(e)?;
+        draw_chart(&mut chart, fig, None).map_err(e)?;
     }
     draw_legend(root, TITLE_H + SIZE.1).map_err(e)?;
     root.present().map_err(e)
@@ -143,6 +146,7 @@ fn draw_legend<DB: DrawingBackend>(
 fn draw_chart<DB: DrawingBackend, Y>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
     fig: &ClaimSweepFigure,
+    y_fmt: Option<&dyn Fn(&f64) -> String>,
 ) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>>
 where
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
@@ -156,17 +160,19 @@ where
             String::new()
         }
     };
-    chart
-        .configure_mesh()
-        .x_labels(n)
+    let mut mesh = chart.configure_mesh();
+    mesh.x_labels(n)
         .x_label_formatter(&x_fmt)
         .x_desc(&fig.x_desc)
         .y_desc(&fig.y_desc)
         .label_style((FONT, style::TICK_SIZE))
         .axis_desc_style((FONT, style::AXIS_SIZE))
         .bold_line_style(style::GRID_BOLD)
-        .light_line_style(style::GRID)
-        .draw()?;
+        .light_line_style(style::GRID);
+    if let Some(f) = y_fmt {
+        mesh.y_label_formatter(f);
+    }
+    mesh.draw()?;
     if let Some(p) = fig.paper {
         chart.draw_series(LineSeries::new(vec![(-0.5, p), (n as f64 - 0.5, p)], PAPER.stroke_width(2)))?;
     }

@@ -166,7 +166,29 @@ pub(crate) fn svg_text(
 ) -> std::result::Result<String, String> {
     let mut text = String::new();
     style::guarded(|| draw(SVGBackend::with_string(&mut text, size).into_drawing_area()))?;
-    Ok(text)
+    Ok(compact_svg(&text))
+}
+
+/// The same SVG, shorter: without the default `opacity="1"` plotters writes on every element and
+/// with font sizes to two decimals (a third of a heat map's bytes).
+fn compact_svg(text: &str) -> String {
+    let text = text.replace(" opacity=\"1\"", "");
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text.as_str();
+    const KEY: &str = "font-size=\"";
+    while let Some(i) = rest.find(KEY) {
+        let (head, tail) = rest.split_at(i + KEY.len());
+        out.push_str(head);
+        let end = tail.find('"').unwrap_or(tail.len());
+        let value = &tail[..end];
+        match value.parse::<f64>() {
+            Ok(v) => out.push_str(&format!("{}", (v * 100.0).round() / 100.0)),
+            Err(_) => out.push_str(value),
+        }
+        rest = &tail[end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// Renders a figure of `size` pixels with `draw` (given an SVG drawing area) and writes it to

@@ -29,13 +29,14 @@ pub fn budget_unit(kind: &str) -> &str {
 }
 
 /// The legend text of estimator `name` on a (test bed, variant): its display name and, when
-/// fitted, its convergence slope with the 95% interval (and the slope over the right end).
+/// fitted, its convergence slope with the 95% interval (and the slope over the right end when
+/// that is a fit over fewer budgets).
 pub fn legend(report: &RunReport, names: &DisplayNames, testbed: &str, variant: &str, name: &str) -> String {
     let mut label = names.estimator(name, Some(label_of(report, name)));
     let fit = report.fits.iter().find(|f| f.testbed == testbed && f.variant == variant && f.estimator == name);
     if let Some(f) = fit.filter(|f| f.slope.is_finite()) {
         label.push_str(&format!(": slope {:.2} [{:.2}, {:.2}]", f.slope, f.slope_ci_low, f.slope_ci_high));
-        if f.slope_right.is_finite() {
+        if f.slope_right.is_finite() && f.budgets_right.len() < f.budgets.len() {
             label.push_str(&format!(
                 ", right end {:.2} [{:.2}, {:.2}]",
                 f.slope_right, f.slope_right_ci_low, f.slope_right_ci_high

@@ -174,7 +174,7 @@ fn one_figure_of_panels_per_test_bed_as_svg_and_png() {
     // One legend entry per estimator, with its slope; the guides have their own.
     assert_eq!(svg.matches("MCMC (independent MC): slope -0.4").count(), 1, "legend text missing or repeated");
     assert!(svg.contains("IS1 + CV2: slope -0.90 ["), "legend slope missing");
-    assert!(svg.contains(", right end -0.90 ["), "legend right-end slope missing");
+    assert!(!svg.contains("right end"), "three budgets: the right end is the whole fit");
     assert!(svg.contains("slope -1/2 (guide)") && svg.contains("break-even (speed-up 1)"));
     // No band columns in the rows: no band, no note.
     assert!(!svg.contains("Shaded: 90%"));
@@ -194,6 +194,9 @@ fn bed(_: &str, _: &str) -> Option<String> {
 #[test]
 fn bands_display_names_and_the_same_bytes_twice() {
     let mut report = synthetic_report();
+    report.rows.push(row("is0_cv0", 256, 0.2 / 16.0, 2e-7 * 256.0));
+    report.rows.push(row("is1_cv2", 256, 0.15 * 256f64.powf(-0.9), 3.5e-7 * 256.0));
+    report.fits = fits(&report.rows);
     for r in &mut report.rows {
         (r.rmse_lo, r.rmse_hi) = (Some(r.rmse * 0.8), Some(r.rmse * 1.25));
     }
@@ -208,6 +211,7 @@ fn bands_display_names_and_the_same_bytes_twice() {
     let svg = read(a.path(), "gradient-plane_default_convergence.svg");
     assert!(svg.contains("surface-smc: gradient plane (a test)"), "the test bed's display name");
     assert!(svg.contains("IS1 CV2 (SMC cache): slope"), "the estimator's display name");
+    assert!(svg.contains(", right end -0.90 ["), "four budgets: the slope over the last three");
     assert!(svg.contains("MCMC (independent MC): slope"), "the registered label where the hook has none");
     assert!(svg.contains("Shaded: 90%"), "the band's note");
     assert!(svg.contains("opacity=\"0.16\""), "a shaded band");
@@ -246,4 +250,10 @@ fn names_are_sanitised() {
     assert_eq!(sanitize("a b/c.d-e_f"), "a_b_c_d-e_f");
     assert_eq!(sanitize(""), "_");
     assert_eq!(plot_stem("checker direct", "occl/uded", PlotKind::Convergence), "checker_direct_occl_uded_convergence");
+}
+
+#[test]
+fn svgs_drop_default_opacities_and_round_font_sizes() {
+    let svg = r##"<text x="1" font-size="8.064516129032258" opacity="1" fill="#000">a</text><rect opacity="0.16"/>"##;
+    assert_eq!(compact_svg(svg), r##"<text x="1" font-size="8.06" fill="#000">a</text><rect opacity="0.16"/>"##);
 }
