@@ -305,13 +305,15 @@ fn summary_files_report_target_evaluations_and_cache_operations() {
         csv.lines()
             .next()
             .unwrap_or_default()
-            .ends_with(",free_flights,target_evals,cache_ops,rmse_display,fom_display"),
+            .ends_with(",free_flights,target_evals,cache_ops,rmse_display,fom_display,rmse_lo,rmse_hi"),
         "{csv}"
     );
     for row in &out.report.rows {
         let shown = row.rmse_display.expect("display-clamped error kept");
         assert!(shown > 0.0 && shown <= row.rmse + 1e-12, "clamping to [0, 1] never adds error here: {row:?}");
         assert_eq!(row.fom_display, None, "no fetches on a surface, no FoM");
+        let band = row.rmse_lo.zip(row.rmse_hi).expect("a band over the repetition blocks");
+        assert!(band.0 <= row.rmse && row.rmse <= band.1, "the band brackets the RMSE: {band:?} {}", row.rmse);
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(res.join("summary.json")).expect("read")).expect("json");

@@ -1,6 +1,8 @@
-//! The heat maps of `canonical-sweep`: per profile, variance x cost of every estimator
-//! over (target T, sigma_samp ratio) and the measured-over-predicted variance in every cell
-//! (colour: z, the distance in error bars); and the best estimator per cell for every profile.
+//! The heat maps of `canonical-sweep`, three figures: variance x cost of every estimator over
+//! (target T, sigma_samp ratio), one row of panels per profile on one colour scale; the
+//! measured-over-predicted variance in every cell (colour: z, the distance in error bars), laid
+//! out alike; and the best estimator per cell for every profile, with and without control
+//! variates.
 
 use crate::canonical_cells::{Agreement, CellRow};
 use crate::canonical_sweep::{FAMILIES, RATIOS};
@@ -49,7 +51,8 @@ fn panels(a: &Analysis, profile: Profile, cell: &dyn Fn(&CellRow) -> HeatCell) -
                 })
                 .collect();
             let title = if fam.key == "ray-marching" { "ray marching (MSE)".into() } else { fam.key.to_string() };
-            Panel { title, columns: columns(fam.swept), cells }
+            let heading = if f == 0 { format!("profile: {}", profile.name()) } else { String::new() };
+            Panel { heading, title, columns: columns(fam.swept), cells }
         })
         .collect()
 }
@@ -62,28 +65,33 @@ fn cost_value(r: &CellRow) -> Option<f64> {
     }
 }
 
-fn var_cost_figure(a: &Analysis, profile: Profile) -> HeatFigure {
+/// The profiles the sweep ran.
+fn profiles(a: &Analysis) -> Vec<Profile> {
+    Profile::ALL.into_iter().filter(|p| a.rows.iter().any(|r| r.profile == *p)).collect()
+}
+
+fn var_cost_figure(a: &Analysis) -> HeatFigure {
     let cell = |r: &CellRow| match cost_value(r) {
         Some(v) if v < ZERO => HeatCell { fill: Fill::Empty, text: "0".into() },
         Some(v) if v.is_finite() => HeatCell { fill: Fill::Value(v.log10()), text: sig(v, 2) },
         _ => HeatCell { fill: Fill::Empty, text: "-".into() },
     };
-    let panels = panels(a, profile, &cell);
-    let logs = panels.iter().flat_map(|p| p.cells.iter().flatten()).filter_map(|c| match c.fill {
+    let all: Vec<Panel> = profiles(a).into_iter().flat_map(|p| panels(a, p, &cell)).collect();
+    let logs = all.iter().flat_map(|p| p.cells.iter().flatten()).filter_map(|c| match c.fill {
         Fill::Value(v) => Some(v),
         _ => None,
     });
     let (lo, hi) = logs.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
     HeatFigure {
-        title: format!("canonical-sweep: variance x cost / T^2 — {}", profile.name()),
+        title: "canonical-sweep: variance x cost / T^2 per profile".into(),
         rows: rows(),
-        axes: "rows: target transmittance; columns: sigma_samp / max sigma_t (own: the estimator's density); cell: variance of one estimate x fetches per estimate / T^2 (lower is better)".into(),
-        panels,
+        axes: "rows: target transmittance; columns: sigma_samp / max sigma_t (own: the estimator's density); cell: variance of one estimate x fetches per estimate / T^2 (lower is better); one colour scale for every profile".into(),
+        panels: all,
         scale: Scale::Sequential { lo: lo.min(hi), hi: hi.max(lo), label: "log10(variance x fetches / T^2)".into() },
     }
 }
 
-fn agreement_figure(a: &Analysis, profile: Profile) -> HeatFigure {
+fn agreement_figure(a: &Analysis) -> HeatFigure {
     let limit = (1.5 * a.z_crit).max(1.0);
     let cell = |r: &CellRow| {
         let ratio = r.measured.as_ref().zip(r.predicted).map(|(m, p)| m.variance / p.variance());
@@ -100,19 +108,19 @@ fn agreement_figure(a: &Analysis, profile: Profile) -> HeatFigure {
         }
     };
     HeatFigure {
-        title: format!("canonical-sweep: measured / predicted variance (paper 002 Eq. 16-20) — {}", profile.name()),
+        title: "canonical-sweep: measured / predicted variance (paper 002 Eq. 16-20) per profile".into(),
         rows: rows(),
         axes: format!(
             "cell text: measured / predicted variance; colour: z = (measured - predicted) / error bar, |z| <= {} agrees; grey (x): error bar > 25% of the prediction (unresolved); 0=0: zero-variance; n/a: no prediction",
             sig(a.z_crit, 3)
         ),
-        panels: panels(a, profile, &cell),
+        panels: profiles(a).into_iter().flat_map(|p| panels(a, p, &cell)).collect(),
         scale: Scale::Diverging { limit, label: "z (measured - predicted, in error bars)".into() },
     }
 }
 
 fn best_figure(a: &Analysis, with_cv: bool) -> HeatFigure {
-    let panels = Profile::ALL
+    let mut panels = Profile::ALL
         .iter()
         .map(|&p| {
             let cells = TARGETS
@@ -136,12 +144,14 @@ fn best_figure(a: &Analysis, with_cv: bool) -> HeatFigure {
                         .collect()
                 })
                 .collect();
-            Panel { title: p.name().into(), columns: columns(true), cells }
+            Panel { heading: String::new(), title: p.name().into(), columns: columns(true), cells }
         })
-        .collect();
-    let which = if with_cv { "every estimator" } else { "without control variates" };
+        .collect::<Vec<_>>();
+    if let Some(first) = panels.first_mut() {
+        first.heading = if with_cv { "every estimator" } else { "without control variates" }.into();
+    }
     HeatFigure {
-        title: format!("canonical-sweep: lowest measured variance x cost per cell ({which})"),
+        title: "canonical-sweep: lowest measured variance x cost per cell".into(),
         rows: rows(),
         axes: "rows: target transmittance; columns: sigma_samp / max sigma_t; ?: the winner's variance is not resolved (heavy tails); ≈: the runner-up is within two error bars; RT/DP and DT/ST: one estimator at ratio >= 1".into(),
         panels,
@@ -150,13 +160,14 @@ fn best_figure(a: &Analysis, with_cv: bool) -> HeatFigure {
     }
 }
 
-/// Writes every heat map into `dir` and returns the files.
+/// Writes the three heat-map figures into `dir` and returns the files.
 pub fn heat_maps(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut files = write_heatmap(dir, "heat_best_estimator", &best_figure(a, true))?;
-    files.extend(write_heatmap(dir, "heat_best_without_cv", &best_figure(a, false))?);
-    for p in Profile::ALL.into_iter().filter(|p| a.rows.iter().any(|r| r.profile == *p)) {
-        files.extend(write_heatmap(dir, &format!("heat_var_cost_{}", p.name()), &var_cost_figure(a, p))?);
-        files.extend(write_heatmap(dir, &format!("heat_agreement_{}", p.name()), &agreement_figure(a, p))?);
+    let mut best = best_figure(a, true);
+    best.panels.extend(best_figure(a, false).panels);
+    let mut files = write_heatmap(dir, "heat_best_estimator", &best)?;
+    if !profiles(a).is_empty() {
+        files.extend(write_heatmap(dir, "heat_var_cost", &var_cost_figure(a))?);
+        files.extend(write_heatmap(dir, "heat_agreement", &agreement_figure(a))?);
     }
     Ok(files)
 }

@@ -165,8 +165,10 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
     assert!(!cells.contains("DISAGREES"), "{cells}");
     let winners = std::fs::read_to_string(out.results_dir.join("winners.md")).unwrap();
     assert!(winners.contains("## hole") && winners.contains("DP+M"), "{winners}");
-    for stem in ["heat_best_estimator", "heat_var_cost_hole", "heat_agreement_linear-up"] {
+    for stem in ["heat_best_estimator", "heat_var_cost", "heat_agreement"] {
         assert!(out.plots_dir.join(format!("{stem}.png")).is_file(), "{stem}");
     }
-    assert!(!out.plots_dir.join("heat_var_cost_step.png").exists(), "no heat maps of profiles not run");
+    let grid = std::fs::read_to_string(out.plots_dir.join("heat_var_cost.svg")).unwrap();
+    assert!(grid.contains("profile: hole") && grid.contains("profile: linear-up"), "a heading per profile run");
+    assert!(!grid.contains("profile: step"), "no panels of profiles not run");
 }

@@ -9,7 +9,7 @@ use mcbench::error::{HarnessError, Result};
 use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
-use mcbench::plot::{write_figure, Figure, Series};
+use mcbench::plot::{write_panels, Figure, Panels, Series};
 use mcbench::runner::RunResults;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -157,12 +157,22 @@ fn bridges_halve(report: &RunReport, frames: usize, (one, five): (Option<f64>, O
 }
 
 fn series(label: &str, style: usize, points: Vec<(f64, f64)>) -> Series {
-    Series {
-        label: label.into(),
-        style,
-        points: points.into_iter().filter(|(x, y)| *x > 0.0 && *y > 0.0 && y.is_finite()).collect(),
-    }
+    Series::new(label, style, points.into_iter().filter(|(x, y)| *x > 0.0 && *y > 0.0 && y.is_finite()).collect())
 }
+
+/// The figures of the post-run analysis: (file stem, title, the stems of its panels).
+const FIGURES: [(&str, &str, [&str; 2]); 2] = [
+    (
+        "lns_rmse_and_resampled_vs_p",
+        "envmap-smc: paper 004 Fig. 3 and §7 against P, mixed BRDF",
+        ["a_lns_rmse_vs_p", "c_share_resampled_vs_p"],
+    ),
+    (
+        "lr_rmse_per_frame",
+        "envmap-smc: paper 004 Fig. 4-5, RMSE of L_r per frame at equal time",
+        ["b_lr_rmse_per_frame_specular", "b_lr_rmse_per_frame_mixed"],
+    ),
+];
 
 /// The experiment's post-run analysis (see the module doc).
 pub fn post(
@@ -198,9 +208,9 @@ pub fn post(
 
     // (a) RMSE of L_ns at the first propagated frame (paper Fig. 3: one 1.5 degree rotation) vs P.
     let families = [
-        ("smc", "moves", "single distribution, P MH moves"),
-        ("smc_bridge", "bridges", "P bridges, ratio (Eq. 10)"),
-        ("smc_path", "bridges", "P bridges, path sampling (Eq. 15)"),
+        ("smc", "moves", "SMC, one distribution, P MH moves"),
+        ("smc_bridge", "bridges", "SMC, ratio, P bridges (Eq. 10)"),
+        ("smc_path", "bridges", "SMC, path sampling, P bridges (Eq. 15)"),
     ];
     let ps = p_values(mode);
     let lns_at =
@@ -216,10 +226,11 @@ pub fn post(
     figures.push((
         "a_lns_rmse_vs_p".into(),
         Figure {
-            title: "envmap-smc (a): RMSE of L_ns at frame 2 vs P (paper 004 Fig. 3), mixed BRDF".into(),
+            title: "(a) RMSE of L_ns at frame 2 vs P (Fig. 3)".into(),
             x_desc: "P (MH moves or intermediate distributions)".into(),
             y_desc: "RMSE of L_ns".into(),
             series: fig_a,
+            guides: Vec::new(),
         },
     ));
     // (b) RMSE of L_r per frame, SMC (P = 5 path sampling, as in Fig. 4-5) vs bidirectional IS at
@@ -254,10 +265,11 @@ pub fn post(
         figures.push((
             format!("b_lr_rmse_per_frame_{variant}"),
             Figure {
-                title: format!("envmap-smc (b): RMSE of L_r per frame at equal time, {variant} BRDF (paper 004 {fig})"),
+                title: format!("RMSE of L_r per frame, {variant} BRDF ({fig})"),
                 x_desc: "frame".into(),
                 y_desc: "RMSE of L_r".into(),
                 series: s,
+                guides: Vec::new(),
             },
         ));
     }
@@ -281,10 +293,11 @@ pub fn post(
     figures.push((
         "c_share_resampled_vs_p".into(),
         Figure {
-            title: "envmap-smc (c): share of pixels resampled per frame vs P, mixed BRDF (paper 004 §7)".into(),
+            title: "(b) share of pixels resampled per frame vs P (§7)".into(),
             x_desc: "P (MH moves or intermediate distributions)".into(),
             y_desc: "share of pixels resampled".into(),
             series: fig_c,
+            guides: Vec::new(),
         },
     ));
     let (one, five) = (share("smc[moves=5]"), share("smc_path[bridges=5]"));
@@ -360,9 +373,15 @@ pub fn post(
     report.tests.extend(dedicated);
     let mut files = Vec::new();
     if let Some(dir) = plots_dir {
-        for (stem, fig) in &figures {
-            if fig.series.iter().any(|s| !s.points.is_empty()) {
-                files.extend(write_figure(dir, stem, fig)?);
+        for (stem, title, parts) in FIGURES {
+            let panels: Vec<Figure> = parts
+                .iter()
+                .filter_map(|p| figures.iter().find(|(s, _)| s == p).map(|(_, f)| f.clone()))
+                .filter(|f| f.series.iter().any(|s| !s.points.is_empty()))
+                .collect();
+            if !panels.is_empty() {
+                let fig = Panels { title: title.into(), panels, keys: Vec::new(), note: String::new() };
+                files.extend(write_panels(dir, stem, &fig)?);
             }
         }
     }

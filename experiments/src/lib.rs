@@ -18,6 +18,7 @@ pub mod envmap_smc_post;
 pub mod envmap_unbiasedness;
 pub mod media_smc;
 pub mod media_smc_post;
+pub mod names;
 pub mod particle_sweep;
 pub mod particle_sweep_post;
 pub mod pmc_hi;
@@ -87,7 +88,9 @@ pub fn registry() -> Registry {
     let r = papers.iter().fold(Registry::builtin().without_experiments(), |r, d| r.with_experiment(d.experiment()));
     let r = r.with_experiment(mcbench::unbiasedness::experiment());
     let r = last.iter().fold(r, |r, d| r.with_experiment(d.experiment()));
-    r.with_experiment_on_demand(mcbench::calibration::experiment()).with_experiment_on_demand(sensitivity::experiment())
+    r.with_experiment_on_demand(mcbench::calibration::experiment())
+        .with_experiment_on_demand(sensitivity::experiment())
+        .with_display_names(names::DISPLAY)
 }
 
 /// The registry for the crate's own tests: [`registry`] reading the repository's stored

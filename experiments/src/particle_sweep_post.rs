@@ -10,7 +10,7 @@ use mcbench::folder::OutputDir;
 use mcbench::metrics::SummaryRow;
 use mcbench::output::RunReport;
 use mcbench::plan::Plan;
-use mcbench::plot::{write_figure, Figure, Series};
+use mcbench::plot::{write_panels, Figure, Line, Panels, Series};
 use mcbench::runner::RunResults;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -71,34 +71,43 @@ pub fn post(
     results.write_csv("fom.csv", &rows)?;
     let Some(dir) = plots else { return Ok(Vec::new()) };
     let budget = report.rows.iter().map(|r| r.budget).max().unwrap_or(0);
-    let mut files = Vec::new();
+    let mut panels = Vec::new();
     for tb in ["eq21-medium", "perlin-medium"] {
         let rows: Vec<&SummaryRow> = report.rows.iter().filter(|r| r.testbed == tb && r.budget == budget).collect();
         let mut series = Vec::new();
         for (style, model) in IDS.iter().enumerate() {
-            let mut points: Vec<(f64, f64)> = if *model == "delta_tracking" {
+            let name = crate::names::estimator(model).unwrap_or_else(|| model.to_string());
+            if *model == "delta_tracking" {
                 let f = rows.iter().find(|r| r.estimator == *model).and_then(|r| r.fom);
-                f.map(|f| vec![(SIGMAS[0], f), (SIGMAS[SIGMAS.len() - 1], f)]).unwrap_or_default()
-            } else {
-                rows.iter()
-                    .filter(|r| model_of(&r.estimator) == *model)
-                    .filter_map(|r| Some((sigma_of(&r.estimator)?, r.fom?)))
-                    .filter(|(s, f)| *s > 0.0 && *f > 0.0)
-                    .collect()
-            };
+                let points = f.map(|f| vec![(SIGMAS[0], f), (SIGMAS[SIGMAS.len() - 1], f)]).unwrap_or_default();
+                let label = format!("{name} (majorant 1, no σ_samp)");
+                series.push(Series::new(label, style, points).with_line(Line::Dashed).without_markers());
+                continue;
+            }
+            let mut points: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| model_of(&r.estimator) == *model)
+                .filter_map(|r| Some((sigma_of(&r.estimator)?, r.fom?)))
+                .filter(|(s, f)| *s > 0.0 && *f > 0.0)
+                .collect();
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let label = if *model == "delta_tracking" { "delta_tracking (majorant 1, no sigma_samp)" } else { model };
-            series.push(Series { label: label.to_string(), style, points });
+            series.push(Series::new(name, style, points));
         }
-        let fig = Figure {
-            title: format!("particle-sweep: paper 002 Fig. 6-7 — FoM vs σ_samp at {budget} fetches, {tb}"),
-            x_desc: "sampling density σ_samp (max extinction = 1)".into(),
-            y_desc: "FoM = 1 / (MSE × fetches)".into(),
+        let bed = crate::names::testbed(tb, "multiple").unwrap_or_else(|| tb.to_string());
+        panels.push(Figure::new(
+            bed,
+            "sampling density σ_samp (max extinction = 1)",
+            "FoM = 1 / (MSE × fetches)",
             series,
-        };
-        files.extend(write_figure(dir, &format!("{tb}_fom_vs_sigma_samp"), &fig)?);
+        ));
     }
-    Ok(files)
+    let fig = Panels {
+        title: format!("particle-sweep: paper 002 Fig. 6-7, FoM vs σ_samp at {budget} fetches"),
+        panels,
+        keys: Vec::new(),
+        note: String::new(),
+    };
+    write_panels(dir, "fom_vs_sigma_samp", &fig)
 }
 
 #[cfg(test)]

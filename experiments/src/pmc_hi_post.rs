@@ -136,7 +136,7 @@ pub fn post(
     let Some(est) = plan.estimators.iter().find(|e| e.name == "pmc_hi") else { return Ok(Vec::new()) };
     let budget = Budget::samples(FIG7_SPP).map_err(|e| HarnessError::write("fig7", e))?;
     let mut alphas = Vec::new();
-    let mut files = Vec::new();
+    let mut panels: Vec<Map> = Vec::new();
     for bed in plan.beds.iter().filter(|b| b.bed.hemisphere().is_some_and(|h| h.lights().len() == 2)) {
         let (w, h) = bed.bed.resolution();
         let label = bed.label();
@@ -166,25 +166,22 @@ pub fn post(
                 alpha_cone: maps[3][i],
             });
         }
-        if let Some(dir) = plots {
-            let panels: Vec<Map> = maps
-                .into_iter()
-                .zip(WEIGHTS)
-                .map(|(values, (_, label))| Map {
-                    label: label.into(),
-                    width: w,
-                    height: h,
-                    values,
-                    scale: Scale::Linear(0.0, 1.0),
-                })
-                .collect();
-            let title = format!(
-                "pmc-hi: paper 003 Fig. 7, PMC-HI weights after {FIG7_SPP} samples, checker-direct / {}",
-                bed.variant
-            );
-            files.extend(write_maps(dir, &format!("fig7_{}", bed.variant), &title, &panels)?);
-        }
+        let heading = crate::names::testbed(&bed.spec.id, &bed.variant).unwrap_or_else(|| bed.label());
+        panels.extend(maps.into_iter().zip(WEIGHTS).enumerate().map(|(k, (values, (_, label)))| Map {
+            heading: if k == 0 { heading.clone() } else { String::new() },
+            label: label.into(),
+            width: w,
+            height: h,
+            values,
+            scale: Scale::Linear(0.0, 1.0),
+        }));
     }
     results.write_csv("alpha_maps.csv", &alphas)?;
-    Ok(files)
+    match plots {
+        Some(dir) if !panels.is_empty() => {
+            let title = format!("pmc-hi: paper 003 Fig. 7, PMC-HI weights after {FIG7_SPP} samples");
+            write_maps(dir, "fig7", &title, &panels)
+        }
+        _ => Ok(Vec::new()),
+    }
 }

@@ -190,7 +190,7 @@ pub fn post(
     let budget = 10;
     let Some(ip) = pmc_ip_of(plan, "pmc_ip") else { return Ok(Vec::new()) };
     let mut rows = Vec::new();
-    let mut files = Vec::new();
+    let mut all: Vec<Map> = Vec::new();
     for (bi, bed) in plan.beds.iter().enumerate() {
         let (w, h) = bed.bed.resolution();
         let pixels = w * h;
@@ -213,12 +213,15 @@ pub fn post(
             var_uniform_10: var_u[p],
             var_pmc_ip_10: var_p[p],
         }));
-        let Some(dir) = plots else { continue };
+        if plots.is_none() {
+            continue;
+        }
         let channel = |img: &[Rgb]| img.iter().map(|v| v[0]).collect::<Vec<f64>>();
         let images = [reference.clone(), channel(&trace.initial_image), channel(&trace.estimate), channel(&uniform)];
         let radiance = Scale::log_of(images.iter().map(|v| v.as_slice()));
         let variance = Scale::log_of([var_u.as_slice(), var_p.as_slice()]);
         let map = |label: &str, values: Vec<f64>, scale: Scale| Map {
+            heading: String::new(),
             label: label.into(),
             width: w,
             height: h,
@@ -227,7 +230,7 @@ pub fn post(
         };
         let [r0, r1, r2, r3] = images;
         let sched = schedule(&ip, budget);
-        let maps = vec![
+        let mut maps = vec![
             map("reference", r0, radiance),
             map(&format!("initial image ({} spp)", ip.initial.min(budget)), r1, radiance),
             map("alpha(1) x pixels", alpha.clone(), Scale::log_of([alpha.as_slice()])),
@@ -237,12 +240,15 @@ pub fn post(
             map(&format!("variance, PMC-IP {sched}"), var_p, variance),
             map(&format!("variance, uniform {budget} spp"), var_u, variance),
         ];
-        let title = format!(
-            "pmc-ip: paper 003 Fig. 4 on checker-image / {} ({} reps for variances)",
-            bed.variant, plan.sweep.reps
-        );
-        files.extend(write_maps(dir, &format!("fig4_{}", bed.variant), &title, &maps)?);
+        maps[0].heading = crate::names::testbed(&bed.spec.id, &bed.variant).unwrap_or_else(|| bed.label());
+        all.extend(maps);
     }
     results.write_csv("pixels.csv", &rows)?;
-    Ok(files)
+    match plots {
+        Some(dir) if !all.is_empty() => {
+            let title = format!("pmc-ip: paper 003 Fig. 4 ({} reps for variances)", plan.sweep.reps);
+            write_maps(dir, "fig4", &title, &all)
+        }
+        _ => Ok(Vec::new()),
+    }
 }

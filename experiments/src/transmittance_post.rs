@@ -3,7 +3,8 @@
 //! ([`crate::variance_claims::CASES`]) and s = 1, 2, ..., 20 it writes the exact T(s), the predicted
 //! standard deviation and the measured mean and standard deviation of 4000 one-ray estimates to
 //! `fig8_bands.csv`, and plots the relative standard deviation sd / T against s (log-log: the
-//! band T +- sd has a negative lower edge where sd > T), predicted beside measured.
+//! band T +- sd has a negative lower edge where sd > T): one colour per case, measured solid with
+//! markers, Eq. 16's prediction dashed.
 
 use crate::variance_claims::{build, central_ray, measure, Measured, CASES};
 use estimators::math::Vec3;
@@ -12,7 +13,7 @@ use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
-use mcbench::plot::{write_figure, Figure, Series};
+use mcbench::plot::{write_panels, Figure, Key, Line, Panels, Series};
 use mcbench::runner::RunResults;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -81,9 +82,9 @@ pub fn post(
             p_pts.push((s, v.sqrt() / t));
             m_pts.push((s, variance.sqrt() / t));
         }
-        let name = format!("{id} σ_samp={samp}");
-        series.push(Series { label: format!("{name}: Eq. 16"), style: 2 * ci, points: p_pts });
-        series.push(Series { label: format!("{name}: measured"), style: 2 * ci + 1, points: m_pts });
+        let name = crate::names::estimator(&format!("{id}[sigma_samp={samp}]")).unwrap_or_else(|| id.to_string());
+        series.push(Series::new(name, ci, m_pts));
+        series.push(Series::new("", ci, p_pts).with_line(Line::Dashed).without_markers());
         report.paper.push(Claim {
             testbed: "eq21-medium/central-ray".into(),
             claim: format!("paper 002 Fig. 8 ({id}, sigma_samp {samp}): the measured standard-deviation band of T(s) matches Eq. 16 along the ray"),
@@ -96,11 +97,24 @@ pub fn post(
     }
     results.write_csv("fig8_bands.csv", &rows)?;
     let Some(dir) = plots else { return Ok(Vec::new()) };
-    let fig = Figure {
-        title: "transmittance: paper 002 Fig. 8 — relative std sd[T̂(s)] / T(s), eq21 central ray".into(),
-        x_desc: "distance s along the ray".into(),
-        y_desc: "relative standard deviation of a one-ray estimate".into(),
+    let chart = Figure::new(
+        "",
+        "distance s along the ray",
+        "relative standard deviation sd[T̂(s)] / T(s) of a one-ray estimate",
         series,
+    );
+    let fig = Panels {
+        title: "transmittance: paper 002 Fig. 8, Eq. 21 medium, central ray".into(),
+        panels: vec![chart],
+        keys: vec![
+            Key {
+                label: format!("solid: measured ({RAYS} one-ray estimates per point)"),
+                line: Line::Solid,
+                marker: true,
+            },
+            Key { label: "dashed: predicted by Eq. 16".into(), line: Line::Dashed, marker: false },
+        ],
+        note: String::new(),
     };
-    write_figure(dir, "fig8_bands", &fig)
+    write_panels(dir, "fig8_bands", &fig)
 }

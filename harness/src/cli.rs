@@ -418,7 +418,7 @@ enum Checked {
 
 /// `mcbench plot`: redraws a finished run's plots into `<plots>/<results folder's name>` (the
 /// folder name comes from the command line, never from the files read).
-fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, _registry: &Registry) -> Result<()> {
+fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, registry: &Registry) -> Result<()> {
     let name = std::fs::canonicalize(results_dir)
         .ok()
         .and_then(|p| p.file_name().and_then(|n| n.to_str()).map(String::from))
@@ -428,7 +428,7 @@ fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, _reg
     let dir = plots.join(&name);
     crate::folder::check_output_dir("--plots", &dir)?;
     let _lock = crate::folder::FolderLock::acquire(&dir, wait, &[])?;
-    execute::draw(&report, &dir, results_dir)?;
+    execute::draw(&report, &dir, results_dir, registry.display_names())?;
     println!("plots, report.md and index.html written to {}", dir.display());
     Ok(())
 }

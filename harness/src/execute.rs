@@ -9,6 +9,7 @@ use crate::folder::{check_output_dir, FolderLock, OutputDir};
 use crate::metrics::SummaryRow;
 use crate::output::{self, Diagnostic, IntegralRow, Meta, RunReport};
 use crate::plan::{Plan, PreparedBed, PreparedEstimator};
+use crate::plot::DisplayNames;
 use crate::registry::{Experiment, Registry};
 use crate::runner::{self, Observer, RunOptions, RunResults};
 use estimators::budget::BudgetKind;
@@ -208,7 +209,7 @@ pub fn finish(
     crate::report::write_tables(&results, &report)?;
     results.commit(&run_id, None)?;
     if opts.plots {
-        draw_with(&report, &plots_dir, &results_dir, extra_plots, &integrals)?;
+        draw_with(&report, &plots_dir, &results_dir, extra_plots, &integrals, opts.registry.display_names())?;
     }
     Ok(Outcome { report, results_dir, plots_dir })
 }
@@ -238,10 +239,10 @@ fn previous_budget_gate(run: &RunResults, bi: usize, ei: usize, cell: &CellResul
 
 /// Draws the plots, `report.md` and `index.html` of a finished run into `plots_dir` (the per-pixel
 /// maps from the results folder's `integrals.csv`), commits them, and rewrites the plots root's
-/// `index.html`.
-pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path) -> Result<()> {
+/// `index.html`; `names` names estimators and test beds in legends and titles.
+pub fn draw(report: &RunReport, plots_dir: &Path, results_dir: &Path, names: &DisplayNames) -> Result<()> {
     let integrals = crate::html::read_integrals(results_dir)?;
-    draw_with(report, plots_dir, results_dir, Vec::new(), &integrals)
+    draw_with(report, plots_dir, results_dir, Vec::new(), &integrals, names)
 }
 
 fn draw_with(
@@ -250,9 +251,10 @@ fn draw_with(
     results_dir: &Path,
     extra: Vec<PathBuf>,
     integrals: &[IntegralRow],
+    names: &DisplayNames,
 ) -> Result<()> {
     let plots = OutputDir::new(plots_dir);
-    let mut files = crate::plot::write_plots(report, plots_dir)?;
+    let mut files = crate::plot::write_plots_named(report, plots_dir, names)?;
     files.extend(extra);
     for f in &files {
         plots.record(f)?;

@@ -132,6 +132,14 @@ pub struct SummaryRow {
     /// Figure of merit on display-clamped values, 1 / (`rmse_display`^2 x fetches).
     #[serde(default)]
     pub fom_display: Option<f64>,
+    /// Low end of the 90% bootstrap interval of `rmse` over the cell's repetition blocks
+    /// ([`crate::rmse_band`]; the band of the RMSE plots). Empty for cells with fewer than two
+    /// blocks and in files written before it.
+    #[serde(default)]
+    pub rmse_lo: Option<f64>,
+    /// High end of that interval.
+    #[serde(default)]
+    pub rmse_hi: Option<f64>,
     /// The cell's repetition blocks, for the bootstrap intervals of ratio claims: carried in memory
     /// only (neither `summary.csv` nor `summary.json` has them), so rows read back from files, and
     /// rows of cells stored before blocks were kept, have none and fall back to the delta method.
@@ -244,6 +252,11 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         .then(|| cell.blocks.iter().map(|b| b.display_sq).sum::<Option<f64>>())
         .flatten()
         .map(|s| s / cell.blocks.iter().map(|b| b.reps).sum::<u64>().max(1) as f64);
+    let band = {
+        let held = cell.blocks.iter().map(|b| b.reps).sum::<u64>().max(1) as f64;
+        let offset = mse_v - cell.blocks.iter().map(|b| b.sq).sum::<f64>() / held;
+        crate::rmse_band::rmse_band(&cell.blocks, offset, crate::rmse_band::seed(&cell.key))
+    };
     let rep_blocks = if cpu && !cell.blocks.is_empty() {
         let held = cell.blocks.iter().map(|b| b.reps).sum::<u64>().max(1) as f64;
         let (sq, pe) = cell.blocks.iter().fold((0.0, 0.0), |(s, p), b| (s + b.sq, p + b.p_err));
@@ -296,6 +309,8 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         cache_ops: per(cell.costs.cache_ops),
         rmse_display: display_mse.map(f64::sqrt),
         fom_display: display_mse.filter(|_| fetches > 0.0).and_then(|m| inverse(m * fetches)),
+        rmse_lo: band.map(|b| b.0),
+        rmse_hi: band.map(|b| b.1),
         rep_blocks,
     }
 }

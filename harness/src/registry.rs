@@ -20,6 +20,7 @@ use crate::error::Result;
 use crate::folder::OutputDir;
 use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
+use crate::plot::DisplayNames;
 use crate::references::ReferenceDir;
 use crate::runner::RunResults;
 use estimators::error::ConfigError;
@@ -104,6 +105,7 @@ pub struct Registry {
     /// Names of experiments that run only when named (not in the default suite).
     on_demand: Vec<String>,
     references: Arc<dyn ReferenceSource>,
+    display_names: DisplayNames,
 }
 
 impl Default for Registry {
@@ -114,6 +116,7 @@ impl Default for Registry {
             experiments: Vec::new(),
             on_demand: Vec::new(),
             references: Arc::new(ReferenceDir::new(DEFAULT_REFERENCES)),
+            display_names: DisplayNames::NONE,
         }
     }
 }
@@ -168,6 +171,18 @@ impl Registry {
     /// Where test beds find stored references.
     pub fn references(&self) -> &dyn ReferenceSource {
         self.references.as_ref()
+    }
+
+    /// Names estimators and test beds in plots' legends and titles with `names` (a suite's
+    /// vocabulary; ids and registered labels where it has none).
+    pub fn with_display_names(mut self, names: DisplayNames) -> Self {
+        self.display_names = names;
+        self
+    }
+
+    /// The display names of plots.
+    pub fn display_names(&self) -> &DisplayNames {
+        &self.display_names
     }
 
     /// Adds an estimator.

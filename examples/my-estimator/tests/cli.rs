@@ -42,7 +42,7 @@ fn the_crate_runs_its_sweep_with_plots_tests_and_claims() {
     let tests = summary["tests"].as_array().expect("tests");
     assert!(tests.iter().any(|t| t["estimator"] == "antithetic_cosine" && t["agrees"] == true));
     let plots = dir.path().join("plots/my-sweep");
-    assert!(plots.join("tilted-patches_matte_rmse.svg").is_file() && plots.join("report.md").is_file());
+    assert!(plots.join("tilted-patches_matte_convergence.svg").is_file() && plots.join("report.md").is_file());
 }
 
 #[test]

@@ -291,6 +291,8 @@ mod tests {
             target_evals: 0.0,
             cache_ops: 0.0,
             rmse_display: None,
+            rmse_lo: None,
+            rmse_hi: None,
             fom_display: None,
             rep_blocks: Default::default(),
         };

@@ -1,19 +1,23 @@
 //! A claim judged across the settings of one parameter: the claim's value at every setting with
 //! its interval, the paper's number as a horizontal line, and the verdict as the marker (filled
 //! green circle held, red cross not held, hollow grey circle inconclusive or reported) and, where
-//! the scene bounds the claim, its ceiling (orange triangle). The x axis
-//! is categorical (one slot per setting, labelled with the setting), so numeric and named
+//! the scene bounds the claim, its ceiling (orange triangle); a legend strip below says so. The x
+//! axis is categorical (one slot per setting, labelled with the setting), so numeric and named
 //! settings (a variant, a rule) plot alike; the y axis is logarithmic when every value is positive
-//! and they span more than a decade.
+//! and they span more than a decade. Drawn in the figures' style ([`super::style`]).
 
-use super::{ensure_font, write_png_with, PLOT_SIZE};
+use super::style::{self, named, text, FONT, LEGEND_ROW, MARGIN, TITLE_H};
 use crate::error::{HarnessError, Result};
-use crate::output::write_atomic;
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::{Path, PathBuf};
+
+/// Width and height of the chart; the legend strip adds [`LEGEND_H`].
+const SIZE: (u32, u32) = (900, 520);
+const LEGEND_H: u32 = 2 * LEGEND_ROW + 10;
 
 /// One setting of the swept parameter.
 #[derive(Clone, Debug, PartialEq)]
@@ -72,28 +76,18 @@ impl ClaimSweepFigure {
 pub fn write_claim_sweep(dir: &Path, stem: &str, fig: &ClaimSweepFigure) -> Result<Vec<PathBuf>> {
     let Some(range) = fig.y_range() else { return Ok(Vec::new()) };
     std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
-    ensure_font(dir)?;
     let (svg, png) = (dir.join(format!("{stem}.svg")), dir.join(format!("{stem}.png")));
-    let mut text = String::new();
-    guarded(|| render(&SVGBackend::with_string(&mut text, PLOT_SIZE).into_drawing_area(), fig, range))
-        .map_err(|e| HarnessError::write(&svg, e))?;
-    write_atomic(&svg, text.as_bytes())?;
-    write_png_with(&png, |tmp| {
-        guarded(|| render(&BitMapBackend::new(tmp, PLOT_SIZE).into_drawing_area(), fig, range))
-    })?;
+    let size = (SIZE.0, TITLE_H + SIZE.1 + LEGEND_H);
+    super::write_svg(&svg, size, |root| render(&root, fig, range))?;
+    super::png::write_png(&png, size, |root| render(&root, fig, range))?;
     Ok(vec![svg, png])
 }
 
-fn guarded<F: FnOnce() -> std::result::Result<(), String>>(f: F) -> std::result::Result<(), String> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f))
-        .unwrap_or_else(|_| Err("the plotting library panicked".to_string()))
-}
-
-const GREEN: RGBColor = RGBColor(0, 140, 60);
-const RED: RGBColor = RGBColor(200, 30, 30);
-const GREY: RGBColor = RGBColor(110, 110, 110);
-const PAPER: RGBColor = RGBColor(40, 70, 200);
-const CEILING: RGBColor = RGBColor(230, 120, 0);
+const GREEN: RGBColor = named::GREEN;
+const RED: RGBColor = named::RED;
+const GREY: RGBColor = style::GUIDE;
+const PAPER: RGBColor = named::BLUE;
+const CEILING: RGBColor = named::ORANGE;
 
 fn render<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
@@ -102,24 +96,57 @@ fn render<DB: DrawingBackend>(
 ) -> std::result::Result<(), String> {
     let e = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(e)?;
+    let title = text(style::TITLE_SIZE, BLACK).pos(Pos::new(HPos::Center, VPos::Top));
+    root.draw(&Text::new(fig.title.clone(), (SIZE.0 as i32 / 2, 10), title)).map_err(e)?;
+    let chart_area = root.clone().shrink((0, TITLE_H), SIZE);
     let n = fig.points.len().max(1);
-    let mut builder = ChartBuilder::on(root);
-    builder.margin(16).caption(&fig.title, ("sans-serif", 18)).x_label_area_size(50).y_label_area_size(80);
+    let mut builder = ChartBuilder::on(&chart_area);
+    builder.margin(10).x_label_area_size(46).y_label_area_size(72);
     let x_range = -0.5..(n as f64 - 0.5);
     if log {
-        let mut chart = builder.build_cartesian_2d(x_range, (lo..hi).log_scale()).map_err(e)?;
-        draw_chart(&mut chart, fig).map_err(e)?;
+        // The log axis labels its ticks like the line figures' ([`super::ticks`]).
+        let (bold, light) = super::ticks::log_ticks(&(lo..hi), f64::from(SIZE.1 - 20 - 46), true);
+        let y = (lo..hi).log_scale().with_key_points(bold).with_light_points(light);
+        let mut chart = builder.build_cartesian_2d(x_range, y).map_err(e)?;
+        draw_chart(&mut chart, fig, Some(&|v: &f64| super::ticks::tick(*v))).map_err(e)?;
     } else {
         let mut chart = builder.build_cartesian_2d(x_range, lo..hi).map_err(e)?;
-        draw_chart(&mut chart, fig).map_err(e)?;
+        draw_chart(&mut chart, fig, None).map_err(e)?;
     }
+    draw_legend(root, TITLE_H + SIZE.1).map_err(e)?;
     root.present().map_err(e)
+}
+
+/// The legend strip: what the markers and lines mean.
+fn draw_legend<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    top: u32,
+) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let label = text(style::LEGEND_SIZE, BLACK).pos(Pos::new(HPos::Left, VPos::Center));
+    let entries = ["held", "not held", "inconclusive or reported", "scene's ceiling", "paper's number", "interval"];
+    let font = (FONT, style::LEGEND_SIZE).into_font();
+    let (mut x, y) = (MARGIN as i32, (top + 4 + LEGEND_ROW / 2) as i32);
+    for (k, name) in entries.iter().enumerate() {
+        let c = (x + 15, y);
+        match k {
+            0 => root.draw(&Circle::new(c, 6, GREEN.filled()))?,
+            1 => root.draw(&Cross::new(c, 7, RED.stroke_width(3)))?,
+            2 => root.draw(&Circle::new(c, 6, GREY.stroke_width(2)))?,
+            3 => root.draw(&TriangleMarker::new(c, 7, CEILING.filled()))?,
+            4 => root.draw(&PathElement::new(vec![(x, y), (x + 30, y)], PAPER.stroke_width(2)))?,
+            _ => root.draw(&PathElement::new(vec![(x + 15, y - 8), (x + 15, y + 8)], GREY.stroke_width(2)))?,
+        }
+        root.draw(&Text::new(name.to_string(), (x + 38, y), label.clone()))?;
+        x += 38 + font.box_size(name).map(|b| b.0 as i32).unwrap_or(80) + 24;
+    }
+    Ok(())
 }
 
 /// The mesh (one x label per setting), the paper's line and the points, on either y axis.
 fn draw_chart<DB: DrawingBackend, Y>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, Y>>,
     fig: &ClaimSweepFigure,
+    y_fmt: Option<&dyn Fn(&f64) -> String>,
 ) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>>
 where
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
@@ -133,14 +160,19 @@ where
             String::new()
         }
     };
-    chart
-        .configure_mesh()
-        .x_labels(n)
+    let mut mesh = chart.configure_mesh();
+    mesh.x_labels(n)
         .x_label_formatter(&x_fmt)
         .x_desc(&fig.x_desc)
         .y_desc(&fig.y_desc)
-        .label_style(("sans-serif", 14))
-        .draw()?;
+        .label_style((FONT, style::TICK_SIZE))
+        .axis_desc_style((FONT, style::AXIS_SIZE))
+        .bold_line_style(style::GRID_BOLD)
+        .light_line_style(style::GRID);
+    if let Some(f) = y_fmt {
+        mesh.y_label_formatter(f);
+    }
+    mesh.draw()?;
     if let Some(p) = fig.paper {
         chart.draw_series(LineSeries::new(vec![(-0.5, p), (n as f64 - 0.5, p)], PAPER.stroke_width(2)))?;
     }

@@ -1,26 +1,27 @@
 //! Heat maps: panels of coloured cells (one panel per estimator, rows and columns two swept
 //! parameters), each cell annotated, with a colour bar (sequential or diverging scale) or a legend
-//! of categories. Written as SVG and PNG like the line plots, with the bundled font.
+//! of categories. Panels flow left to right; a panel with a heading starts a new row under that
+//! heading, so one figure holds a grid of sections (e.g. one per profile) on one scale. Written as
+//! SVG and PNG like the line plots, in the same style ([`super::style`]).
 
-use super::{ensure_font, write_png_with};
+use super::style::{self, text, FONT, MARGIN};
 use crate::error::{HarnessError, Result};
-use crate::output::write_atomic;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-const FONT: &str = "sans-serif";
 const CELL: (i32, i32) = (50, 24);
-const ROW_LABELS: i32 = 40;
+const ROW_LABELS: i32 = 44;
 const PANEL_TITLE: i32 = 20;
 const COL_LABELS: i32 = 18;
 const GAP: (i32, i32) = (22, 16);
-const MARGIN: i32 = 16;
-const TITLE: i32 = 34;
+const HEADING: i32 = 28;
+const TITLE: i32 = 48;
 const LEGEND: i32 = 64;
 const MAX_WIDTH: i32 = 1500;
+/// Size of the text inside cells (smaller than the other text: it annotates a 50 x 24 cell).
+const CELL_TEXT: u32 = 10;
 
 /// What fills a cell.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,6 +46,8 @@ pub struct HeatCell {
 /// One panel: a title, column labels and `rows x columns` cells.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Panel {
+    /// A heading: when not empty the panel starts a new row of panels, under this text.
+    pub heading: String,
     /// Panel title.
     pub title: String,
     /// Column labels (left to right).
@@ -158,115 +161,130 @@ fn text_colour(c: RGBColor) -> RGBColor {
     }
 }
 
-/// Panel origins (left, top) and the figure size, panels flowing left to right.
-fn layout(fig: &HeatFigure) -> (Vec<(i32, i32)>, (u32, u32)) {
+/// Panel origins (left, top), the headings (top, text) and the figure size.
+type Layout = (Vec<(i32, i32)>, Vec<(i32, String)>, (u32, u32));
+
+/// Panels flow left to right and wrap at [`MAX_WIDTH`]; a heading starts a new row.
+fn layout(fig: &HeatFigure) -> Layout {
     let rows = fig.rows.len() as i32;
     let panel_h = PANEL_TITLE + rows * CELL.1 + COL_LABELS;
-    let (mut x, mut y, mut width) = (MARGIN, MARGIN + TITLE, 0);
-    let mut at = Vec::new();
-    for p in &fig.panels {
+    let (mut x, mut y, mut width) = (MARGIN as i32, MARGIN as i32 + TITLE, 0);
+    let (mut at, mut headings) = (Vec::new(), Vec::new());
+    for (k, p) in fig.panels.iter().enumerate() {
         let w = ROW_LABELS + p.columns.len() as i32 * CELL.0;
-        if x > MARGIN && x + w > MAX_WIDTH - MARGIN {
-            x = MARGIN;
+        if k > 0 && (!p.heading.is_empty() || x + w > MAX_WIDTH - MARGIN as i32) {
+            x = MARGIN as i32;
             y += panel_h + GAP.1;
+        }
+        if !p.heading.is_empty() {
+            headings.push((y, p.heading.clone()));
+            y += HEADING;
         }
         at.push((x, y));
         x += w + GAP.0;
-        width = width.max(x - GAP.0 + MARGIN);
+        width = width.max(x - GAP.0 + MARGIN as i32);
     }
     let height = y + panel_h + GAP.1 + LEGEND;
-    (at, (width.max(600) as u32, height as u32))
+    (at, headings, (width.max(900) as u32, height as u32))
 }
 
 fn render<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, fig: &HeatFigure) -> std::result::Result<(), String> {
     let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
     root.fill(&WHITE).map_err(err)?;
+    let (at, headings, size) = layout(fig);
     let centre = Pos::new(HPos::Center, VPos::Center);
     let left = Pos::new(HPos::Left, VPos::Center);
     let right = Pos::new(HPos::Right, VPos::Center);
-    let style = |size: u32, c: RGBColor, pos: Pos| TextStyle {
-        font: (FONT, size).into_font(),
-        color: c.to_backend_color(),
-        pos,
-    };
-    root.draw(&Text::new(fig.title.clone(), (MARGIN, MARGIN + 8), style(18, BLACK, left))).map_err(err)?;
-    root.draw(&Text::new(fig.axes.clone(), (MARGIN, MARGIN + 28), style(12, RGBColor(80, 80, 80), left)))
-        .map_err(err)?;
-    let (at, size) = layout(fig);
+    let grey = RGBColor(80, 80, 80);
+    let title = text(style::TITLE_SIZE, BLACK).pos(Pos::new(HPos::Center, VPos::Top));
+    root.draw(&Text::new(fig.title.clone(), (size.0 as i32 / 2, 10), title)).map_err(err)?;
+    let axes = text(style::LEGEND_SIZE, grey).pos(left);
+    root.draw(&Text::new(fig.axes.clone(), (MARGIN as i32, MARGIN as i32 + 28), axes)).map_err(err)?;
+    for (y, heading) in &headings {
+        let t = text(style::PANEL_TITLE_SIZE, BLACK).pos(left);
+        root.draw(&Text::new(heading.clone(), (MARGIN as i32, y + HEADING / 2), t)).map_err(err)?;
+    }
+    let small = |c: RGBColor, pos: Pos| text(CELL_TEXT, c).pos(pos);
     for (p, &(x, y)) in fig.panels.iter().zip(&at) {
         let x0 = x + ROW_LABELS;
-        root.draw(&Text::new(p.title.clone(), (x0, y + PANEL_TITLE / 2), style(13, BLACK, left))).map_err(err)?;
+        let t = text(style::LEGEND_SIZE, BLACK).pos(left);
+        root.draw(&Text::new(p.title.clone(), (x0, y + PANEL_TITLE / 2), t)).map_err(err)?;
         let top = y + PANEL_TITLE;
         for (r, label) in fig.rows.iter().enumerate() {
             let cy = top + r as i32 * CELL.1 + CELL.1 / 2;
-            root.draw(&Text::new(label.clone(), (x0 - 4, cy), style(11, BLACK, right))).map_err(err)?;
+            root.draw(&Text::new(label.clone(), (x0 - 4, cy), small(BLACK, right))).map_err(err)?;
             for (c, cell) in p.cells.get(r).into_iter().flatten().enumerate() {
                 let cx = x0 + c as i32 * CELL.0;
                 let fill = colour(&cell.fill, &fig.scale);
                 let (a, b) = ((cx, top + r as i32 * CELL.1), (cx + CELL.0 - 1, top + (r as i32 + 1) * CELL.1 - 1));
                 root.draw(&Rectangle::new([a, b], fill.filled())).map_err(err)?;
-                let t = Text::new(cell.text.clone(), (cx + CELL.0 / 2, cy), style(10, text_colour(fill), centre));
+                let t = Text::new(cell.text.clone(), (cx + CELL.0 / 2, cy), small(text_colour(fill), centre));
                 root.draw(&t).map_err(err)?;
             }
         }
         let ly = top + fig.rows.len() as i32 * CELL.1 + COL_LABELS / 2;
         for (c, label) in p.columns.iter().enumerate() {
-            let t = Text::new(label.clone(), (x0 + c as i32 * CELL.0 + CELL.0 / 2, ly), style(10, BLACK, centre));
+            let t = Text::new(label.clone(), (x0 + c as i32 * CELL.0 + CELL.0 / 2, ly), small(BLACK, centre));
             root.draw(&t).map_err(err)?;
         }
     }
-    let y = size.1 as i32 - LEGEND + 8;
-    let bar = match &fig.scale {
-        Scale::Sequential { lo, hi, label } => Some((*lo, *hi, label)),
-        Scale::Diverging { limit, label } => Some((-limit, *limit, label)),
-        Scale::Categories(_) => None,
-    };
-    if let Scale::Categories(names) = &fig.scale {
-        let mut x = MARGIN;
-        for (k, name) in names.iter().enumerate() {
-            let w = 14 + 7 * name.chars().count() as i32;
-            if x + w > size.0 as i32 - MARGIN {
-                break;
-            }
-            let c = colour(&Fill::Category(k), &fig.scale);
-            root.draw(&Rectangle::new([(x, y), (x + 12, y + 12)], c.filled())).map_err(err)?;
-            root.draw(&Text::new(name.clone(), (x + 16, y + 6), style(11, BLACK, left))).map_err(err)?;
-            x += w + 20;
-        }
-    }
-    if let Some((lo, hi, label)) = bar {
-        let (w, steps) = (360, 90);
-        for k in 0..steps {
-            let v = lo + (hi - lo) * (k as f64 + 0.5) / steps as f64;
-            let x = MARGIN + k * w / steps;
-            let c = colour(&Fill::Value(v), &fig.scale);
-            root.draw(&Rectangle::new([(x, y), (x + w / steps + 1, y + 14)], c.filled())).map_err(err)?;
-        }
-        let end = |v: f64| format!("{v:.3}");
-        root.draw(&Text::new(end(lo), (MARGIN, y + 24), style(11, BLACK, left))).map_err(err)?;
-        root.draw(&Text::new(end(hi), (MARGIN + w, y + 24), style(11, BLACK, right))).map_err(err)?;
-        root.draw(&Text::new(label.clone(), (MARGIN + w + 16, y + 7), style(12, BLACK, left))).map_err(err)?;
-    }
+    draw_scale(root, fig, size.1 as i32 - LEGEND + 8, size.0 as i32)?;
     root.present().map_err(err)
 }
 
-fn guarded(f: impl FnOnce() -> std::result::Result<(), String>) -> std::result::Result<(), String> {
-    catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|_| Err("the plotting library panicked".to_string()))
+/// The colour bar (ends and middle labelled) or the legend of categories, from `y` down.
+fn draw_scale<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    fig: &HeatFigure,
+    y: i32,
+    width: i32,
+) -> std::result::Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    let label = |pos: HPos| text(style::LEGEND_SIZE, BLACK).pos(Pos::new(pos, VPos::Center));
+    let m = MARGIN as i32;
+    if let Scale::Categories(names) = &fig.scale {
+        let font = (FONT, style::LEGEND_SIZE).into_font();
+        let mut x = m;
+        for (k, name) in names.iter().enumerate() {
+            let w = 18 + font.box_size(name).map(|b| b.0 as i32).unwrap_or(8 * name.len() as i32);
+            if x + w > width - m {
+                break;
+            }
+            let c = colour(&Fill::Category(k), &fig.scale);
+            root.draw(&Rectangle::new([(x, y), (x + 13, y + 13)], c.filled())).map_err(err)?;
+            root.draw(&Text::new(name.clone(), (x + 18, y + 7), label(HPos::Left))).map_err(err)?;
+            x += w + 20;
+        }
+        return Ok(());
+    }
+    let (lo, hi, what) = match &fig.scale {
+        Scale::Sequential { lo, hi, label } => (*lo, *hi, label),
+        Scale::Diverging { limit, label } => (-limit, *limit, label),
+        Scale::Categories(_) => return Ok(()),
+    };
+    let (w, steps) = (360, 90);
+    for k in 0..steps {
+        let v = lo + (hi - lo) * (k as f64 + 0.5) / steps as f64;
+        let x = m + k * w / steps;
+        let c = colour(&Fill::Value(v), &fig.scale);
+        root.draw(&Rectangle::new([(x, y), (x + w / steps + 1, y + 14)], c.filled())).map_err(err)?;
+    }
+    let end = |v: f64| crate::report::sig(v, 3);
+    root.draw(&Text::new(end(lo), (m, y + 25), label(HPos::Left))).map_err(err)?;
+    root.draw(&Text::new(end((lo + hi) / 2.0), (m + w / 2, y + 25), label(HPos::Center))).map_err(err)?;
+    root.draw(&Text::new(end(hi), (m + w, y + 25), label(HPos::Right))).map_err(err)?;
+    root.draw(&Text::new(what.clone(), (m + w + 16, y + 7), label(HPos::Left))).map_err(err)?;
+    Ok(())
 }
 
 /// Writes `fig` as `<stem>.svg` and `<stem>.png` in `dir`.
 pub fn write_heatmap(dir: &Path, stem: &str, fig: &HeatFigure) -> Result<Vec<PathBuf>> {
     let _phase = crate::phases::enter(crate::phases::Phase::Output);
     std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
-    ensure_font(dir)?;
-    let size = layout(fig).1;
-    let svg = dir.join(format!("{stem}.svg"));
-    let mut text = String::new();
-    guarded(|| render(&SVGBackend::with_string(&mut text, size).into_drawing_area(), fig))
-        .map_err(|e| HarnessError::write(&svg, e))?;
-    write_atomic(&svg, text.as_bytes())?;
-    let png = dir.join(format!("{stem}.png"));
-    write_png_with(&png, |tmp| guarded(|| render(&BitMapBackend::new(tmp, size).into_drawing_area(), fig)))?;
+    let size = layout(fig).2;
+    let (svg, png) = (dir.join(format!("{stem}.svg")), dir.join(format!("{stem}.png")));
+    super::write_svg(&svg, size, |root| render(&root, fig))?;
+    super::png::write_png(&png, size, |root| render(&root, fig))?;
     Ok(vec![svg, png])
 }
 
@@ -295,11 +313,13 @@ mod tests {
             axes: "rows: a/b; columns: x".into(),
             panels: vec![
                 Panel {
+                    heading: String::new(),
                     title: "p".into(),
                     columns: vec!["1".into(), "2".into()],
                     cells: vec![vec![cell(0.0), cell(1.0)], vec![cell(2.0), cell(f64::NAN)]],
                 },
                 Panel {
+                    heading: "second row".into(),
                     title: "q".into(),
                     columns: vec!["own".into()],
                     cells: vec![vec![cell(1.5)], vec![HeatCell { fill: Fill::Empty, text: "-".into() }]],
@@ -310,7 +330,10 @@ mod tests {
         let files = write_heatmap(dir.path(), "h", &fig).unwrap();
         assert_eq!(files.len(), 2);
         let svg = std::fs::read_to_string(&files[0]).unwrap();
-        assert!(svg.contains("<svg") && svg.contains("own"));
+        assert!(svg.contains("<svg") && svg.contains("own") && svg.contains("second row"));
+        let (at, headings, _) = layout(&fig);
+        assert!(at[1].1 > at[0].1, "a heading starts a new row: {at:?}");
+        assert_eq!(headings.len(), 1);
         assert!(std::fs::metadata(&files[1]).unwrap().len() > 1000);
     }
 }

@@ -1,5 +1,6 @@
 use super::*;
 use crate::analysis::{fits, SpeedUp, TestRow};
+use crate::metrics::SummaryRow;
 use crate::output::{Claim, Diagnostic, Meta};
 use crate::plan::Skipped;
 
@@ -44,6 +45,8 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         target_evals: 0.0,
         cache_ops: 0.0,
         rmse_display: None,
+        rmse_lo: None,
+        rmse_hi: None,
         fom_display: None,
         rep_blocks: Default::default(),
     }
@@ -147,33 +150,71 @@ pub fn synthetic_report() -> RunReport {
     }
 }
 
+fn read(dir: &Path, name: &str) -> String {
+    std::fs::read_to_string(dir.join(name)).unwrap()
+}
+
 #[test]
-fn writes_svg_and_png_for_every_plot() {
+fn one_figure_of_panels_per_test_bed_as_svg_and_png() {
     let report = synthetic_report();
     assert_eq!(report.fits.len(), 2);
     let dir = tempfile::TempDir::new().unwrap();
     let files = write_plots(&report, dir.path()).unwrap();
-    // Three plots against the budget and the speed-up against the cost of a ray.
-    assert_eq!(files.len(), 8);
-    let curve = std::fs::read_to_string(dir.path().join("gradient-plane_default_speedup_vs_ray_cost.svg")).unwrap();
-    assert!(curve.contains("break-even (1x)") && curve.contains("limit 20.000"), "ray-cost legend missing");
-    for kind in PlotKind::ALL {
-        let stem = plot_stem("gradient-plane", "default", kind);
-        let png = dir.path().join(format!("{stem}.png"));
-        let bytes = std::fs::read(&png).unwrap();
-        assert!(bytes.len() > 1000 && bytes.starts_with(b"\x89PNG\r\n\x1a\n"), "{png:?}");
-        assert!(dir.path().join(format!("{stem}.svg")).is_file());
+    // RMSE, efficiency and RMSE against time, and the speed-up against the cost of a ray: one file.
+    assert_eq!(files.len(), 2, "{files:?}");
+    let stem = plot_stem("gradient-plane", "default", PlotKind::Convergence);
+    let bytes = std::fs::read(dir.path().join(format!("{stem}.png"))).unwrap();
+    assert!(bytes.len() > 1000 && bytes.starts_with(b"\x89PNG\r\n\x1a\n"));
+    let svg = read(dir.path(), &format!("{stem}.svg"));
+    for panel in
+        ["(a) RMSE vs samples per pixel (spp)", "(b) efficiency vs", "(c) RMSE vs CPU time", "(d) speed-up over"]
+    {
+        assert!(svg.contains(panel), "{panel} missing");
     }
-    let svg = std::fs::read_to_string(dir.path().join("gradient-plane_default_rmse.svg")).unwrap();
-    assert!(svg.contains("MCMC (independent MC)  slope -0.4"), "legend text missing");
-    // The points lie on a line; the interval is the one their standard errors give.
-    assert!(svg.contains("IS1 + CV2  slope -0.90 ["), "legend slope missing");
-    assert!(svg.contains(", right end -0.90 ["), "legend right-end slope missing");
-    assert!(svg.contains("samples per pixel (spp)"));
-    // No temp files are left behind.
+    // One legend entry per estimator, with its slope; the guides have their own.
+    assert_eq!(svg.matches("MCMC (independent MC): slope -0.4").count(), 1, "legend text missing or repeated");
+    assert!(svg.contains("IS1 + CV2: slope -0.90 ["), "legend slope missing");
+    assert!(!svg.contains("right end"), "three budgets: the right end is the whole fit");
+    assert!(svg.contains("slope -1/2 (guide)") && svg.contains("break-even (speed-up 1)"));
+    // No band columns in the rows: no band, no note.
+    assert!(!svg.contains("Shaded: 90%"));
     let names: Vec<String> =
         std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
-    assert!(names.iter().all(|n| !n.starts_with('.')), "{names:?}");
+    assert!(names.iter().all(|n| !n.starts_with('.')), "no temporary files left: {names:?}");
+}
+
+fn named(name: &str) -> Option<String> {
+    (name == "is1_cv2").then(|| "IS1 CV2 (SMC cache)".to_string())
+}
+
+fn bed(_: &str, _: &str) -> Option<String> {
+    Some("gradient plane (a test)".to_string())
+}
+
+#[test]
+fn bands_display_names_and_the_same_bytes_twice() {
+    let mut report = synthetic_report();
+    report.rows.push(row("is0_cv0", 256, 0.2 / 16.0, 2e-7 * 256.0));
+    report.rows.push(row("is1_cv2", 256, 0.15 * 256f64.powf(-0.9), 3.5e-7 * 256.0));
+    report.fits = fits(&report.rows);
+    for r in &mut report.rows {
+        (r.rmse_lo, r.rmse_hi) = (Some(r.rmse * 0.8), Some(r.rmse * 1.25));
+    }
+    let names = DisplayNames { estimator: Some(named), testbed: Some(bed) };
+    let (a, b) = (tempfile::TempDir::new().unwrap(), tempfile::TempDir::new().unwrap());
+    let files = write_plots_named(&report, a.path(), &names).unwrap();
+    write_plots_named(&report, b.path(), &names).unwrap();
+    for f in &files {
+        let name = f.file_name().unwrap();
+        assert_eq!(std::fs::read(f).unwrap(), std::fs::read(b.path().join(name)).unwrap(), "{name:?} differs");
+    }
+    let svg = read(a.path(), "gradient-plane_default_convergence.svg");
+    assert!(svg.contains("surface-smc: gradient plane (a test)"), "the test bed's display name");
+    assert!(svg.contains("IS1 CV2 (SMC cache): slope"), "the estimator's display name");
+    assert!(svg.contains(", right end -0.90 ["), "four budgets: the slope over the last three");
+    assert!(svg.contains("MCMC (independent MC): slope"), "the registered label where the hook has none");
+    assert!(svg.contains("Shaded: 90%"), "the band's note");
+    assert!(svg.contains("opacity=\"0.16\""), "a shaded band");
 }
 
 #[test]
@@ -183,7 +224,7 @@ fn empty_and_degenerate_reports_do_not_panic() {
     report.rows.clear();
     assert!(write_plots(&report, dir.path()).unwrap().is_empty());
 
-    // Single-point series only (a single-budget sweep): no plot against the budget is drawn.
+    // Single-point series only (a single-budget sweep): no figure is drawn.
     let mut report = synthetic_report();
     report.rows.truncate(2);
     report.speedups.clear();
@@ -194,18 +235,25 @@ fn empty_and_degenerate_reports_do_not_panic() {
     report.rows.push(row("nan_estimator", 4, f64::NAN, f64::NAN));
     report.rows.push(row("zero_estimator", 4, 0.0, 0.0));
     report.rows[0].efficiency = None;
+    report.rows[1].rmse_lo = Some(-1.0);
+    report.rows[1].rmse_hi = Some(f64::NAN);
     report.rows.push(row("inf", 8, f64::INFINITY, -1.0));
     report.fits[0].slope = f64::NAN;
+    // A two-point series beside single points and undrawable values (NaN, zero, infinite,
+    // negative) still makes the figure.
     let files = write_plots(&report, dir.path()).unwrap();
-    // RMSE and RMSE-vs-time have a two-point series beside single points and undrawable values
-    // (NaN, zero, infinite, negative); efficiency has at most one point per series. The speed-up
-    // against the cost of a ray is drawn from the speed-ups, not the rows.
-    assert_eq!(files.len(), 6, "{files:?}");
+    assert_eq!(files.len(), 2, "{files:?}");
 }
 
 #[test]
 fn names_are_sanitised() {
     assert_eq!(sanitize("a b/c.d-e_f"), "a_b_c_d-e_f");
     assert_eq!(sanitize(""), "_");
-    assert_eq!(plot_stem("checker direct", "occl/uded", PlotKind::RmseVsTime), "checker_direct_occl_uded_rmse_vs_time");
+    assert_eq!(plot_stem("checker direct", "occl/uded", PlotKind::Convergence), "checker_direct_occl_uded_convergence");
+}
+
+#[test]
+fn svgs_drop_default_opacities_and_round_font_sizes() {
+    let svg = r##"<text x="1" font-size="8.064516129032258" opacity="1" fill="#000">a</text><rect opacity="0.16"/>"##;
+    assert_eq!(compact_svg(svg), r##"<text x="1" font-size="8.06" fill="#000">a</text><rect opacity="0.16"/>"##);
 }
