@@ -5,6 +5,7 @@
 //! Every medium access goes through the counted [`MediumProbe`]: one extinction evaluation is one
 //! fetch, one ray or path is one sample.
 
+pub mod constant;
 pub mod delta_tracking;
 pub mod double_particle;
 pub mod params;
