@@ -18,8 +18,8 @@ use rand::Rng;
 /// [`track`] with `SamplingDensity::constant(sigma)`, no main part and no observer: the weight of
 /// the transmitted particle on `[t0, t1]` of the probe's ray `origin + s dir`. Falls back to
 /// [`track`] when the segment starts before 0 (where the constant density's first knot splits a
-/// flight), its end is NaN or the density is not positive (no interaction). Always inlined, so a
-/// caller's constant `rule` is folded into its own copy of the loop.
+/// flight) or the density is not positive (no interaction). Always inlined, so a caller's
+/// constant `rule` is folded into its own copy of the loop.
 #[inline(always)]
 pub fn track_constant(
     probe: &MediumProbe<'_>,
@@ -29,7 +29,7 @@ pub fn track_constant(
     rng: &mut StreamRng,
 ) -> Result<f64, EstimateError> {
     let v = sigma.max(0.0);
-    if !(seg.0 >= 0.0 && v > 0.0) || seg.1.is_nan() {
+    if !(seg.0 >= 0.0 && v > 0.0) {
         return general(probe, seg, sigma, rule, rng);
     }
     // A local copy of the generator stays in registers across the fetch (an opaque call), instead
@@ -54,7 +54,7 @@ fn general(
     track(probe, line, seg, &SamplingDensity::constant(sigma), None, rule, rng, |_| ())
 }
 
-/// The loop of [`track_constant`] from `t0 >= 0` to `t1` (not NaN) with the density `v > 0`
+/// The loop of [`track_constant`] from `t0 >= 0` to `t1` with the density `v > 0`
 /// (`SamplingDensity::constant(sigma)` holds `sigma.max(0)`).
 ///
 /// The generator is drawn in [`track`]'s order (each step's flight, then its interaction's
@@ -72,10 +72,10 @@ fn steps(
     // Read through the probe at each step rather than copied per ray.
     let ray = probe.ray();
     let (mut e, mut k) = (1.0f64, 0i32);
-    // `solve` ends a flight at `s + x` if `x` is finite, else at +inf, and the loop ends when that
-    // is `>= t1`: exactly when `s + x < t1` fails (`x` is in `[0, +inf]` for `v > 0`, `t1` not NaN).
+    // `solve` ends a flight at `s + x` if `x` is finite, else at +inf: for `v > 0`, `x` is in
+    // `[0, +inf]`, so that is `s + x` itself (never NaN), one addition and no finiteness test.
     let mut s = t0 + flight(rng, v);
-    if !(s < t1) {
+    if s >= t1 {
         return Ok(ScaledWeight { e, k });
     }
     loop {
@@ -92,7 +92,7 @@ fn steps(
             (e, k) = ScaledWeight::rescale(e, k);
         }
         *rng = ahead;
-        if !(next < t1) {
+        if next >= t1 {
             return Ok(ScaledWeight { e, k });
         }
         s = next;
