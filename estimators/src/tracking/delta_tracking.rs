@@ -7,7 +7,7 @@
 //! scattering: Woodcock tracking to the first real collision and a Woodcock shadow ray
 //! ([`crate::single_scatter::delta_tracking`]).
 
-use super::constant::track_constant;
+use super::constant::ConstantTracker;
 use super::params::SigmaSampParams;
 use super::spm::{trace, SpmMode};
 use super::{ray_moments, transmittance, Rule, SigmaSamp};
@@ -58,7 +58,8 @@ impl Estimator for DeltaTracking {
         let probe = task.medium().ok_or_else(|| EstimateError::Refused("the test bed has no medium".into()))?;
         let sigma = self.sigma_samp.resolve(probe.majorant());
         if let MediumQuantity::Transmittance { .. } = probe.ray().quantity {
-            return transmittance(task, rng, |probe, seg, rng| track_constant(probe, seg, sigma, Rule::Delta, rng));
+            let mut tracker = ConstantTracker::default();
+            return transmittance(task, rng, |probe, seg, rng| tracker.track(probe, seg, sigma, Rule::Delta, rng));
         }
         let mut mean = RgbMean::new();
         while task.more() {

@@ -6,7 +6,7 @@
 //! piecewise-linear main part through explorer points spaced `explorer_spacing`, `control = 2`
 //! the constant at its mean (the L2-optimal constant of §3.4).
 
-use super::constant::track_constant;
+use super::constant::ConstantTracker;
 use super::params::DoubleParticleParams;
 use super::residual_ratio_tracking::{main_part, MainPart};
 use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
@@ -54,13 +54,14 @@ pub struct DoubleParticle {
 impl Estimator for DoubleParticle {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         let mut main: Option<(SamplingDensity, f64)> = None;
+        let mut tracker = ConstantTracker::default();
         transmittance(task, rng, |probe, seg, rng| {
             if let (Some(kind), None) = (self.control, &main) {
                 main = Some(main_part(probe, seg, self.spacing, kind));
             }
             let sigma = self.sigma_samp.resolve(probe.majorant());
             match main.as_ref() {
-                None => track_constant(probe, seg, sigma, Rule::Double, rng),
+                None => tracker.track(probe, seg, sigma, Rule::Double, rng),
                 Some((m, t_main)) => {
                     let (samp, line) = (SamplingDensity::constant(sigma), (probe.ray().origin, probe.ray().dir));
                     Ok(track(probe, line, seg, &samp, Some(m), Rule::Double, rng, |_| ())? * t_main)

@@ -3,7 +3,7 @@
 //! must give a majorant: a smaller density is the double particle model, and is refused here as a
 //! skipped pair with the reason), weight `*= 1 - r`.
 
-use super::constant::track_constant;
+use super::constant::ConstantTracker;
 use super::params::SigmaSampParams;
 use super::{ray_moments, supports_transmittance, transmittance, Rule, SigmaSamp};
 use crate::error::EstimateError;
@@ -41,9 +41,9 @@ pub struct RatioTracking {
 
 impl Estimator for RatioTracking {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let mut tracker = ConstantTracker::default();
         transmittance(task, rng, |probe, seg, rng| {
-            let sigma = self.sigma_samp.resolve(probe.majorant());
-            track_constant(probe, seg, sigma, Rule::Double, rng)
+            tracker.track(probe, seg, self.sigma_samp.resolve(probe.majorant()), Rule::Double, rng)
         })
     }
     fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {

@@ -7,7 +7,7 @@
 //!   before the run (`ConfigError`, exit 2), and an `r` out of range met at run time is refused.
 //! - `single_particle_nonterminating`: Eq. 12 probabilities, any `r`.
 
-use super::constant::track_constant;
+use super::constant::ConstantTracker;
 use super::params::SigmaSampParams;
 use super::{ray_moments, supports_transmittance, transmittance, Rule, SigmaSamp};
 use crate::error::{ConfigError, EstimateError};
@@ -83,13 +83,14 @@ pub fn check_terminating(id: &str, sigma_samp: f64, bed: &dyn TestBed) -> Result
 
 impl Estimator for SingleParticle {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let mut tracker = ConstantTracker::default();
         transmittance(task, rng, |probe, seg, rng| {
             let (a, sigma) = (probe.albedo(), self.sigma_samp.resolve(probe.majorant()));
             // One loop per rule (the rule is folded into each).
             if self.terminating {
-                track_constant(probe, seg, sigma, Rule::Terminating { a }, rng)
+                tracker.track(probe, seg, sigma, Rule::Terminating { a }, rng)
             } else {
-                track_constant(probe, seg, sigma, Rule::NonTerminating { a }, rng)
+                tracker.track(probe, seg, sigma, Rule::NonTerminating { a }, rng)
             }
         })
     }
