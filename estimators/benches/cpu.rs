@@ -7,7 +7,7 @@
 //! cargo bench -p estimators --bench cpu -- media 1024 is0_cv0 is1_cv2      # gradient-box albedo 0.8, 16x16
 //! cargo bench -p estimators --bench cpu -- surface 1024 brdf_is0_cv0 is1_cv2 brdf_is1_cv2   # gradient-plane 16x16
 //! cargo bench -p estimators --bench cpu -- envmap 10 bidirectional_is smc smc_bridge   # envmap-sequence mixed 16x16, 10 frames, N = 16
-//! cargo bench -p estimators --bench cpu -- tracking 20000 bare delta_tracking ratio_tracking   # eq21-medium, CPU per fetch
+//! cargo bench -p estimators --bench cpu -- tracking 20000 bare bare_chained delta_tracking ratio_tracking   # eq21-medium, CPU per fetch
 //! ```
 //! Options after the ids: `storage=f32` (the caches' cell precision), `reps=K` (repeat K times,
 //! each line its own measurement), `res=R` (the image side of gradient-plane and envmap-sequence,
@@ -62,7 +62,8 @@ fn run(bed: &dyn TestBed, id: &str, spp: u64, params: &Params, seed: u64) -> Mea
 /// fetch over `estimates` transmittance estimates of 16 rays on eq21-medium's central ray s = 20
 /// (the tracking bench's setup); the id `bare` is the floor, `sigma_t` at 1024 points of that ray
 /// in a tight loop, `estimates x 16` times over, and `bare_chained` the same loop with each point
-/// made dependent on the previous fetch.
+/// made dependent on the previous fetch. A tracker's line ends with a hash of the bits of all its
+/// estimates (equal hashes: bit-identical results).
 fn tracking(estimates: u64, ids: &[String]) {
     use rand::Rng;
     let bed = (registry::testbed("eq21-medium").unwrap().build)(
@@ -72,6 +73,7 @@ fn tracking(estimates: u64, ids: &[String]) {
     )
     .expect("bed");
     for id in ids {
+        let mut hash = None;
         let (t0, fetches) = if id == "bare" || id == "bare_chained" {
             let scene = bed.medium().expect("medium");
             let mut rng = stream(7, "bench fetch points");
@@ -94,17 +96,20 @@ fn tracking(estimates: u64, ids: &[String]) {
         } else {
             let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
             let mut rng = stream(11, id);
-            let mut fetches = 0;
+            let (mut fetches, mut h) = (0, 0xcbf2_9ce4_8422_2325u64);
             let t0 = thread_cpu_seconds();
             for _ in 0..estimates {
                 let task = Task::new(bed.as_ref(), bed.integrals() - 1, Budget::samples(16).expect("budget"));
-                std::hint::black_box(est.estimate(&task, &mut rng).expect("estimates"));
+                let value = std::hint::black_box(est.estimate(&task, &mut rng).expect("estimates"));
+                h = value.0.iter().fold(h, |h, x| (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3));
                 fetches += task.costs().fetches;
             }
+            hash = Some(h);
             (t0, fetches)
         };
         let cpu = thread_cpu_seconds() - t0;
-        println!("tracking {id} fetches={fetches} ns_per_fetch={:.3}", cpu * 1e9 / fetches as f64);
+        let hash = hash.map(|h| format!(" hash={h:016x}")).unwrap_or_default();
+        println!("tracking {id} fetches={fetches} ns_per_fetch={:.3}{hash}", cpu * 1e9 / fetches as f64);
     }
 }
 

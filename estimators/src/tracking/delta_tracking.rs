@@ -7,9 +7,10 @@
 //! scattering: Woodcock tracking to the first real collision and a Woodcock shadow ray
 //! ([`crate::single_scatter::delta_tracking`]).
 
+use super::constant::ConstantTracker;
 use super::params::SigmaSampParams;
 use super::spm::{trace, SpmMode};
-use super::{ray_moments, track, transmittance, Rule, SigmaSamp};
+use super::{ray_moments, transmittance, Rule, SigmaSamp};
 use crate::accumulate::RgbMean;
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
@@ -18,7 +19,6 @@ use crate::media::moments::EstimateMoments;
 use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
 use crate::task::Task;
 use crate::testbed::{MediumQuantity, Needs, TestBed};
 
@@ -58,18 +58,8 @@ impl Estimator for DeltaTracking {
         let probe = task.medium().ok_or_else(|| EstimateError::Refused("the test bed has no medium".into()))?;
         let sigma = self.sigma_samp.resolve(probe.majorant());
         if let MediumQuantity::Transmittance { .. } = probe.ray().quantity {
-            return transmittance(task, rng, |probe, seg, rng| {
-                track(
-                    probe,
-                    (probe.ray().origin, probe.ray().dir),
-                    seg,
-                    &SamplingDensity::constant(sigma),
-                    None,
-                    Rule::Delta,
-                    rng,
-                    |_| (),
-                )
-            });
+            let mut tracker = ConstantTracker::default();
+            return transmittance(task, rng, |probe, seg, rng| tracker.track(probe, seg, sigma, Rule::Delta, rng));
         }
         let mut mean = RgbMean::new();
         while task.more() {

@@ -6,6 +6,7 @@
 //! piecewise-linear main part through explorer points spaced `explorer_spacing`, `control = 2`
 //! the constant at its mean (the L2-optimal constant of §3.4).
 
+use super::constant::ConstantTracker;
 use super::params::DoubleParticleParams;
 use super::residual_ratio_tracking::{main_part, MainPart};
 use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
@@ -53,23 +54,19 @@ pub struct DoubleParticle {
 impl Estimator for DoubleParticle {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         let mut main: Option<(SamplingDensity, f64)> = None;
+        let mut tracker = ConstantTracker::default();
         transmittance(task, rng, |probe, seg, rng| {
             if let (Some(kind), None) = (self.control, &main) {
                 main = Some(main_part(probe, seg, self.spacing, kind));
             }
-            let samp = SamplingDensity::constant(self.sigma_samp.resolve(probe.majorant()));
-            let m = main.as_ref();
-            let e = track(
-                probe,
-                (probe.ray().origin, probe.ray().dir),
-                seg,
-                &samp,
-                m.map(|x| &x.0),
-                Rule::Double,
-                rng,
-                |_| (),
-            )?;
-            Ok(e * m.map_or(1.0, |x| x.1))
+            let sigma = self.sigma_samp.resolve(probe.majorant());
+            match main.as_ref() {
+                None => tracker.track(probe, seg, sigma, Rule::Double, rng),
+                Some((m, t_main)) => {
+                    let (samp, line) = (SamplingDensity::constant(sigma), (probe.ray().origin, probe.ray().dir));
+                    Ok(track(probe, line, seg, &samp, Some(m), Rule::Double, rng, |_| ())? * t_main)
+                }
+            }
         })
     }
     fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {

@@ -5,6 +5,7 @@
 //! Every medium access goes through the counted [`MediumProbe`]: one extinction evaluation is one
 //! fetch, one ray or path is one sample.
 
+pub mod constant;
 pub mod delta_tracking;
 pub mod double_particle;
 pub mod params;
@@ -135,13 +136,27 @@ pub struct ScaledWeight {
 impl ScaledWeight {
     /// Exponent step of a rescale.
     pub const RESCALE: i32 = 512;
+    /// The bound on `|e|` above which a tracker rescales (`2^RESCALE`).
+    pub const BIG: f64 = f64::from_bits((1023 + Self::RESCALE as u64) << 52);
     /// `e 2^k` as an f64 (infinite where it overflows).
+    #[inline]
     pub fn value(self) -> f64 {
         if self.k == 0 {
             self.e
         } else {
-            self.e * 2f64.powi(self.k)
+            self.scaled_value()
         }
+    }
+    /// [`ScaledWeight::value`] of a rescaled weight (rare: a cold call, not a select).
+    #[cold]
+    fn scaled_value(self) -> f64 {
+        self.e * 2f64.powi(self.k)
+    }
+    /// `(e 2^-RESCALE, k + RESCALE)`: the weight `(e, k)` rescaled once (exact). A cold call, so
+    /// the tracker loops test `|e| > BIG` with a predictable branch.
+    #[cold]
+    pub fn rescale(e: f64, k: i32) -> (f64, i32) {
+        (e * 2f64.powi(-Self::RESCALE), k + Self::RESCALE)
     }
     /// `e 2^k exp(-tau)` without intermediate overflow or underflow: the product with a main
     /// part's transmittance `exp(-tau)` given as its optical depth `tau`; `t_main` (= `exp(-tau)`
@@ -171,7 +186,6 @@ pub fn track_scaled(
     mut seen: impl FnMut(&Interaction),
 ) -> Result<ScaledWeight, EstimateError> {
     let (mut e, mut k, mut s) = (1.0f64, 0i32, t0);
-    let (big, step) = (2f64.powi(ScaledWeight::RESCALE), 2f64.powi(-ScaledWeight::RESCALE));
     loop {
         s = samp.sample(s, rng.gen::<f64>());
         if s >= t1 {
@@ -187,9 +201,8 @@ pub fn track_scaled(
         if e == 0.0 {
             return Ok(ScaledWeight { e: 0.0, k: 0 });
         }
-        if e.abs() > big {
-            e *= step;
-            k += ScaledWeight::RESCALE;
+        if e.abs() > ScaledWeight::BIG {
+            (e, k) = ScaledWeight::rescale(e, k);
         }
     }
 }

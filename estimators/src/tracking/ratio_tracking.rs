@@ -3,8 +3,9 @@
 //! must give a majorant: a smaller density is the double particle model, and is refused here as a
 //! skipped pair with the reason), weight `*= 1 - r`.
 
+use super::constant::ConstantTracker;
 use super::params::SigmaSampParams;
-use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
+use super::{ray_moments, supports_transmittance, transmittance, Rule, SigmaSamp};
 use crate::error::EstimateError;
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
@@ -12,7 +13,6 @@ use crate::media::moments::EstimateMoments;
 use crate::params::{parse, ParamSpec};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
 use crate::task::Task;
 use crate::testbed::{Needs, TestBed};
 
@@ -41,9 +41,9 @@ pub struct RatioTracking {
 
 impl Estimator for RatioTracking {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let mut tracker = ConstantTracker::default();
         transmittance(task, rng, |probe, seg, rng| {
-            let samp = SamplingDensity::constant(self.sigma_samp.resolve(probe.majorant()));
-            track(probe, (probe.ray().origin, probe.ray().dir), seg, &samp, None, Rule::Double, rng, |_| ())
+            tracker.track(probe, seg, self.sigma_samp.resolve(probe.majorant()), Rule::Double, rng)
         })
     }
     fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {

@@ -165,10 +165,16 @@ impl RecentMaximum {
 
 impl Estimator for ResidualRatioTracking {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
-        let mut main: Option<(SamplingDensity, f64)> = None;
+        // The main part, its transmittance and its optical depth on the segment (the same for
+        // every ray of the estimate: computed on the first).
+        let mut main: Option<(SamplingDensity, f64, f64)> = None;
         let mut memory: Option<RecentMaximum> = None;
         transmittance(task, rng, |probe, seg, rng| {
-            let (m, tm) = main.get_or_insert_with(|| main_part(probe, seg, self.spacing, self.kind));
+            let (m, tm, depth) = main.get_or_insert_with(|| {
+                let (m, tm) = main_part(probe, seg, self.spacing, self.kind);
+                let depth = m.integral(seg.0, seg.1);
+                (m, tm, depth)
+            });
             let memory = memory.get_or_insert_with(|| self.memory(probe.majorant()));
             let sigma = memory.sigma();
             let mut seen = 0.0f64;
@@ -180,7 +186,7 @@ impl Estimator for ResidualRatioTracking {
             memory.push(seen);
             task.note("sigma_samp", sigma);
             // In log space where the product overflows and T_main underflows (optical depth 1e4).
-            Ok(e.times_transmittance(*tm, m.integral(seg.0, seg.1)))
+            Ok(e.times_transmittance(*tm, *depth))
         })
     }
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {

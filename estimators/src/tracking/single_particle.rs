@@ -7,8 +7,9 @@
 //!   before the run (`ConfigError`, exit 2), and an `r` out of range met at run time is refused.
 //! - `single_particle_nonterminating`: Eq. 12 probabilities, any `r`.
 
+use super::constant::ConstantTracker;
 use super::params::SigmaSampParams;
-use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
+use super::{ray_moments, supports_transmittance, transmittance, Rule, SigmaSamp};
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};
 use crate::math::Rgb;
@@ -16,7 +17,6 @@ use crate::media::moments::EstimateMoments;
 use crate::params::{parse, ParamSpec, Params};
 use crate::registry::{Checks, EstimatorEntry};
 use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
 use crate::task::Task;
 use crate::testbed::{Needs, TestBed};
 
@@ -83,11 +83,15 @@ pub fn check_terminating(id: &str, sigma_samp: f64, bed: &dyn TestBed) -> Result
 
 impl Estimator for SingleParticle {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
+        let mut tracker = ConstantTracker::default();
         transmittance(task, rng, |probe, seg, rng| {
-            let a = probe.albedo();
-            let rule = if self.terminating { Rule::Terminating { a } } else { Rule::NonTerminating { a } };
-            let samp = SamplingDensity::constant(self.sigma_samp.resolve(probe.majorant()));
-            track(probe, (probe.ray().origin, probe.ray().dir), seg, &samp, None, rule, rng, |_| ())
+            let (a, sigma) = (probe.albedo(), self.sigma_samp.resolve(probe.majorant()));
+            // One loop per rule (the rule is folded into each).
+            if self.terminating {
+                tracker.track(probe, seg, sigma, Rule::Terminating { a }, rng)
+            } else {
+                tracker.track(probe, seg, sigma, Rule::NonTerminating { a }, rng)
+            }
         })
     }
     fn sample_moments(&self, task: &Task<'_>) -> Option<EstimateMoments> {
