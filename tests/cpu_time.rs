@@ -109,7 +109,7 @@ fn summaries(plan: &mcbench::plan::Plan, run: &runner::RunResults) -> Vec<mcbenc
 fn cpu_seconds_count_work_and_not_sleep() {
     let plan =
         mcbench::plan::Plan::prepare(sweep(&["sleeper", "spinner"], 2.0, samples(&[1]), 3), registry()).expect("plans");
-    let opts = RunOptions { threads: Some(1), cell_dir: None, observer: &Silent };
+    let opts = RunOptions { threads: Some(1), store: None, observer: &Silent };
     let run = runner::run(&plan, &opts).expect("runs");
     let rows = summaries(&plan, &run);
     let row = |name: &str| rows.iter().find(|r| r.estimator == name).expect("row");
@@ -154,7 +154,7 @@ fn interleaved_cells_equal_cells_run_alone() {
     for s in [surface, media] {
         let plan = mcbench::plan::Plan::prepare(s, registry()).expect("plans");
         for threads in [1, 2] {
-            let opts = RunOptions { threads: Some(threads), cell_dir: None, observer: &Silent };
+            let opts = RunOptions { threads: Some(threads), store: None, observer: &Silent };
             let run = runner::run(&plan, &opts).expect("runs");
             assert_eq!(run.cells.len(), plan.pairs.len() * plan.sweep.budgets.len());
             let mut k = 0;
