@@ -141,9 +141,12 @@ fn a_custom_sweep_runs_end_to_end_and_plots_can_be_redrawn() {
     std::fs::write(d.join("tiny.toml"), SMALL).expect("write");
     let o = mcbench(d, &["run", "--config", "tiny.toml", "--threads", "2"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    for f in
-        ["results/tiny/summary.csv", "results/tiny/integrals.csv.gz", "results/tiny/summary.json", "plots/tiny/report.md"]
-    {
+    for f in [
+        "results/tiny/summary.csv",
+        "results/tiny/integrals.csv.gz",
+        "results/tiny/summary.json",
+        "plots/tiny/report.md",
+    ] {
         assert!(d.join(f).is_file(), "{f} missing");
     }
     assert!(String::from_utf8_lossy(&o.stdout).contains("clamped_is0_cv0[clamp=1.5]"));

@@ -212,7 +212,8 @@ fn a_torn_store_tail_is_dropped_and_a_corrupt_middle_refused() {
     assert_eq!((again.records().len(), again.torn_bytes()), (records.len(), 0), "truncated, then appended");
     // One flipped byte inside the second record: refused, naming the store and where.
     let mut bad = std::fs::read(&store).expect("store");
-    let second = mcbench::store::HEADER_LEN + mcbench::store::frame(&again.records()[0].name, &again.records()[0].payload).len();
+    let second =
+        mcbench::store::HEADER_LEN + mcbench::store::frame(&again.records()[0].name, &again.records()[0].payload).len();
     bad[second + mcbench::store::FRAME_LEN + 20] ^= 0x40;
     std::fs::write(&store, &bad).expect("damage");
     refused(d, &["run", "--config", "tiny.toml"], 2, "cells.store");

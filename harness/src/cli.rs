@@ -73,9 +73,8 @@ enum Command {
         /// Where stored references are read (default: `<results>/references`).
         #[arg(long, value_name = "DIR")]
         references: Option<PathBuf>,
-        /// How the per-integral file is written: `gz` (integrals.csv.gz, the default), `csv`
-        /// (plain integrals.csv) or `none`.
-        #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz)]
+        /// The per-integral file: gz (integrals.csv.gz), csv (plain integrals.csv) or none
+        #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
         integrals: IntegralsFormat,
     },
     /// Run the conformance suite on estimators (every registered one when none is named): builds,
@@ -176,9 +175,8 @@ struct RunArgs {
     /// Where stored references are read (default: `<results>/references`).
     #[arg(long, value_name = "DIR")]
     references: Option<PathBuf>,
-    /// How the per-integral file is written: `gz` (integrals.csv.gz, the default), `csv`
-    /// (plain integrals.csv) or `none`.
-    #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz)]
+    /// The per-integral file: gz (integrals.csv.gz), csv (plain integrals.csv) or none
+    #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
     integrals: IntegralsFormat,
 }
 

@@ -132,7 +132,9 @@ pub fn write(dir: &OutputDir, rows: &[IntegralRow], format: IntegralsFormat) -> 
     for other in [CSV, GZ] {
         if format.file_name() != Some(other) {
             match std::fs::remove_file(dir.join(other)) {
-                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return Err(HarnessError::write(dir.join(other), e)),
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(HarnessError::write(dir.join(other), e))
+                }
                 _ => {}
             }
         }

@@ -92,6 +92,7 @@ pub mod progress;
 pub mod references;
 pub mod registry;
 pub mod report;
+pub mod resume;
 pub mod runner;
 pub mod sensitivity;
 pub mod shard;

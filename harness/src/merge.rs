@@ -137,8 +137,7 @@ pub fn merge(dirs: &[PathBuf], opts: &ExecOptions<'_>) -> Result<Outcome> {
     if opts.plots {
         crate::folder::check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
     }
-    let stores =
-        shards.iter().map(|(d, _)| Store::open(&d.join(crate::store::BLOCKS))).collect::<Result<Vec<_>>>()?;
+    let stores = shards.iter().map(|(d, _)| Store::open(&d.join(crate::store::BLOCKS))).collect::<Result<Vec<_>>>()?;
     let mut cells = Vec::with_capacity(plan.pairs.len() * plan.sweep.budgets.len());
     for (c, cell_units) in units.chunks(blocks).enumerate() {
         let (bi, ei) = plan.pairs[cell_units[0].pair];

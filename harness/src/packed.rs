@@ -53,7 +53,7 @@ pub fn pack_moments(moments: &[[Moments; 3]]) -> Vec<u8> {
 pub fn unpack_moments(bytes: &[u8]) -> Result<Vec<[Moments; 3]>, String> {
     let head: [u8; 4] = bytes.get(..4).and_then(|b| b.try_into().ok()).ok_or("no moment count")?;
     let k = u32::from_le_bytes(head) as usize;
-    if k % 3 != 0 {
+    if !k.is_multiple_of(3) {
         return Err(format!("{k} moments are not 3 channels per integral"));
     }
     let cols = &bytes[4..];
@@ -116,10 +116,7 @@ pub fn decode_cell(payload: &[u8]) -> Result<CellResult, String> {
 pub fn encode_block(block: &BlockFile) -> Vec<u8> {
     let stats = CellResult { moments: Vec::new(), ..block.stats.clone() };
     let meta = BlockFile { stats, ..block.clone() };
-    join(&Parts {
-        meta: serde_json::to_string(&meta).unwrap_or_default(),
-        moments: pack_moments(&block.stats.moments),
-    })
+    join(&Parts { meta: serde_json::to_string(&meta).unwrap_or_default(), moments: pack_moments(&block.stats.moments) })
 }
 
 /// A shard's repetition block from its payload; `Err` says what is wrong.

@@ -128,7 +128,7 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
     let _ = writeln!(out, "- **commit**: {} (mcbench {})", m.git_commit, m.version);
     let _ = writeln!(out, "- **threads**: {}; **cpu**: {}", m.threads, m.cpu);
     let _ = writeln!(out, "- **wall time**: {} s", sig(m.wall_seconds, 4));
-    let files: Vec<String> = ["summary.csv", "summary.json", "integrals.csv"]
+    let files: Vec<String> = ["summary.csv", "summary.json", "integrals.csv", "integrals.csv.gz"]
         .iter()
         .filter(|f| results_dir.join(f).is_file())
         .map(|f| format!("[{f}]({})", relative(plots_dir, &results_dir.join(f))))

@@ -10,13 +10,14 @@ use crate::error::{HarnessError, Result};
 use crate::interleave::empty_cell;
 pub use crate::interleave::{run_group_with, GroupCell};
 use crate::plan::Plan;
-use crate::store::{Store, StoreWriter};
+pub use crate::resume::{preload, preload_from};
+use crate::store::StoreWriter;
 use estimators::budget::{Budget, BudgetKind};
 use estimators::error::EstimateError;
 use estimators::math::Rgb;
 use estimators::rng::StreamKey;
 use estimators::task::{Costs, Task};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Receives progress (no-op by default): the CLI draws bars from it.
@@ -278,50 +279,6 @@ pub fn cell_key(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> CellKey {
         seed: plan.sweep.seed,
         version: env!("CARGO_PKG_VERSION").to_string(),
     }
-}
-
-/// Reads a stored cell back from `store`: `None` when absent; a record that does not decode, holds
-/// another cell or does not fit the plan (integrals, repetitions, finite statistics) is bad input
-/// naming the store and the cell.
-pub(crate) fn read_cell(store: &Store, key: &CellKey, integrals: usize) -> Result<Option<CellResult>> {
-    let name = key.name();
-    let Some(record) = store.get(&name) else { return Ok(None) };
-    let refuse = |why: String| {
-        HarnessError::bad_file(
-            store.path(),
-            format!("corrupt stored cell {name} ({why}); delete the store to recompute its cells"),
-        )
-    };
-    let cell = crate::packed::decode_cell(&record.payload).map_err(refuse)?;
-    if cell.key != *key {
-        return Err(refuse("it holds another cell than its name says".into()));
-    }
-    cell.check_shape(integrals, key.reps).map_err(refuse)?;
-    Ok(Some(cell))
-}
-
-/// The stored cells of a plan, in (pair, budget) order, read and checked before anything runs:
-/// a corrupt cell is refused before any other cell is recomputed or written.
-pub fn preload(plan: &Plan, store: Option<&Path>) -> Result<Vec<Option<CellResult>>> {
-    match store {
-        Some(path) => preload_from(plan, Some(&Store::open(path)?)),
-        None => preload_from(plan, None),
-    }
-}
-
-/// [`preload`] from a store already read (one reading for several plans).
-pub fn preload_from(plan: &Plan, store: Option<&Store>) -> Result<Vec<Option<CellResult>>> {
-    let mut out = Vec::with_capacity(plan.pairs.len() * plan.sweep.budgets.len());
-    for &(bi, ei) in &plan.pairs {
-        for &budget in &plan.sweep.budgets {
-            let key = cell_key(plan, bi, ei, budget);
-            out.push(match store {
-                Some(s) => read_cell(s, &key, plan.beds[bi].bed.integrals())?,
-                None => None,
-            });
-        }
-    }
-    Ok(out)
 }
 
 /// Runs `plan`'s cells on `threads` threads with progress on a terminal, reading back and storing

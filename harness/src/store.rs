@@ -241,7 +241,8 @@ impl StoreWriter {
             let kept: Vec<Record> = last.into_iter().map(|(_, r)| r.clone()).collect();
             write_records(path, &kept)?;
         }
-        let mut file = OpenOptions::new().read(true).write(true).open(path).map_err(|e| HarnessError::write(path, e))?;
+        let mut file =
+            OpenOptions::new().read(true).write(true).open(path).map_err(|e| HarnessError::write(path, e))?;
         if store.torn_bytes() > 0 && !store.has_duplicates() && store.len >= HEADER_LEN {
             file.set_len(store.valid as u64).map_err(|e| HarnessError::write(path, e))?;
         }

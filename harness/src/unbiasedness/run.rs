@@ -159,8 +159,11 @@ pub fn post(
     registry: &Registry,
 ) -> Result<Vec<PathBuf>> {
     let threads = report.meta.threads;
-    let first_pilot =
-        runner::run_stored(&Plan::prepare(pilot_of(&plan.sweep), registry)?, results.join(crate::store::CELLS), threads)?;
+    let first_pilot = runner::run_stored(
+        &Plan::prepare(pilot_of(&plan.sweep), registry)?,
+        results.join(crate::store::CELLS),
+        threads,
+    )?;
     let mut rows = rows_of(plan, run, &first_pilot, report, registry);
     let first_bed = plan.sweep.testbeds.first().map(|t| t.id.clone()).unwrap_or_default();
     let mut notes = vec![format!("part {first_bed}... ({} reps)", plan.sweep.reps)];
@@ -169,8 +172,11 @@ pub fn post(
         let (plans, invalid) = prepare_valid(sweep, registry)?;
         rows.extend(invalid);
         for p in plans {
-            let pilot =
-                runner::run_stored(&Plan::prepare(pilot_of(&p.sweep), registry)?, results.join(crate::store::CELLS), threads)?;
+            let pilot = runner::run_stored(
+                &Plan::prepare(pilot_of(&p.sweep), registry)?,
+                results.join(crate::store::CELLS),
+                threads,
+            )?;
             let r = runner::run_stored(&p, results.join(crate::store::CELLS), threads)?;
             for (bi, ei, cell) in &r.cells {
                 report.rows.push(p.summary_row(*bi, *ei, cell));
