@@ -42,7 +42,7 @@ fn plan(reps: usize) -> Plan {
 }
 
 fn run(plan: &Plan, threads: usize) -> Vec<CellResult> {
-    let opts = RunOptions { threads: Some(threads), cell_dir: None, observer: &Silent };
+    let opts = RunOptions { threads: Some(threads), store: None, observer: &Silent };
     runner::run(plan, &opts).expect("runs").cells.into_iter().map(|(_, _, c)| c).collect()
 }
 

@@ -141,9 +141,12 @@ fn a_custom_sweep_runs_end_to_end_and_plots_can_be_redrawn() {
     std::fs::write(d.join("tiny.toml"), SMALL).expect("write");
     let o = mcbench(d, &["run", "--config", "tiny.toml", "--threads", "2"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    for f in
-        ["results/tiny/summary.csv", "results/tiny/integrals.csv", "results/tiny/summary.json", "plots/tiny/report.md"]
-    {
+    for f in [
+        "results/tiny/summary.csv",
+        "results/tiny/integrals.csv.gz",
+        "results/tiny/summary.json",
+        "plots/tiny/report.md",
+    ] {
         assert!(d.join(f).is_file(), "{f} missing");
     }
     assert!(String::from_utf8_lossy(&o.stdout).contains("clamped_is0_cv0[clamp=1.5]"));
@@ -185,12 +188,10 @@ fn a_killed_run_resumes_to_the_same_results() {
         .stderr(std::process::Stdio::null())
         .spawn()
         .expect("starts");
-    let cells = killed.path().join("results/slow/cells");
-    let count = || {
-        std::fs::read_dir(&cells)
-            .map(|d| d.filter_map(|e| e.ok()).filter(|e| e.path().extension().is_some_and(|x| x == "json")).count())
-            .unwrap_or(0)
-    };
+    let store = killed.path().join("results/slow/cells.store");
+    // Cells whose records are whole (the store is read as a reader sees it while a writer appends:
+    // a torn last record is not counted).
+    let count = || mcbench::store::Store::open(&store).map(|s| s.records().len()).unwrap_or(0);
     let start = std::time::Instant::now();
     while count() < 3 && start.elapsed() < std::time::Duration::from_secs(120) {
         std::thread::sleep(std::time::Duration::from_millis(5));
@@ -201,14 +202,9 @@ fn a_killed_run_resumes_to_the_same_results() {
     assert!(still_running, "the run finished before it could be killed: make the sweep slower");
     let stored = count();
     assert!((3..21).contains(&stored), "{stored} cells stored when killed");
-    // Every stored cell is a whole JSON document (writes are atomic: temp file + rename).
-    for e in std::fs::read_dir(&cells).expect("cells") {
-        let p = e.expect("entry").path();
-        if p.extension().is_some_and(|x| x == "json") {
-            let text = std::fs::read_to_string(&p).expect("read");
-            serde_json::from_str::<serde_json::Value>(&text).unwrap_or_else(|err| panic!("{p:?} corrupt: {err}"));
-        }
-    }
+    // Every stored cell decodes whole (records are appended with one write each and checksummed;
+    // a torn last record would be dropped, never read).
+    assert_eq!(common::stored_cells(&store).len(), stored);
     let resumed = mcbench(killed.path(), &[&args[..], &["--progress"]].concat());
     assert!(resumed.status.success(), "{}", stderr(&resumed));
     let log = String::from_utf8_lossy(&resumed.stdout).to_string() + &stderr(&resumed);
@@ -217,8 +213,5 @@ fn a_killed_run_resumes_to_the_same_results() {
     assert!(uninterrupted.status.success(), "{}", stderr(&uninterrupted));
     let (a, b) = (killed.path().join("results/slow"), clean.path().join("results/slow"));
     assert_eq!(deterministic_csv(&a.join("summary.csv")), deterministic_csv(&b.join("summary.csv")));
-    assert_eq!(
-        std::fs::read_to_string(a.join("integrals.csv")).expect("integrals"),
-        std::fs::read_to_string(b.join("integrals.csv")).expect("integrals")
-    );
+    assert_eq!(common::integrals_text(&a), common::integrals_text(&b));
 }

@@ -3,6 +3,7 @@
 //! fallback, said so); and the interleaved scheduling of the cells of one (test bed, budget) does
 //! not change any result.
 
+mod common;
 use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::estimators::budget::{Budget, BudgetKind};
 use mcbench::estimators::params::{ParamSpec, Params};
@@ -109,7 +110,7 @@ fn summaries(plan: &mcbench::plan::Plan, run: &runner::RunResults) -> Vec<mcbenc
 fn cpu_seconds_count_work_and_not_sleep() {
     let plan =
         mcbench::plan::Plan::prepare(sweep(&["sleeper", "spinner"], 2.0, samples(&[1]), 3), registry()).expect("plans");
-    let opts = RunOptions { threads: Some(1), cell_dir: None, observer: &Silent };
+    let opts = RunOptions { threads: Some(1), store: None, observer: &Silent };
     let run = runner::run(&plan, &opts).expect("runs");
     let rows = summaries(&plan, &run);
     let row = |name: &str| rows.iter().find(|r| r.estimator == name).expect("row");
@@ -154,7 +155,7 @@ fn interleaved_cells_equal_cells_run_alone() {
     for s in [surface, media] {
         let plan = mcbench::plan::Plan::prepare(s, registry()).expect("plans");
         for threads in [1, 2] {
-            let opts = RunOptions { threads: Some(threads), cell_dir: None, observer: &Silent };
+            let opts = RunOptions { threads: Some(threads), store: None, observer: &Silent };
             let run = runner::run(&plan, &opts).expect("runs");
             assert_eq!(run.cells.len(), plan.pairs.len() * plan.sweep.budgets.len());
             let mut k = 0;
@@ -178,17 +179,14 @@ fn interleaved_cells_equal_cells_run_alone() {
 fn cells_stored_without_cpu_time_fall_back_to_wall_time() {
     let dir = tempfile::tempdir().expect("tempdir");
     let plan = mcbench::plan::Plan::prepare(sweep(&["is0_cv0"], 3.0, samples(&[4]), 4), registry()).expect("plans");
-    let opts = RunOptions { threads: Some(2), cell_dir: Some(dir.path().to_path_buf()), observer: &Silent };
+    let store = dir.path().join(mcbench::store::CELLS);
+    let opts = RunOptions { threads: Some(2), store: Some(store.clone()), observer: &Silent };
     let first = runner::run(&plan, &opts).expect("runs");
     let mut edited = 0;
-    for f in std::fs::read_dir(dir.path()).expect("cells") {
-        let path = f.expect("entry").path();
-        let mut json: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(&path).expect("read")).expect("json");
+    common::edit_cells(&store, |_, json| {
         assert!(json.as_object_mut().expect("object").remove("cpu_time").is_some());
-        std::fs::write(&path, json.to_string()).expect("write");
         edited += 1;
-    }
+    });
     assert_eq!(edited, 1);
     let again = runner::run(&plan, &opts).expect("resumes");
     let (old, new) = (&summaries(&plan, &first)[0], &summaries(&plan, &again)[0]);

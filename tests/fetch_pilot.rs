@@ -61,6 +61,7 @@ fn fetch_budgets_are_spent_within_ten_percent_at_every_resolution() {
             plots: false,
             wait: false,
             registry: &registry,
+            integrals: Default::default(),
         };
         let out = execute(&plan, None, &opts).expect("run succeeds");
         let hit = hit_fraction(side);

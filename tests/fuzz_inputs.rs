@@ -9,6 +9,7 @@ use mcbench::error::HarnessError;
 use mcbench::execute::{execute, ExecOptions};
 use mcbench::output::{read_results, read_results_unverified};
 use mcbench::runner::Silent;
+use mcbench::store::Store;
 use proptest::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
@@ -184,6 +185,7 @@ fn options(root: &Path) -> ExecOptions<'static> {
         plots: false,
         wait: false,
         registry: registry(),
+        integrals: Default::default(),
     }
 }
 
@@ -212,7 +214,7 @@ fn edited_result_files_never_panic_and_fail_in_one_line() {
         .run(&edits(), |edits| {
             let copy = dir.path().join("copy");
             std::fs::create_dir_all(&copy).expect("dir");
-            for f in ["summary.csv", "integrals.csv", "commit.json"] {
+            for f in ["summary.csv", "integrals.csv.gz", "commit.json"] {
                 std::fs::copy(res.join(f), copy.join(f)).expect("copy");
             }
             let edited = mutate(&original, &edits);
@@ -226,22 +228,57 @@ fn edited_result_files_never_panic_and_fail_in_one_line() {
         .expect("no edit makes the reader panic or fail in more than one line");
 }
 
-/// Random edits of a stored cell: the resume's check ([`mcbench::runner::preload`]) never
-/// panics, and refuses in one line naming the cell file.
+/// Random edits of a stored cell's JSON (inside its record, checksums made good): the resume's
+/// check ([`mcbench::runner::preload`]) never panics, and refuses in one line naming the cell.
 #[test]
 fn edited_cells_never_panic_and_fail_in_one_line() {
     let (dir, plan) = tiny_run();
-    let cells = dir.path().join("results/tiny/cells");
-    let cell = std::fs::read_dir(&cells).expect("cells").next().expect("a cell").expect("entry").path();
-    let name = cell.file_name().and_then(|n| n.to_str()).expect("name").to_string();
-    let original = std::fs::read_to_string(&cell).expect("cell");
+    let path = dir.path().join("results/tiny/cells.store");
+    let records = Store::open(&path).expect("store").records().to_vec();
+    let name = records[0].name.clone();
+    let original = mcbench::packed::split(&records[0].payload).expect("a record");
     runner(300)
         .run(&edits(), |edits| {
-            std::fs::write(&cell, mutate(&original, &edits)).expect("write");
-            prop_assert_eq!(file_rejected_well(&name, || mcbench::runner::preload(&plan, Some(&cells))), Ok(()));
+            let mut parts = original.clone();
+            parts.meta = mutate(&original.meta, &edits);
+            let mut edited = records.clone();
+            edited[0].payload = mcbench::packed::join(&parts);
+            mcbench::store::write_records(&path, &edited).expect("write");
+            prop_assert_eq!(file_rejected_well("cells.store", || mcbench::runner::preload(&plan, Some(&path))), Ok(()));
+            if let Err(e) = mcbench::runner::preload(&plan, Some(&path)) {
+                prop_assert!(e.to_string().contains(&name), "the refusal names the cell: {}", e);
+            }
             Ok(())
         })
         .expect("no edit makes the resume panic or fail in more than one line");
+}
+
+/// Random byte edits of a whole cell store (frames, checksums, compressed payloads): reading it
+/// back never panics; it reads (a damaged last record is dropped as a torn tail) or is refused in
+/// one line naming the store.
+#[test]
+fn edited_stores_never_panic_and_fail_in_one_line() {
+    let (dir, plan) = tiny_run();
+    let path = dir.path().join("results/tiny/cells.store");
+    let original = std::fs::read(&path).expect("store");
+    let byte_edits = prop::collection::vec((0usize..1_000_000, any::<u8>(), 0u8..3), 1..4);
+    runner(300)
+        .run(&byte_edits, |edits| {
+            let mut b = original.clone();
+            for &(pos, byte, kind) in &edits {
+                let i = pos % b.len().max(1);
+                match kind {
+                    0 if !b.is_empty() => drop(b.remove(i)),
+                    1 => b.insert(i, byte),
+                    _ if !b.is_empty() => b[i] ^= byte | 1,
+                    _ => {}
+                }
+            }
+            std::fs::write(&path, &b).expect("write");
+            prop_assert_eq!(file_rejected_well("cells.store", || mcbench::runner::preload(&plan, Some(&path))), Ok(()));
+            Ok(())
+        })
+        .expect("no edit makes the store's reader panic or fail in more than one line");
 }
 
 /// Random edits of a shard manifest: `merge` never panics and refuses in one line naming the

@@ -5,6 +5,7 @@
 use estimators::params::Params;
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::execute::{execute, ExecOptions};
+use mcbench::integrals::IntegralsFormat;
 use mcbench::runner::Silent;
 use std::path::Path;
 
@@ -32,6 +33,16 @@ fn sweep(ids: &[&str], reps: usize) -> Sweep {
 }
 
 fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> mcbench::execute::Outcome {
+    run_with(dir, sweep, threads, plots, IntegralsFormat::default())
+}
+
+fn run_with(
+    dir: &Path,
+    sweep: Sweep,
+    threads: usize,
+    plots: bool,
+    integrals: IntegralsFormat,
+) -> mcbench::execute::Outcome {
     let plan = plan_of(sweep).expect("valid sweep");
     let opts = ExecOptions {
         results_root: dir.join("results"),
@@ -41,6 +52,7 @@ fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> mcbench::e
         plots,
         wait: false,
         registry: registry(),
+        integrals,
     };
     execute(&plan, None, &opts).expect("run succeeds")
 }
@@ -50,7 +62,7 @@ fn writes_the_contract_files_with_the_contract_columns() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = run_into(dir.path(), sweep(&["is0_cv0", "brdf_is0_cv0", "clamped_is0_cv0"], 4), 2, true);
     let res = dir.path().join("results/itest");
-    for f in ["summary.csv", "integrals.csv", "summary.json"] {
+    for f in ["summary.csv", "integrals.csv.gz", "summary.json", "cells.store"] {
         assert!(res.join(f).is_file(), "{f} missing");
     }
     let header =
@@ -62,12 +74,21 @@ fn writes_the_contract_files_with_the_contract_columns() {
     for k in ["meta", "fits", "tests", "paper"] {
         assert!(json.get(k).is_some(), "summary.json lacks {k}");
     }
-    let integrals = std::fs::read_to_string(res.join("integrals.csv")).expect("read");
+    let integrals = common::integrals_text(&res);
     assert!(
         integrals.starts_with("testbed,variant,estimator,integral,px,py,channel,reference,reference_se,mean,std_err")
     );
     // 3 estimators x 36 pixels x 3 channels at the largest budget.
     assert_eq!(integrals.lines().count(), 1 + 3 * 36 * 3);
+    // Parameters are summary.csv's, per (testbed, variant, estimator); integrals.csv keeps the id.
+    let first = integrals.lines().next().unwrap_or_default();
+    assert!(first.ends_with(",estimator_id") && !first.contains("params"), "{first}");
+    assert!(header.contains(",estimator_id,params,testbed_params,"), "{header}");
+    // The plain file on request, with the same text; the commit lists whichever was written.
+    run_with(dir.path(), sweep(&["is0_cv0", "brdf_is0_cv0", "clamped_is0_cv0"], 4), 2, false, IntegralsFormat::Csv);
+    assert!(!res.join("integrals.csv.gz").exists());
+    assert_eq!(std::fs::read_to_string(res.join("integrals.csv")).expect("plain"), integrals);
+    mcbench::output::read_results(&res).expect("the folder is one committed run");
     assert_eq!(out.report.rows.len(), 3 * 4);
     // Costs are counted by the harness: samples per estimate equal the sample budget.
     assert!(out.report.rows.iter().all(|r| r.samples == r.budget as f64 && r.fetches == 0.0));
@@ -97,8 +118,8 @@ fn same_seed_same_results_whatever_the_thread_count() {
             run_into(d.path(), media, threads, false);
             let mut csv = deterministic_csv(&d.path().join("results/itest/summary.csv"));
             csv.push_str(&deterministic_csv(&d.path().join("results/itest-media/summary.csv")));
-            let mut integrals = std::fs::read(d.path().join("results/itest/integrals.csv")).expect("read");
-            integrals.extend(std::fs::read(d.path().join("results/itest-media/integrals.csv")).expect("read"));
+            let mut integrals = common::integrals_text(&d.path().join("results/itest")).into_bytes();
+            integrals.extend(common::integrals_text(&d.path().join("results/itest-media")).into_bytes());
             (csv, integrals)
         })
         .collect();
@@ -113,11 +134,13 @@ fn a_rerun_resumes_from_stored_cells() {
     let dir = tempfile::tempdir().expect("tempdir");
     run_into(dir.path(), sweep(&["is0_cv0"], 3), 2, false);
     let first = std::fs::read(dir.path().join("results/itest/summary.csv")).expect("read");
-    let cells = dir.path().join("results/itest/cells");
-    assert_eq!(std::fs::read_dir(&cells).expect("cells dir").count(), 4);
+    let store = dir.path().join("results/itest/cells.store");
+    assert_eq!(common::stored_cells(&store).len(), 4);
+    let before = std::fs::read(&store).expect("store");
     // Same seed: cells are read back, so even the timing columns are identical.
     run_into(dir.path(), sweep(&["is0_cv0"], 3), 1, false);
     assert_eq!(first, std::fs::read(dir.path().join("results/itest/summary.csv")).expect("read"));
+    assert_eq!(before, std::fs::read(&store).expect("store"), "a run that computes nothing leaves the store as it was");
     // A different seed does not reuse them.
     let mut s = sweep(&["is0_cv0"], 3);
     s.seed = 43;
@@ -126,6 +149,11 @@ fn a_rerun_resumes_from_stored_cells() {
         deterministic_csv(&dir.path().join("results/itest/summary.csv")),
         String::from_utf8_lossy(&first).to_string()
     );
+    assert_eq!(common::stored_cells(&store).len(), 8, "the other seed's cells are appended beside the first's");
+    // The store is a cache beside the committed files, not one of them: it grows, the commit holds.
+    let commit = std::fs::read_to_string(dir.path().join("results/itest/commit.json")).expect("commit");
+    assert!(!commit.contains("cells.store"), "{commit}");
+    mcbench::output::read_results(&dir.path().join("results/itest")).expect("a consistent folder");
 }
 
 #[test]
@@ -207,8 +235,8 @@ fn sequences_are_deterministic_whatever_the_thread_count() {
     let b = tempfile::tempdir().expect("tempdir");
     run_into(a.path(), mk(), 1, false);
     run_into(b.path(), mk(), 2, false);
-    let ia = std::fs::read(a.path().join("results/itest/integrals.csv")).expect("read");
-    let ib = std::fs::read(b.path().join("results/itest/integrals.csv")).expect("read");
+    let ia = common::integrals_text(&a.path().join("results/itest")).into_bytes();
+    let ib = common::integrals_text(&b.path().join("results/itest")).into_bytes();
     assert_eq!(ia, ib);
     // 9 pixels x 3 frames x 3 channels per estimator; px, py come from the pixel, not the integral.
     let text = String::from_utf8_lossy(&ia).to_string();

@@ -95,7 +95,7 @@ fn one_file_and_one_registration_are_enough() {
     let plan = mcbench::plan::Plan::prepare(sweep(Params::new().with("tilt", 0.5)), &registry).expect("plans");
     let bad = mcbench::plan::Plan::prepare(sweep(Params::new().with("tlit", 0.5)), &registry);
     assert!(bad.err().map(|e| e.to_string()).unwrap_or_default().contains("throw_away.tlit"));
-    let opts = mcbench::runner::RunOptions { threads: Some(1), cell_dir: None, observer: &mcbench::runner::Silent };
+    let opts = mcbench::runner::RunOptions { threads: Some(1), store: None, observer: &mcbench::runner::Silent };
     let run = mcbench::runner::run(&plan, &opts).expect("runs");
     assert_eq!(run.cells.len(), 3);
     // In the unbiasedness experiment wherever a case provides a surface, with nothing listing it.

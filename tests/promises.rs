@@ -4,6 +4,8 @@
 //! the one table, and leaves the results and plots folders byte for byte as they were; folders are
 //! locked, committed as a whole and checked when read back.
 
+mod common;
+use mcbench::store::Store;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -179,15 +181,49 @@ fn outputs_and_stored_cells_are_checked_first() {
     refused(d, &["run", "--config", "tiny.toml", "--plots", "afile"], 2, "--plots");
     refused(d, &["run", "--config", "tiny.toml", "--results", "afile"], 2, "--results");
     refused(d, &["reference", "gradient-plane", "--results", "afile"], 2, "--results");
-    let cells = d.join("results/tiny/cells");
-    let mut names: Vec<PathBuf> = std::fs::read_dir(&cells).expect("cells").map(|e| e.expect("e").path()).collect();
-    names.sort();
-    for p in &names[..3] {
-        std::fs::remove_file(p).expect("remove");
-    }
-    std::fs::write(&names[5], "{\"key\":").expect("corrupt");
-    let stem = names[5].file_name().and_then(|n| n.to_str()).expect("name").to_string();
-    refused(d, &["run", "--config", "tiny.toml"], 2, &stem);
+    let store = d.join("results/tiny/cells.store");
+    let mut records = Store::open(&store).expect("store").records().to_vec();
+    records.sort_by(|a, b| a.name.cmp(&b.name));
+    records.drain(..3);
+    let corrupt = mcbench::packed::join(&mcbench::packed::Parts { meta: "{\"key\":".into(), moments: Vec::new() });
+    records[2].payload = corrupt;
+    let name = records[2].name.clone();
+    mcbench::store::write_records(&store, &records).expect("rewrite");
+    refused(d, &["run", "--config", "tiny.toml"], 2, &name);
+    refused(d, &["run", "--config", "tiny.toml"], 2, "cells.store");
+}
+
+/// Class 5b: a store a killed writer left with a torn last record is read without it and the
+/// next run truncates it before appending; a record damaged in the middle is refused naming the
+/// store, and nothing is written.
+#[test]
+fn a_torn_store_tail_is_dropped_and_a_corrupt_middle_refused() {
+    let dir = finished();
+    let d = dir.path();
+    let store = d.join("results/tiny/cells.store");
+    let whole = std::fs::read(&store).expect("store");
+    let records = Store::open(&store).expect("store").records().to_vec();
+    // The last record cut in half, as SIGKILL during its write leaves it.
+    let last = mcbench::store::frame(&records[records.len() - 1].name, &records[records.len() - 1].payload);
+    std::fs::write(&store, &whole[..whole.len() - last.len() / 2]).expect("cut");
+    let o = ok(d, &["run", "--config", "tiny.toml", "--progress"]);
+    assert_eq!(stderr(&o).matches("(resumed)").count(), records.len() - 1, "{}", stderr(&o));
+    let again = Store::open(&store).expect("store");
+    assert_eq!((again.records().len(), again.torn_bytes()), (records.len(), 0), "truncated, then appended");
+    // One flipped byte inside the second record: refused, naming the store and where.
+    let mut bad = std::fs::read(&store).expect("store");
+    let second =
+        mcbench::store::HEADER_LEN + mcbench::store::frame(&again.records()[0].name, &again.records()[0].payload).len();
+    bad[second + mcbench::store::FRAME_LEN + 20] ^= 0x40;
+    std::fs::write(&store, &bad).expect("damage");
+    refused(d, &["run", "--config", "tiny.toml"], 2, "cells.store");
+    refused(d, &["run", "--config", "tiny.toml"], 2, &format!("corrupt record at byte {second}"));
+    // Deleting the store recomputes every cell (an older folder's cells/ is never read).
+    std::fs::remove_file(&store).expect("rm");
+    std::fs::create_dir_all(d.join("results/tiny/cells")).expect("old cells folder");
+    std::fs::write(d.join("results/tiny/cells/old.json"), "{").expect("old cell");
+    let o = ok(d, &["run", "--config", "tiny.toml", "--progress"]);
+    assert_eq!(stderr(&o).matches("(resumed)").count(), 0, "{}", stderr(&o));
 }
 
 /// Class 6: files read back are checked, and no path comes from their content: `plot` of a
@@ -212,9 +248,9 @@ fn files_read_back_are_checked() {
     std::fs::write(res.join("summary.json"), &json).expect("restore");
     recommit(&res, "summary.json");
     ok(d, &["plot", "results/tiny"]);
-    let cell = std::fs::read_dir(res.join("cells")).expect("cells").next().expect("one").expect("e").path();
-    let original = std::fs::read_to_string(&cell).expect("cell");
-    let v: serde_json::Value = serde_json::from_str(&original).expect("json");
+    let store = res.join("cells.store");
+    let original = std::fs::read(&store).expect("store");
+    let name = Store::open(&store).expect("store").records()[0].name.clone();
     type Edit = Box<dyn Fn(&mut serde_json::Value)>;
     let edits: [(&str, Edit); 4] = [
         ("integrals", Box::new(|v| drop(v["moments"].as_array_mut().expect("m").pop()))),
@@ -237,15 +273,17 @@ fn files_read_back_are_checked() {
         ),
         ("another cell", Box::new(|v| v["key"]["seed"] = serde_json::json!(99))),
     ];
-    let stem = cell.file_name().and_then(|n| n.to_str()).expect("name").to_string();
     for (needle, edit) in edits.iter() {
-        let mut w = v.clone();
-        edit(&mut w);
-        std::fs::write(&cell, serde_json::to_string(&w).expect("json")).expect("write");
+        std::fs::write(&store, &original).expect("restore");
+        common::edit_cells(&store, |n, v| {
+            if n == name {
+                edit(v)
+            }
+        });
         refused(d, &["run", "--config", "tiny.toml"], 2, needle);
-        refused(d, &["run", "--config", "tiny.toml"], 2, &stem);
+        refused(d, &["run", "--config", "tiny.toml"], 2, &name);
     }
-    std::fs::write(&cell, original).expect("restore");
+    std::fs::write(&store, original).expect("restore");
     ok(d, &["run", "--config", "tiny.toml"]);
 }
 
@@ -279,9 +317,11 @@ fn folders_are_locked_and_committed_as_a_whole() {
         .stderr(std::process::Stdio::null())
         .spawn()
         .expect("starts");
-    let cells = d.join("results/tiny/cells");
+    let store = d.join("results/tiny/cells.store");
+    let stored = || Store::open(&store).map(|s| s.records().len()).unwrap_or(0);
     let t0 = std::time::Instant::now();
-    while std::fs::read_dir(&cells).map(|r| r.count()).unwrap_or(0) < 7 && t0.elapsed().as_secs() < 60 {
+    // The finished run's 6 cells, and a first one of the slow sweep.
+    while stored() < 7 && t0.elapsed().as_secs() < 60 {
         std::thread::sleep(std::time::Duration::from_millis(10));
     }
     assert!(first.try_wait().expect("status").is_none(), "the first run finished too soon to be raced");
@@ -328,7 +368,7 @@ fn temp_files_progress_and_exit_codes() {
     let d = dir.path();
     let stale = [
         d.join("results/tiny/.summary.csv.tmp-4242"),
-        d.join("results/tiny/cells/.x.json.tmp-4242"),
+        d.join("results/tiny/.cells.store.tmp-4242"),
         d.join("plots/tiny/.report.md.tmp-4242"),
     ];
     for s in &stale {

@@ -50,6 +50,7 @@ fn small_run(dir: &Path) {
         plots: false,
         wait: false,
         registry: &registry,
+        integrals: Default::default(),
     };
     execute(&plan, None, &opts).expect("run succeeds");
 }

@@ -8,6 +8,7 @@ use std::process::{Command, Output};
 mod common;
 use common::deterministic_csv;
 use mcbench::metrics::TIMING_COLUMNS;
+use mcbench::store::{Record, Store};
 
 /// The transmittance experiment (its claims and post hook included) shrunk to seconds: two small
 /// test beds, three fetch budgets (pilot-calibrated per cell), and 40 repetitions, i.e. three
@@ -82,9 +83,15 @@ fn three_shard_processes_merged_equal_a_single_run() {
     ok(d, &["merge", "sh/results/transmittance", "--results", "sh/results", "--plots", "sh/plots", "--threads", "2"]);
     let (single, merged) = (d.join("single/results/transmittance"), d.join("sh/results/transmittance"));
     assert_eq!(deterministic_csv(&merged.join("summary.csv")), deterministic_csv(&single.join("summary.csv")));
-    for f in ["integrals.csv", "fig8_bands.csv"] {
-        assert!(read(merged.join(f)) == read(single.join(f)), "{f} differs");
-    }
+    assert_eq!(common::integrals_text(&merged), common::integrals_text(&single), "integrals.csv differs");
+    assert!(read(merged.join("fig8_bands.csv")) == read(single.join("fig8_bands.csv")), "fig8_bands.csv differs");
+    // A shard folder is its block store, its manifest and its lock.
+    let mut names: Vec<String> = std::fs::read_dir(d.join("sh/results/transmittance/shard-2-of-3"))
+        .expect("shard folder")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().to_string())
+        .collect();
+    names.sort();
+    assert_eq!(names, [".lock", "blocks.store", "manifest.json"]);
     assert_eq!(deterministic_json(&merged.join("summary.json")), deterministic_json(&single.join("summary.json")));
     // Plots that do not show time are byte-identical too (a test bed's figure has panels against
     // CPU time; its RMSE bands are summary.csv's rmse_lo and rmse_hi, compared above).
@@ -144,18 +151,10 @@ fn bad_shard_values_and_bad_shard_sets_are_refused() {
     refused(d, &[&s1, "seed2/transmittance/shard-2-of-3", &s3], "seed");
     refused(d, &[&s1, "reps/transmittance/shard-2-of-3", &s3], "reps");
     refused(d, &["nowhere"], "nowhere");
-    // Damaged copies of shard 2: a truncated block, a missing block, a garbled or absent manifest.
-    let blocks = |p: &str| -> Vec<PathBuf> {
-        let mut v: Vec<PathBuf> = std::fs::read_dir(d.join(p))
-            .expect("read_dir")
-            .map(|e| e.expect("entry").path())
-            .filter(|p| {
-                p.extension().is_some_and(|x| x == "json") && p.file_name().is_some_and(|n| n != "manifest.json")
-            })
-            .collect();
-        v.sort();
-        v
-    };
+    // Damaged copies of shard 2: a truncated block, a missing block, a foreign block, a torn or
+    // corrupt store, a garbled or absent manifest.
+    let records = |p: &Path| -> Vec<Record> { Store::open(&p.join("blocks.store")).expect("store").records().to_vec() };
+    let rewrite = |p: &Path, r: &[Record]| mcbench::store::write_records(&p.join("blocks.store"), r).expect("write");
     let damage = |name: &str, how: &dyn Fn(&Path)| -> String {
         let to = d.join(name).join("shard-2-of-3");
         copy_dir(&d.join(&s2), &to);
@@ -163,13 +162,33 @@ fn bad_shard_values_and_bad_shard_sets_are_refused() {
         format!("{name}/shard-2-of-3")
     };
     let truncated = damage("truncated", &|p| {
-        let f = &blocks(p.to_str().expect("utf8"))[0];
-        let text = std::fs::read(f).expect("read");
-        std::fs::write(f, &text[..text.len() / 2]).expect("write");
+        let mut r = records(p);
+        let half = r[0].payload.len() / 2;
+        r[0].payload.truncate(half);
+        rewrite(p, &r);
     });
     refused(d, &[&s1, &truncated, &s3], "corrupt shard block");
-    let missing = damage("missing", &|p| std::fs::remove_file(&blocks(p.to_str().expect("utf8"))[0]).expect("rm"));
+    let missing = damage("missing", &|p| rewrite(p, &records(p)[1..]));
     refused(d, &[&s1, &missing, &s3], "shard 2/3 is incomplete");
+    let foreign = damage("foreign", &|p| {
+        let mut r = records(p);
+        let first = r[0].name.clone();
+        r[0].name = r[1].name.clone();
+        r[1].name = first;
+        rewrite(p, &r);
+    });
+    refused(d, &[&s1, &foreign, &s3], "holds another cell or block");
+    let torn = damage("torn", &|p| {
+        let bytes = std::fs::read(p.join("blocks.store")).expect("read");
+        std::fs::write(p.join("blocks.store"), &bytes[..bytes.len() - 7]).expect("write");
+    });
+    refused(d, &[&s1, &torn, &s3], "shard 2/3 is incomplete");
+    let corrupt = damage("corrupt", &|p| {
+        let mut bytes = std::fs::read(p.join("blocks.store")).expect("read");
+        bytes[mcbench::store::HEADER_LEN + mcbench::store::FRAME_LEN + 8] ^= 0x10;
+        std::fs::write(p.join("blocks.store"), &bytes).expect("write");
+    });
+    refused(d, &[&s1, &corrupt, &s3], "corrupt record");
     let garbled = damage("garbled", &|p| std::fs::write(p.join("manifest.json"), "{\"format\": 1,").expect("write"));
     refused(d, &[&s1, &garbled, &s3], "corrupt shard manifest");
     let unfinished = damage("unfinished", &|p| std::fs::remove_file(p.join("manifest.json")).expect("rm"));

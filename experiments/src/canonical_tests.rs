@@ -151,6 +151,7 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
         plots: true,
         wait: false,
         registry: &registry,
+        integrals: Default::default(),
     };
     let def = crate::canonical_sweep::DEF.experiment();
     let out = execute(&prepare(sweep, &registry).unwrap(), Some(&def), &opts).unwrap();

@@ -49,7 +49,7 @@ fn rows(
         cost_model: Default::default(),
     };
     let plan = Plan::prepare(sweep, registry).expect("valid sweep");
-    let opts = RunOptions { threads: Some(threads), cell_dir: None, observer: &Silent };
+    let opts = RunOptions { threads: Some(threads), store: None, observer: &Silent };
     let done = run(&plan, &opts).expect("run");
     done.cells.iter().map(|(bi, ei, cell)| plan.summary_row(*bi, *ei, cell)).collect()
 }

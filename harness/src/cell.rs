@@ -33,16 +33,17 @@ pub struct CellKey {
 }
 
 impl CellKey {
-    /// A file name for the cell: a short readable prefix (test bed, variant, estimator and budget,
-    /// each cut to 32 characters) and a digest of the whole key, so that no parameter value can
-    /// make the name long (the key itself is inside the file and checked on reading).
-    pub fn file_name(&self) -> String {
+    /// The cell's name in a store ([`crate::store`]): a short readable prefix (test bed, variant,
+    /// estimator and budget, each cut to 32 characters) and a digest of the whole key, so that no
+    /// parameter value can make the name long (the key itself is inside the record and checked on
+    /// reading).
+    pub fn name(&self) -> String {
         let text = serde_json::to_string(self).unwrap_or_default();
         let clean = |s: &str| {
             s.chars().take(32).map(|c| if c.is_ascii_alphanumeric() || c == '-' { c } else { '_' }).collect::<String>()
         };
         format!(
-            "{}_{}_{}_{}{}_{:016x}.json",
+            "{}_{}_{}_{}{}_{:016x}",
             clean(&self.testbed),
             clean(&self.variant),
             clean(&self.estimator),

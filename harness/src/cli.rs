@@ -6,6 +6,7 @@
 use crate::config::{Mode, SweepFile};
 use crate::error::{HarnessError, Result};
 use crate::execute::{self, ExecOptions};
+use crate::integrals::IntegralsFormat;
 use crate::progress::Progress;
 use crate::registry::Registry;
 use crate::shard::ShardSpec;
@@ -72,6 +73,9 @@ enum Command {
         /// Where stored references are read (default: `<results>/references`).
         #[arg(long, value_name = "DIR")]
         references: Option<PathBuf>,
+        /// The per-integral file: gz (integrals.csv.gz), csv (plain integrals.csv) or none
+        #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
+        integrals: IntegralsFormat,
     },
     /// Run the conformance suite on estimators (every registered one when none is named): builds,
     /// finite output on the stability cases, determinism, its samplers' chi-square tests, and
@@ -171,6 +175,9 @@ struct RunArgs {
     /// Where stored references are read (default: `<results>/references`).
     #[arg(long, value_name = "DIR")]
     references: Option<PathBuf>,
+    /// The per-integral file: gz (integrals.csv.gz), csv (plain integrals.csv) or none
+    #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
+    integrals: IntegralsFormat,
 }
 
 impl RunArgs {
@@ -257,7 +264,7 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             Ok(())
         }
         Some(Command::Reference(args)) => reference(args, registry),
-        Some(Command::Merge { dirs, results, plots, threads, no_plots, wait, progress, references }) => {
+        Some(Command::Merge { dirs, results, plots, threads, no_plots, wait, progress, references, integrals }) => {
             let registry = &with_references(registry, &results, &references);
             let progress = Progress::new(progress);
             let opts = ExecOptions {
@@ -268,6 +275,7 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
                 plots: !no_plots,
                 wait,
                 registry,
+                integrals,
             };
             let t0 = Instant::now();
             let out = crate::merge::merge(&dirs, &opts)?;
@@ -328,6 +336,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         plots: !args.no_plots,
         wait: args.wait,
         registry,
+        integrals: args.integrals,
     };
     // Everything every experiment of the call will read is checked before the first one writes.
     let mut checked = Vec::new();

@@ -6,8 +6,9 @@ use crate::cell::CellResult;
 use crate::config::Sweep;
 use crate::error::Result;
 use crate::folder::{check_output_dir, FolderLock, OutputDir};
+use crate::integrals::{IntegralRow, IntegralsFormat};
 use crate::metrics::SummaryRow;
-use crate::output::{self, Diagnostic, IntegralRow, Meta, RunReport};
+use crate::output::{self, Diagnostic, Meta, RunReport};
 use crate::plan::{Plan, PreparedBed, PreparedEstimator};
 use crate::plot::DisplayNames;
 use crate::registry::{Experiment, Registry};
@@ -32,6 +33,8 @@ pub struct ExecOptions<'a> {
     pub wait: bool,
     /// Where names are looked up (experiments' own analyses build further plans).
     pub registry: &'a Registry,
+    /// How `integrals.csv` is written (gzip-compressed by default).
+    pub integrals: IntegralsFormat,
 }
 
 /// What a finished experiment produced.
@@ -62,7 +65,7 @@ pub fn preflight(plan: &Plan, def: Option<&Experiment>, opts: &ExecOptions<'_>) 
     if opts.plots {
         check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
     }
-    let cells = results_dir.join("cells");
+    let cells = results_dir.join(crate::store::CELLS);
     let stored = runner::preload(plan, Some(&cells))?;
     if let Some(check) = def.and_then(|d| d.preflight) {
         check(opts.registry, &plan.sweep, &cells)?;
@@ -76,9 +79,9 @@ pub fn execute(plan: &Plan, def: Option<&Experiment>, opts: &ExecOptions<'_>) ->
     execute_checked(plan, def, opts, checked)
 }
 
-/// The folders' locks of a run: results (with its `cells`) and, when plots are drawn, plots.
+/// The folders' locks of a run: results (with its cell store) and, when plots are drawn, plots.
 pub fn lock_folders(experiment: &str, opts: &ExecOptions<'_>) -> Result<Vec<FolderLock>> {
-    let mut locks = vec![FolderLock::acquire(&opts.results_root.join(experiment), opts.wait, &["cells"])?];
+    let mut locks = vec![FolderLock::acquire(&opts.results_root.join(experiment), opts.wait, &[])?];
     if opts.plots {
         locks.push(FolderLock::acquire(&opts.plots_root.join(experiment), opts.wait, &[])?);
     }
@@ -98,7 +101,11 @@ pub fn execute_checked(
     let results_dir = opts.results_root.join(&plan.sweep.experiment);
     let run = runner::run_preloaded(
         plan,
-        &RunOptions { threads: opts.threads, cell_dir: Some(results_dir.join("cells")), observer: opts.observer },
+        &RunOptions {
+            threads: opts.threads,
+            store: Some(results_dir.join(crate::store::CELLS)),
+            observer: opts.observer,
+        },
         checked.stored,
     )?;
     finish(plan, def, &run, opts, started)
@@ -204,7 +211,7 @@ pub fn finish(
     drop(analysis);
     let _output = crate::phases::enter(crate::phases::Phase::Output);
     output::write_summary_csv(&results, &report.rows)?;
-    output::write_integrals_csv(&results, &integrals)?;
+    crate::integrals::write(&results, &integrals, opts.integrals)?;
     output::write_summary_json(&results, &report)?;
     crate::report::write_tables(&results, &report)?;
     results.commit(&run_id, None)?;
@@ -293,8 +300,6 @@ fn integral_rows(cell: &CellResult, prepared: &PreparedBed, est: &PreparedEstima
                 std_err: mc.std_err(),
                 geometry: geometry.clone(),
                 estimator_id: est.spec.id.clone(),
-                params: est.params_json.clone(),
-                testbed_params: prepared.params_json.clone(),
             });
         }
     }

@@ -317,11 +317,11 @@ mod tests {
     fn a_second_lock_is_refused_and_stale_temps_are_removed() {
         let dir = tempfile::tempdir().expect("tempdir");
         let d = dir.path().join("r");
-        std::fs::create_dir_all(d.join("cells")).expect("dirs");
+        std::fs::create_dir_all(d.join("sub")).expect("dirs");
         std::fs::write(d.join(".summary.csv.tmp-123"), b"half").expect("temp");
-        std::fs::write(d.join("cells/.x.json.tmp-9"), b"half").expect("temp");
-        let lock = FolderLock::acquire(&d, false, &["cells"]).expect("free");
-        assert!(!d.join(".summary.csv.tmp-123").exists() && !d.join("cells/.x.json.tmp-9").exists());
+        std::fs::write(d.join("sub/.x.json.tmp-9"), b"half").expect("temp");
+        let lock = FolderLock::acquire(&d, false, &["sub"]).expect("free");
+        assert!(!d.join(".summary.csv.tmp-123").exists() && !d.join("sub/.x.json.tmp-9").exists());
         let e = FolderLock::acquire(&d, false, &[]).expect_err("held");
         assert_eq!(e.exit_code(), 3, "{e}");
         assert!(read_lock(&d, false).is_err(), "a reader waits for the writer");

@@ -1,17 +1,18 @@
 //! `mcbench merge <dir>...` (SPEC §12): shard folders ([`crate::shard`]) back into the files a
 //! single run writes. The shard set is checked first: one format, harness version (this binary's),
 //! experiment, seed, repetitions and config (sweep digest) throughout, every shard `1..=n` exactly
-//! once, every owned block present, parsable and of the right cell. Then the plan is rebuilt from
-//! the manifests' sweep, each cell's blocks are merged in block order ([`runner::merge_blocks`],
-//! exactly as a single run reduces them), stored for resume, and the run ends in
-//! [`execute::finish`] like a single run: same metrics, claims, post hook, files and plots.
+//! once, every owned block present in its shard's block store, decodable and of the right cell.
+//! Then the plan is rebuilt from the manifests' sweep, each cell's blocks are merged in block order
+//! ([`runner::merge_blocks`], exactly as a single run reduces them), appended to the results
+//! folder's cell store for resume, and the run ends in [`execute::finish`] like a single run: same
+//! metrics, claims, post hook, files and plots.
 
 use crate::error::{HarnessError, Result};
 use crate::execute::{self, ExecOptions, Outcome};
-use crate::output::write_atomic;
 use crate::plan::Plan;
 use crate::runner::{self, RunResults};
 use crate::shard::{self, Manifest, ShardSpec, MANIFEST};
+use crate::store::{Store, StoreWriter};
 use estimators::error::ConfigError;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -136,6 +137,7 @@ pub fn merge(dirs: &[PathBuf], opts: &ExecOptions<'_>) -> Result<Outcome> {
     if opts.plots {
         crate::folder::check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
     }
+    let stores = shards.iter().map(|(d, _)| Store::open(&d.join(crate::store::BLOCKS))).collect::<Result<Vec<_>>>()?;
     let mut cells = Vec::with_capacity(plan.pairs.len() * plan.sweep.budgets.len());
     for (c, cell_units) in units.chunks(blocks).enumerate() {
         let (bi, ei) = plan.pairs[cell_units[0].pair];
@@ -144,10 +146,12 @@ pub fn merge(dirs: &[PathBuf], opts: &ExecOptions<'_>) -> Result<Outcome> {
         let integrals = plan.beds[bi].bed.integrals();
         let mut parts = Vec::with_capacity(blocks);
         for (k, u) in cell_units.iter().enumerate() {
-            let (dir, m) = &shards[(c * blocks + k) % first.shard.count];
-            let path = dir.join(shard::block_file_name(&key, u.block));
-            let file = shard::read_checked_block(&path, &key, u.block, blocks, integrals)?.ok_or_else(|| {
-                HarnessError::bad_file(&path, format!("missing: shard {} is incomplete or damaged", m.shard))
+            let owner = (c * blocks + k) % first.shard.count;
+            let store = &stores[owner];
+            let file = shard::read_checked_block(store, &key, u.block, blocks, integrals)?.ok_or_else(|| {
+                let name = shard::block_name(&key, u.block);
+                let why = format!("block {name} missing: shard {} is incomplete or damaged", shards[owner].1.shard);
+                HarnessError::bad_file(store.path(), why)
             })?;
             parts.push(file.stats);
         }
@@ -155,11 +159,10 @@ pub fn merge(dirs: &[PathBuf], opts: &ExecOptions<'_>) -> Result<Outcome> {
     }
     // Only a complete, consistent set gets here: nothing is written before.
     let _locks = execute::lock_folders(&plan.sweep.experiment, opts)?;
+    // Stored like a single run's cells, so `mcbench run` on these results resumes from them.
+    let mut store = StoreWriter::open(&results_dir.join(crate::store::CELLS))?;
     for (_, _, cell) in &cells {
-        // Stored like a single run's cells, so `mcbench run` on these results resumes from them.
-        let path = results_dir.join("cells").join(cell.key.file_name());
-        let text = serde_json::to_string(cell).map_err(|e| HarnessError::write(&path, e))?;
-        write_atomic(&path, text.as_bytes())?;
+        store.append(&cell.key.name(), &crate::packed::encode_cell(cell))?;
     }
     execute::finish(&plan, def, &RunResults { cells }, opts, started)
 }

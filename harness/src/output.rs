@@ -1,5 +1,6 @@
-//! Result files (SPEC §8, a contract): `summary.csv`, `integrals.csv`, `summary.json`; every write
-//! is atomic (temp file + rename) so an interrupted run never leaves a half-written file.
+//! Result files (SPEC §8, a contract): `summary.csv` and `summary.json` (`integrals.csv` is
+//! [`crate::integrals`]'s); every write is atomic (temp file + rename) so an interrupted run never
+//! leaves a half-written file.
 
 use crate::analysis::{Fit, SpeedUp, TestRow};
 use crate::error::{HarnessError, Result};
@@ -216,41 +217,6 @@ impl Diagnostic {
     }
 }
 
-/// One row of `integrals.csv` (SPEC §8) with the test bed's geometry columns appended.
-#[derive(Clone, Debug, PartialEq)]
-pub struct IntegralRow {
-    /// Test bed id.
-    pub testbed: String,
-    /// Variant.
-    pub variant: String,
-    /// Estimator name.
-    pub estimator: String,
-    /// Integral index.
-    pub integral: usize,
-    /// Pixel column.
-    pub px: usize,
-    /// Pixel row.
-    pub py: usize,
-    /// Channel 0..3 (R, G, B).
-    pub channel: usize,
-    /// Reference value.
-    pub reference: f64,
-    /// Reference standard error.
-    pub reference_se: f64,
-    /// Mean estimate over repetitions.
-    pub mean: f64,
-    /// Standard error of the mean.
-    pub std_err: f64,
-    /// Geometry (name, value).
-    pub geometry: Vec<(&'static str, f64)>,
-    /// Registered id of the estimator.
-    pub estimator_id: String,
-    /// The estimator's parameters with every default filled in, as JSON.
-    pub params: String,
-    /// The test bed's parameters with every default filled in, as JSON.
-    pub testbed_params: String,
-}
-
 fn csv_bytes<F: FnOnce(&mut csv::Writer<Vec<u8>>) -> csv::Result<()>>(f: F) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     f(&mut w).map_err(|e| HarnessError::write("csv", e))?;
@@ -308,58 +274,6 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "target_evals",
     "cache_ops",
 ];
-
-/// Writes `integrals.csv`; geometry columns are the union over rows (empty where absent).
-pub fn write_integrals_csv(dir: &OutputDir, rows: &[IntegralRow]) -> Result<()> {
-    let mut geo: Vec<&'static str> = Vec::new();
-    for r in rows {
-        for (name, _) in &r.geometry {
-            if !geo.contains(name) {
-                geo.push(name);
-            }
-        }
-    }
-    let bytes = csv_bytes(|w| {
-        let mut header: Vec<&str> = vec![
-            "testbed",
-            "variant",
-            "estimator",
-            "integral",
-            "px",
-            "py",
-            "channel",
-            "reference",
-            "reference_se",
-            "mean",
-            "std_err",
-        ];
-        header.extend(&geo);
-        header.extend(["estimator_id", "params", "testbed_params"]);
-        w.write_record(&header)?;
-        for r in rows {
-            let mut rec = vec![
-                r.testbed.clone(),
-                r.variant.clone(),
-                r.estimator.clone(),
-                r.integral.to_string(),
-                r.px.to_string(),
-                r.py.to_string(),
-                r.channel.to_string(),
-                r.reference.to_string(),
-                r.reference_se.to_string(),
-                r.mean.to_string(),
-                r.std_err.to_string(),
-            ];
-            for g in &geo {
-                rec.push(r.geometry.iter().find(|(n, _)| n == g).map(|(_, v)| v.to_string()).unwrap_or_default());
-            }
-            rec.extend([r.estimator_id.clone(), r.params.clone(), r.testbed_params.clone()]);
-            w.write_record(&rec)?;
-        }
-        Ok(())
-    })?;
-    dir.write("integrals.csv", &bytes).map(|_| ())
-}
 
 /// Writes `summary.json`.
 pub fn write_summary_json(dir: &OutputDir, report: &RunReport) -> Result<()> {

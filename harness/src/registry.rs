@@ -39,7 +39,8 @@ pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &OutputDir, Option<&Pat
 pub type ClaimsFn = fn(&RunReport) -> Vec<Claim>;
 
 /// Checks an experiment's own reads before anything is written: (registry, the sweep as it will
-/// run, the results folder's `cells`). For experiments whose analysis runs further sweeps.
+/// run, the results folder's cell store `cells.store`). For experiments whose analysis runs
+/// further sweeps.
 pub type PreflightFn = fn(&Registry, &Sweep, &Path) -> Result<()>;
 
 /// Where an experiment's sweeps come from.

@@ -9,14 +9,15 @@ use crate::cell::{add_diagnostics, CellKey, CellResult, TimeStats};
 use crate::error::{HarnessError, Result};
 use crate::interleave::empty_cell;
 pub use crate::interleave::{run_group_with, GroupCell};
-use crate::output::write_atomic;
 use crate::plan::Plan;
+pub use crate::resume::{preload, preload_from};
+use crate::store::StoreWriter;
 use estimators::budget::{Budget, BudgetKind};
 use estimators::error::EstimateError;
 use estimators::math::Rgb;
 use estimators::rng::StreamKey;
 use estimators::task::{Costs, Task};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Receives progress (no-op by default): the CLI draws bars from it.
@@ -54,8 +55,9 @@ impl Observer for Silent {}
 pub struct RunOptions<'a> {
     /// Worker threads (None: rayon's default).
     pub threads: Option<usize>,
-    /// Where finished cells are stored for resume (None: no resume store).
-    pub cell_dir: Option<PathBuf>,
+    /// The cell store finished cells are read back from and appended to for resume
+    /// (`<results>/<experiment>/cells.store`, [`crate::store`]; None: no resume store).
+    pub store: Option<PathBuf>,
     /// Progress receiver.
     pub observer: &'a dyn Observer,
 }
@@ -279,45 +281,12 @@ pub fn cell_key(plan: &Plan, bi: usize, ei: usize, budget: Budget) -> CellKey {
     }
 }
 
-/// Reads a stored cell back: `None` when absent; a file that does not parse, holds another cell
-/// or does not fit the plan (integrals, repetitions, finite statistics) is bad input naming the file.
-pub(crate) fn read_cell(path: &Path, key: &CellKey, integrals: usize) -> Result<Option<CellResult>> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(HarnessError::bad_file(path, e)),
-    };
-    let refuse =
-        |why: String| HarnessError::bad_file(path, format!("corrupt stored cell ({why}); delete it to recompute"));
-    let cell: CellResult = serde_json::from_str(&text).map_err(|e| refuse(e.to_string()))?;
-    if cell.key != *key {
-        return Err(refuse("it holds another cell than its name says".into()));
-    }
-    cell.check_shape(integrals, key.reps).map_err(refuse)?;
-    Ok(Some(cell))
-}
-
-/// The stored cells of a plan, in (pair, budget) order, read and checked before anything runs:
-/// a corrupt cell is refused before any other cell is recomputed or written.
-pub fn preload(plan: &Plan, cell_dir: Option<&Path>) -> Result<Vec<Option<CellResult>>> {
-    let mut out = Vec::with_capacity(plan.pairs.len() * plan.sweep.budgets.len());
-    for &(bi, ei) in &plan.pairs {
-        for &budget in &plan.sweep.budgets {
-            let key = cell_key(plan, bi, ei, budget);
-            out.push(match cell_dir {
-                Some(d) => read_cell(&d.join(key.file_name()), &key, plan.beds[bi].bed.integrals())?,
-                None => None,
-            });
-        }
-    }
-    Ok(out)
-}
-
 /// Runs `plan`'s cells on `threads` threads with progress on a terminal, reading back and storing
-/// cells in `cell_dir`: the further sweeps an experiment's analysis runs into its results folder.
-pub fn run_stored(plan: &Plan, cell_dir: PathBuf, threads: usize) -> Result<RunResults> {
+/// cells in the cell store `store`: the further sweeps an experiment's analysis runs into its
+/// results folder (whose lock the caller holds).
+pub fn run_stored(plan: &Plan, store: PathBuf, threads: usize) -> Result<RunResults> {
     let progress = crate::progress::Progress::default();
-    let r = run(plan, &RunOptions { threads: Some(threads), cell_dir: Some(cell_dir), observer: &progress });
+    let r = run(plan, &RunOptions { threads: Some(threads), store: Some(store), observer: &progress });
     progress.finish();
     r
 }
@@ -325,13 +294,15 @@ pub fn run_stored(plan: &Plan, cell_dir: PathBuf, threads: usize) -> Result<RunR
 /// Runs every cell of the plan, reading back stored cells (checked first, [`preload`]) and
 /// storing new ones.
 pub fn run(plan: &Plan, opts: &RunOptions<'_>) -> Result<RunResults> {
-    let stored = preload(plan, opts.cell_dir.as_deref())?;
+    let stored = preload(plan, opts.store.as_deref())?;
     run_preloaded(plan, opts, stored)
 }
 
 /// [`run`] with the stored cells already read by [`preload`]. The missing cells of one (test bed,
-/// budget) run together, interleaved ([`run_group_with`]); each is stored as soon as its group has
-/// finished, and the observer hears of a group's cells (in plan order) when the group is done.
+/// budget) run together, interleaved ([`run_group_with`]); each is appended to the store as soon as
+/// its group has finished (the store is opened for writing at the first cell to store, so a run
+/// that computes nothing leaves it untouched), and the observer hears of a group's cells (in plan
+/// order) when the group is done.
 pub fn run_preloaded(plan: &Plan, opts: &RunOptions<'_>, stored: Vec<Option<CellResult>>) -> Result<RunResults> {
     let _phase = crate::phases::enter(crate::phases::Phase::Cells);
     let pool = rayon::ThreadPoolBuilder::new()
@@ -351,6 +322,7 @@ pub fn run_preloaded(plan: &Plan, opts: &RunOptions<'_>, stored: Vec<Option<Cell
         }
     }
     let mut done = 0;
+    let mut writer: Option<StoreWriter> = None;
     for &bi in &beds {
         let pairs: Vec<usize> = (0..plan.pairs.len()).filter(|&p| plan.pairs[p].0 == bi).collect();
         for (bu, &budget) in plan.sweep.budgets.iter().enumerate() {
@@ -368,10 +340,13 @@ pub fn run_preloaded(plan: &Plan, opts: &RunOptions<'_>, stored: Vec<Option<Cell
                 })
             })?;
             for (&p, c) in missing.iter().zip(outs) {
-                if let Some(d) = &opts.cell_dir {
-                    let path = d.join(c.key.file_name());
-                    let text = serde_json::to_string(&c).map_err(|e| HarnessError::write(&path, e))?;
-                    write_atomic(&path, text.as_bytes())?;
+                if let Some(path) = &opts.store {
+                    if writer.is_none() {
+                        writer = Some(StoreWriter::open(path)?);
+                    }
+                    if let Some(w) = writer.as_mut() {
+                        w.append(&c.key.name(), &crate::packed::encode_cell(&c))?;
+                    }
                 }
                 slots[p * budgets + bu] = Some(c);
             }

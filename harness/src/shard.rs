@@ -1,8 +1,9 @@
 //! Scale-out (SPEC §12): `mcbench run <experiment> --shard i/n` runs a deterministic, disjoint part
 //! of a sweep and writes its sufficient statistics (per-integral [`Moments`] of whole repetition
 //! blocks, integer cost totals, time histograms, diagnostic sums: never averages) into
-//! `<results>/<experiment>/shard-<i>-of-<n>/`; [`crate::merge`] turns the `n` shard folders into the
-//! files a single run writes.
+//! `<results>/<experiment>/shard-<i>-of-<n>/`: one record per finished unit in the folder's block
+//! store `blocks.store` ([`crate::store`]), and `manifest.json` when the shard has finished;
+//! [`crate::merge`] turns the `n` shard folders into the files a single run writes.
 //!
 //! The unit of work is one repetition block ([`runner::REP_BLOCK`]) of one cell, numbered in plan
 //! order (pair, budget, block); shard `i` of `n` owns the units `u` with `u mod n = i - 1`. The
@@ -18,6 +19,7 @@ use crate::output::write_atomic;
 use crate::plan::Plan;
 use crate::registry::Experiment;
 use crate::runner::{self, Observer};
+use crate::store::{Store, StoreWriter};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -133,22 +135,9 @@ pub struct BlockFile {
     pub stats: CellResult,
 }
 
-/// The file name of block `block` of the cell `key` inside a shard folder.
-pub fn block_file_name(key: &CellKey, block: usize) -> String {
-    let base = key.file_name();
-    format!("{}_b{block}.json", base.trim_end_matches(".json"))
-}
-
-/// Reads a block file; `None` when absent. Unparsable files are bad input naming the file.
-pub fn read_block(path: &Path) -> Result<Option<BlockFile>> {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(HarnessError::bad_file(path, e)),
-    };
-    serde_json::from_str(&text)
-        .map(Some)
-        .map_err(|e| HarnessError::bad_file(path, format!("corrupt shard block ({e})")))
+/// The name of block `block` of the cell `key` in a shard's block store.
+pub fn block_name(key: &CellKey, block: usize) -> String {
+    format!("{}_b{block}", key.name())
 }
 
 /// Repetitions in block `block` of a sweep with `reps` repetitions.
@@ -156,22 +145,25 @@ pub fn block_reps(reps: usize, block: usize) -> usize {
     ((block + 1) * runner::REP_BLOCK).min(reps).saturating_sub(block * runner::REP_BLOCK)
 }
 
-/// Reads a block file and checks it against the plan: the cell `key`, block `block` of `blocks`,
-/// `integrals` integrals with the block's repetitions each. `None` when absent.
+/// Reads block `block` of the cell `key` from a shard's block store and checks it against the
+/// plan: the cell `key`, block `block` of `blocks`, `integrals` integrals with the block's
+/// repetitions each. `None` when absent; a record that does not decode or holds another cell or
+/// block is bad input naming the store and the block.
 pub fn read_checked_block(
-    path: &Path,
+    store: &Store,
     key: &CellKey,
     block: usize,
     blocks: usize,
     integrals: usize,
 ) -> Result<Option<BlockFile>> {
-    let Some(f) = read_block(path)? else { return Ok(None) };
+    let name = block_name(key, block);
+    let Some(record) = store.get(&name) else { return Ok(None) };
+    let refuse = |why: String| HarnessError::bad_file(store.path(), format!("corrupt shard block {name} ({why})"));
+    let f = crate::packed::decode_block(&record.payload).map_err(refuse)?;
     if f.stats.key != *key || f.block != block || f.blocks != blocks {
-        return Err(HarnessError::bad_file(path, "corrupt shard block (it holds another cell or block)"));
+        return Err(refuse("it holds another cell or block".into()));
     }
-    f.stats
-        .check_shape(integrals, block_reps(key.reps, block))
-        .map_err(|e| HarnessError::bad_file(path, format!("corrupt shard block ({e})")))?;
+    f.stats.check_shape(integrals, block_reps(key.reps, block)).map_err(refuse)?;
     Ok(Some(f))
 }
 
@@ -189,7 +181,7 @@ pub struct ShardPreflight {
 
 /// Checks a shard run before anything is written: the sweep can be split (a time budget is
 /// calibrated per machine, so its blocks could not be merged exactly), the shard folder can be
-/// written, and every block file already there is well formed.
+/// written, and every block its store already holds is well formed.
 pub fn preflight(plan: &Plan, shard: ShardSpec, results_root: &Path) -> Result<ShardPreflight> {
     if plan.sweep.budgets.iter().any(|b| b.kind == estimators::budget::BudgetKind::Micros) {
         return Err(estimators::error::ConfigError::invalid(
@@ -203,6 +195,7 @@ pub fn preflight(plan: &Plan, shard: ShardSpec, results_root: &Path) -> Result<S
     crate::folder::check_output_dir("--results", &dir)?;
     let all = units(plan);
     let blocks = runner::rep_blocks(plan.sweep.reps);
+    let store = Store::open(&dir.join(crate::store::BLOCKS))?;
     let owned: Vec<&Unit> = all.iter().enumerate().filter(|(u, _)| shard.owns(*u)).map(|(_, unit)| unit).collect();
     let mut resumed = 0;
     let mut todo = Vec::new();
@@ -213,7 +206,7 @@ pub fn preflight(plan: &Plan, shard: ShardSpec, results_root: &Path) -> Result<S
         let integrals = plan.beds[bi].bed.integrals();
         let mut missing = Vec::new();
         for u in cell {
-            match read_checked_block(&dir.join(block_file_name(&key, u.block)), &key, u.block, blocks, integrals)? {
+            match read_checked_block(&store, &key, u.block, blocks, integrals)? {
                 Some(_) => resumed += 1,
                 None => missing.push(u.block),
             }
@@ -236,9 +229,10 @@ pub struct ShardOutcome {
 }
 
 /// Runs a shard of a prepared plan whose [`preflight`] passed into
-/// `<results_root>/<experiment>/shard-<i>-of-<n>/`: takes the shard folder's lock, writes one
-/// block file per owned unit as soon as it is reduced (units an interrupted run finished are kept),
-/// then the manifest, last, so a folder without one is an unfinished shard.
+/// `<results_root>/<experiment>/shard-<i>-of-<n>/`: takes the shard folder's lock, appends one
+/// record per owned unit to its block store as soon as it is reduced (units an interrupted run
+/// finished are kept), then writes the manifest, last, so a folder without one is an unfinished
+/// shard.
 pub fn run_shard(
     plan: &Plan,
     def: Option<&Experiment>,
@@ -254,6 +248,7 @@ pub fn run_shard(
         .build()
         .map_err(|e| HarnessError::write("thread pool", e))?;
     let blocks = runner::rep_blocks(plan.sweep.reps);
+    let mut writer = StoreWriter::open(&dir.join(crate::store::BLOCKS))?;
     // The owned cells of one (test bed, budget) run together, interleaved, so that machine load
     // falls on the estimators they compare alike; the owned blocks of one cell run together, so a
     // fetch budget's pilot runs once per cell.
@@ -274,10 +269,8 @@ pub fn run_shard(
         pool.install(|| {
             runner::run_group_with(plan, *bi, budget, &cells, |k, pos, stats| {
                 let block = cells[k].blocks[pos];
-                let path = dir.join(block_file_name(&keys[k], block));
                 let file = BlockFile { block, blocks, stats };
-                let text = serde_json::to_string(&file).map_err(|e| HarnessError::write(&path, e))?;
-                write_atomic(&path, text.as_bytes())
+                writer.append(&block_name(&keys[k], block), &crate::packed::encode_block(&file))
             })
         })?;
         for (c, key) in cells.iter().zip(&keys) {

@@ -15,7 +15,7 @@ read -r wall user sys < "$OUT/ours.time"
 paths=$((256 * 1024 * 8 * 2))  # pixels x spp x reps x two albedos
 echo "mcbench is0_cv0: $paths paths, wall $wall s, cpu $(echo "$user + $sys" | bc) s:" \
   "$(echo "$paths / $wall" | bc) paths/s, $(echo "$paths / ($user + $sys)" | bc) paths/cpu-s (whole run: references, analysis included)"
-python3 "$HERE/image_mean.py" "$OUT/results/peer-gradient-box/integrals.csv"
+python3 "$HERE/image_mean.py" "$OUT/results/peer-gradient-box/integrals.csv.gz"
 for v in llvm_ad_rgb scalar_rgb; do
   for a in 0.8 1.0; do
     "$PY" "$HERE/mitsuba_gradient_box.py" --variant "$v" --albedo "$a" --threads 2

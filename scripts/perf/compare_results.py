@@ -1,7 +1,10 @@
 #!/usr/bin/env python3
 """Compares two results roots of the same suite (e.g. the quick suite before and after a change)
 experiment by experiment, time-derived values aside:
-- every CSV file of an experiment (summary.csv, integrals.csv and the experiments' own tables),
+- every CSV file of an experiment (summary.csv, integrals.csv or integrals.csv.gz, and the
+  experiments' own tables; a gzip-compressed table is compared by its text with the plain one of
+  the same name, and over the columns both sides have: the columns only one side has, such as the
+  `params` columns older integrals.csv files repeated per row, are listed, not compared),
   with the columns named in harness/src/metrics.rs TIMING_COLUMNS (and the other time-derived
   names below) removed, cell by cell; tests.csv and claims.csv are left to the next point (they
   are summary.json's `tests` and `paper` as tables, and a time-derived claim's value may move);
@@ -10,6 +13,7 @@ Claims and table columns that are time-derived are listed apart: they move with 
 Prints one line per experiment and exits 1 if anything that is not time-derived differs.
 Usage: compare_results.py RESULTS_A RESULTS_B"""
 import csv
+import gzip
 import json
 import pathlib
 import sys
@@ -30,13 +34,27 @@ def timed(name):
     return n in TIMING or "seconds" in n or "eff" in n or "speedup" in n or n.endswith("_s") or "time" in n
 
 
-def table(path):
-    rows = list(csv.reader(open(path)))
+def rows_of(path):
+    opener = gzip.open if path.name.endswith(".gz") else open
+    return list(csv.reader(opener(path, "rt", newline="")))
+
+
+def table(rows, other_header):
+    """The rows without time-derived columns and without columns the other side lacks."""
     if not rows:
         return [], []
-    keep = [i for i, h in enumerate(rows[0]) if not timed(h)]
+    keep = [i for i, h in enumerate(rows[0]) if not timed(h) and h in other_header]
     dropped = [h for h in rows[0] if timed(h)]
     return [[r[i] for i in keep if i < len(r)] for r in rows], dropped
+
+
+def tables(d):
+    """CSV tables of a results folder by name, a gzip-compressed one under its plain name."""
+    out = {}
+    for g in ("*.csv", "*.csv.gz"):
+        for p in d.glob(g):
+            out.setdefault(p.name.removesuffix(".gz"), p)
+    return out
 
 
 def verdict(c):
@@ -67,13 +85,19 @@ def main(a, b):
             print(f"{exp}: missing in {b}")
             bad += 1
             continue
-        files = sorted(({p.name for p in da.glob("*.csv")} | {p.name for p in db.glob("*.csv")}) - COPIES)
+        pa, pb = tables(da), tables(db)
+        files = sorted((set(pa) | set(pb)) - COPIES)
         for f in files:
-            if not (da / f).exists() or not (db / f).exists():
+            if f not in pa or f not in pb:
                 notes.append(f"{f} only in one")
                 bad += 1
                 continue
-            (ta, dropped), (tb, _) = table(da / f), table(db / f)
+            ra, rb = rows_of(pa[f]), rows_of(pb[f])
+            ha, hb = (ra[0] if ra else []), (rb[0] if rb else [])
+            extra = sorted(set(ha) ^ set(hb))
+            if extra:
+                notes.append(f"{f}: columns only in one, not compared: {', '.join(extra)}")
+            (ta, dropped), (tb, _) = table(ra, hb), table(rb, ha)
             if ta != tb:
                 diff = sum(x != y for x, y in zip(ta, tb)) + abs(len(ta) - len(tb))
                 notes.append(f"{f}: {diff} rows differ")

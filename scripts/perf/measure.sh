@@ -44,7 +44,7 @@ scaling)
       "cells $(python3 -c "import json,sys; print(round(json.load(open(sys.argv[1]))['meta']['wall_seconds'],1))" "$OUT/scale-$e-$t/results/$e/summary.json") s (summary.json wall_seconds)"
   done
   a="$OUT/scale-$e-1/results/$e" b="$OUT/scale-$e-2/results/$e"
-  if cmp -s <(strip_timing "$a/summary.csv") <(strip_timing "$b/summary.csv") && cmp -s "$a/integrals.csv" "$b/integrals.csv"; then
+  if cmp -s <(strip_timing "$a/summary.csv") <(strip_timing "$b/summary.csv") && cmp -s <(zcat "$a/integrals.csv.gz") <(zcat "$b/integrals.csv.gz"); then
     echo "$e: summary.csv (timing columns aside) and integrals.csv identical at 1 and 2 threads"
   else
     echo "$e: RESULTS DIFFER between 1 and 2 threads"; exit 1

@@ -169,6 +169,18 @@ impl Moments {
         self.n
     }
 
+    /// The whole state, `(n, [mean, m2, m3, mean_comp])`, for compact storage:
+    /// [`Moments::from_raw`] restores it bit for bit (non-finite sums included).
+    pub fn raw(&self) -> (u64, [f64; 4]) {
+        (self.n, [self.mean, self.m2, self.m3, self.mean_comp])
+    }
+
+    /// The state [`Moments::raw`] returned. Nothing is checked: call [`Moments::check`] on state
+    /// read back from files.
+    pub fn from_raw(n: u64, [mean, m2, m3, mean_comp]: [f64; 4]) -> Self {
+        Moments { n, mean, m2, m3, mean_comp }
+    }
+
     /// Whether the state could have come from pushes and merges of finite values: finite mean and
     /// moments, a non-negative sum of squares (to rounding), and nothing but zeros when empty.
     /// For state read back from files.

@@ -19,7 +19,8 @@ pub use index::{write_root_index, Overview, OVERVIEW};
 
 use crate::error::{HarnessError, Result};
 use crate::folder::OutputDir;
-use crate::output::{IntegralRow, RunReport};
+use crate::integrals::IntegralRow;
+use crate::output::RunReport;
 use crate::report::digest;
 use std::path::Path;
 
@@ -39,15 +40,13 @@ pub fn write_page(report: &RunReport, plots: &OutputDir, results_dir: &Path, int
     index::write_overview(plots, &Overview::of(report, figures.len()))
 }
 
-/// The per-integral rows of a results folder's `integrals.csv` (the columns the maps use; the
+/// The per-integral rows of a results folder's `integrals.csv` or `integrals.csv.gz` (the columns the maps use; the
 /// others are left empty), or none when the folder has no such file.
 pub fn read_integrals(results_dir: &Path) -> Result<Vec<IntegralRow>> {
-    let path = results_dir.join("integrals.csv");
-    if !path.is_file() {
-        return Ok(Vec::new());
-    }
+    let Some(text) = crate::integrals::read_text(results_dir)? else { return Ok(Vec::new()) };
+    let path = results_dir.join(crate::integrals::GZ);
     let bad = |why: String| HarnessError::bad_file(&path, why);
-    let mut rd = csv::Reader::from_path(&path).map_err(|e| bad(e.to_string()))?;
+    let mut rd = csv::Reader::from_reader(text.as_bytes());
     let header = rd.headers().map_err(|e| bad(e.to_string()))?.clone();
     let col = |name: &str| header.iter().position(|h| h == name).ok_or_else(|| bad(format!("no column {name}")));
     let names = [
@@ -85,8 +84,6 @@ pub fn read_integrals(results_dir: &Path) -> Result<Vec<IntegralRow>> {
             std_err: num(10)?,
             geometry: Vec::new(),
             estimator_id: String::new(),
-            params: String::new(),
-            testbed_params: String::new(),
         });
     }
     Ok(out)
@@ -112,8 +109,6 @@ mod tests {
             std_err: 0.01,
             geometry: vec![("x", 0.5)],
             estimator_id: "is1_cv2".into(),
-            params: "{}".into(),
-            testbed_params: "{}".into(),
         }
     }
 
@@ -128,7 +123,7 @@ mod tests {
         crate::output::write_summary_csv(&results, &report.rows).expect("csv");
         crate::report::write_tables(&results, &report).expect("tables");
         let rows: Vec<IntegralRow> = (0..4).map(|i| integral(i, 1.0 + 0.01 * i as f64)).collect();
-        crate::output::write_integrals_csv(&results, &rows).expect("integrals");
+        crate::integrals::write(&results, &rows, crate::integrals::IntegralsFormat::Gz).expect("integrals");
         let plots = OutputDir::new(&plots_dir);
         crate::report::write_report(&report, &figures, &plots_dir, &results_dir).expect("report.md");
         write_page(&report, &plots, &results_dir, &read_integrals(&results_dir).expect("read back")).expect("page");

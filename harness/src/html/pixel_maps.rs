@@ -12,7 +12,7 @@
 use super::markup::{esc, table, Cell};
 use super::png::Rgb8;
 use crate::error::Result;
-use crate::output::IntegralRow;
+use crate::integrals::IntegralRow;
 use crate::plot::heatmap::{colour, Fill, Scale};
 use crate::report::sig;
 use std::fmt::Write as _;
@@ -283,8 +283,6 @@ mod tests {
             std_err: 0.1,
             geometry: Vec::new(),
             estimator_id: estimator.into(),
-            params: String::new(),
-            testbed_params: String::new(),
         }
     }
 

@@ -60,9 +60,10 @@ fn settings<'a>(
 /// Checks, before anything is written, that every setting builds (names, parameters, stored
 /// references) and that its stored cells read back.
 pub fn preflight(file: &SensitivityFile, registry: &Registry, first: &Sweep, cells: &Path) -> Result<()> {
+    let store = crate::store::Store::open(cells)?;
     for (_, _, sweep, _) in settings(file, first)? {
         let plan = Plan::prepare(sweep, registry)?;
-        runner::preload(&plan, Some(cells))?;
+        runner::preload_from(&plan, Some(&store))?;
     }
     Ok(())
 }
@@ -147,7 +148,7 @@ pub fn post(
             setting_report(plan, run, report)
         } else {
             let p = Plan::prepare(sweep.clone(), registry)?;
-            let r = runner::run_stored(&p, results.join("cells"), threads)?;
+            let r = runner::run_stored(&p, results.join(crate::store::CELLS), threads)?;
             setting_report(&p, &r, report)
         };
         let judged = claim.judge(&sub);

@@ -136,12 +136,13 @@ fn other_parts(registry: &Registry, first: &Sweep) -> Vec<(String, Sweep)> {
 
 /// Checks, before the run writes anything, every stored cell the other parts will read back.
 pub fn preflight(registry: &Registry, first: &Sweep, cells: &Path) -> Result<()> {
+    let store = crate::store::Store::open(cells)?;
     let parts = other_parts(registry, first).into_iter().map(|(_, s)| s);
     for sweep in std::iter::once(first.clone()).chain(parts) {
         for s in [pilot_of(&sweep), sweep] {
             let (plans, _) = prepare_valid(s, registry)?;
             for p in &plans {
-                runner::preload(p, Some(cells))?;
+                runner::preload_from(p, Some(&store))?;
             }
         }
     }
@@ -158,8 +159,11 @@ pub fn post(
     registry: &Registry,
 ) -> Result<Vec<PathBuf>> {
     let threads = report.meta.threads;
-    let first_pilot =
-        runner::run_stored(&Plan::prepare(pilot_of(&plan.sweep), registry)?, results.join("cells"), threads)?;
+    let first_pilot = runner::run_stored(
+        &Plan::prepare(pilot_of(&plan.sweep), registry)?,
+        results.join(crate::store::CELLS),
+        threads,
+    )?;
     let mut rows = rows_of(plan, run, &first_pilot, report, registry);
     let first_bed = plan.sweep.testbeds.first().map(|t| t.id.clone()).unwrap_or_default();
     let mut notes = vec![format!("part {first_bed}... ({} reps)", plan.sweep.reps)];
@@ -168,9 +172,12 @@ pub fn post(
         let (plans, invalid) = prepare_valid(sweep, registry)?;
         rows.extend(invalid);
         for p in plans {
-            let pilot =
-                runner::run_stored(&Plan::prepare(pilot_of(&p.sweep), registry)?, results.join("cells"), threads)?;
-            let r = runner::run_stored(&p, results.join("cells"), threads)?;
+            let pilot = runner::run_stored(
+                &Plan::prepare(pilot_of(&p.sweep), registry)?,
+                results.join(crate::store::CELLS),
+                threads,
+            )?;
+            let r = runner::run_stored(&p, results.join(crate::store::CELLS), threads)?;
             for (bi, ei, cell) in &r.cells {
                 report.rows.push(p.summary_row(*bi, *ei, cell));
             }

@@ -125,7 +125,7 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
         ))),
     )
     .unwrap();
-    let opts = RunOptions { threads: Some(1), cell_dir: None, observer: &Silent };
+    let opts = RunOptions { threads: Some(1), store: None, observer: &Silent };
     let results = run(&plan, &opts).unwrap();
     let pilot_plan = Plan::prepare(
         Sweep { seed: super::super::run::pilot_seed(plan.sweep.seed), ..plan.sweep.clone() },
