@@ -62,7 +62,7 @@ pub fn panel(
         let (label, line) = if s.baseline == main {
             (legend(&s.estimator), Line::Solid)
         } else {
-            (format!("{} vs {} (speed-up)", display(&s.estimator), display(&s.baseline)), Line::Dashed)
+            (format!("speed-up of {} over {}", display(&s.estimator), display(&s.baseline)), Line::Dashed)
         };
         series.push(Series::new(label, style(&s.estimator), points).with_line(line).without_markers());
     }
