@@ -1,6 +1,7 @@
 //! The plots root's `index.html`: every experiment folder under the root with its headline
-//! verdicts, read from the `overview.json` each experiment's page writes beside itself (so a run
-//! of one experiment keeps the others' rows).
+//! verdicts, read from the data block each experiment's page carries (an [`Overview`] as JSON in a
+//! `<script type="application/json">` element, which a browser does not run), so a run of one
+//! experiment keeps the others' rows and no extra file is written.
 
 use super::markup::{badge, count_badges, esc, page, table, url, verdict_class, Cell};
 use crate::error::{HarnessError, Result};
@@ -10,8 +11,8 @@ use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// The file an experiment's page writes beside itself for the root index.
-pub const OVERVIEW: &str = "overview.json";
+/// The opening tag of an experiment page's data block.
+const OVERVIEW_TAG: &str = "<script type=\"application/json\" id=\"mcbench-overview\">";
 
 /// Claims the root index lists per experiment (beyond it: the ones that need attention).
 const ROOT_CLAIMS: usize = 30;
@@ -46,7 +47,7 @@ impl From<&Claim> for ClaimLine {
     }
 }
 
-/// An experiment's headline (`overview.json` in its plots folder).
+/// An experiment's headline (the data block of its page).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Overview {
     /// Experiment name.
@@ -102,6 +103,21 @@ enum Entry {
     },
 }
 
+/// The data block of a page: `overview` as JSON with `<`, `>` and `&` escaped (`\u003c`, ...), so
+/// no text of a claim can end the element.
+pub fn embed(overview: &Overview) -> Result<String> {
+    let json = serde_json::to_string(overview).map_err(|e| HarnessError::write("the page's data block", e))?;
+    let json = json.replace('<', "\\u003c").replace('>', "\\u003e").replace('&', "\\u0026");
+    Ok(format!("{OVERVIEW_TAG}{json}</script>\n"))
+}
+
+/// The [`Overview`] in a page's data block.
+pub fn read_overview(page: &str) -> std::result::Result<Overview, String> {
+    let start = page.find(OVERVIEW_TAG).ok_or("no data block")? + OVERVIEW_TAG.len();
+    let end = page[start..].find("</script>").ok_or("an unterminated data block")? + start;
+    serde_json::from_str(&page[start..end]).map_err(|e| e.to_string())
+}
+
 fn entries(root: &Path) -> Vec<(String, Entry)> {
     let Ok(dirs) = std::fs::read_dir(root) else { return Vec::new() };
     let mut names: Vec<String> = dirs
@@ -115,13 +131,11 @@ fn entries(root: &Path) -> Vec<(String, Entry)> {
         .into_iter()
         .filter_map(|name| {
             let dir = root.join(&name);
-            let read = std::fs::read_to_string(dir.join(OVERVIEW))
-                .map_err(|e| e.to_string())
-                .and_then(|t| serde_json::from_str::<Overview>(&t).map_err(|e| e.to_string()));
-            match read {
+            let read = std::fs::read_to_string(dir.join("index.html")).map_err(|e| e.to_string());
+            match read.and_then(|page| read_overview(&page)) {
                 Ok(o) => Some((name, Entry::Read(Box::new(o)))),
                 Err(why) if dir.join("index.html").is_file() || dir.join("report.md").is_file() => {
-                    Some((name.clone(), Entry::Bare { name, why: format!("no readable {OVERVIEW} ({why})") }))
+                    Some((name.clone(), Entry::Bare { name, why: format!("no headline verdicts ({why})") }))
                 }
                 Err(_) => None,
             }
@@ -239,16 +253,9 @@ pub fn write_root_index(root: &Path) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// Writes `overview.json` for the root index through the experiment's plots folder writer.
-pub fn write_overview(plots: &crate::folder::OutputDir, overview: &Overview) -> Result<()> {
-    let text = serde_json::to_string_pretty(overview).map_err(|e| HarnessError::write(plots.join(OVERVIEW), e))?;
-    plots.write(OVERVIEW, text.as_bytes()).map(|_| ())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::folder::OutputDir;
     use crate::plot::tests::synthetic_report;
 
     #[test]
@@ -261,20 +268,34 @@ mod tests {
             claim: "a <second> claim".into(),
             ..report.paper[0].clone()
         });
-        let out = OutputDir::new(root.join("surface-smc"));
-        write_overview(&out, &Overview::of(&report, 4)).expect("overview");
-        std::fs::write(root.join("surface-smc/index.html"), "x").expect("page");
+        std::fs::create_dir_all(root.join("surface-smc")).expect("folder");
+        let page = format!("<p>x</p>{}", embed(&Overview::of(&report, 4)).expect("data"));
+        std::fs::write(root.join("surface-smc/index.html"), page).expect("page");
         std::fs::create_dir_all(root.join("old")).expect("old");
         std::fs::write(root.join("old/report.md"), "x").expect("report");
         std::fs::create_dir_all(root.join("unrelated")).expect("other");
         let path = write_root_index(root).expect("written");
         let html = std::fs::read_to_string(path).expect("read");
         assert!(html.contains("<a href=\"surface-smc/index.html\">surface-smc</a>"), "{html}");
-        assert!(html.contains("<a href=\"old/report.md\">old</a>") && html.contains("no readable overview.json"));
+        assert!(
+            html.contains("<a href=\"old/report.md\">old</a>") && html.contains("no headline verdicts (No such file"),
+            "{html}"
+        );
         assert!(!html.contains("unrelated"), "a folder without a page is not an experiment");
         assert!(html.contains("1 held</span> <span class=\"badge v-inconclusive\">1 inconclusive"));
         assert!(html.contains("a &lt;second&gt; claim") && html.contains("1 against the claim"));
         assert!(html.contains("2 experiment folders"));
+    }
+
+    #[test]
+    fn the_data_block_reads_back_and_claim_text_cannot_end_it() {
+        let mut report = synthetic_report();
+        report.paper[0].claim = "a </script><b> & c".into();
+        let block = embed(&Overview::of(&report, 2)).expect("data");
+        assert_eq!(block.matches("</script>").count(), 1, "{block}");
+        let back = read_overview(&format!("<html>{block}</html>")).expect("reads back");
+        assert_eq!(back, Overview::of(&report, 2));
+        assert!(read_overview("<html></html>").is_err());
     }
 
     #[test]

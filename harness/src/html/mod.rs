@@ -15,7 +15,7 @@ pub mod page;
 pub mod pixel_maps;
 pub mod png;
 
-pub use index::{write_root_index, Overview, OVERVIEW};
+pub use index::{write_root_index, Overview};
 
 use crate::error::{HarnessError, Result};
 use crate::folder::OutputDir;
@@ -27,8 +27,8 @@ use std::path::Path;
 /// The experiment page's file name.
 pub const PAGE: &str = "index.html";
 
-/// Writes an experiment's `index.html` and `overview.json` through its plots folder's writer
-/// (atomically, recorded for the folder's commit): `integrals` are the per-integral rows of the
+/// Writes an experiment's `index.html` through its plots folder's writer (atomically, recorded for
+/// the folder's commit): `integrals` are the per-integral rows of the
 /// largest budget (for the per-pixel maps; empty: no maps), `results_dir` the folder whose files
 /// the page links to. Figures are the SVG and PNG files in the plots folder.
 pub fn write_page(report: &RunReport, plots: &OutputDir, results_dir: &Path, integrals: &[IntegralRow]) -> Result<()> {
@@ -36,8 +36,7 @@ pub fn write_page(report: &RunReport, plots: &OutputDir, results_dir: &Path, int
     let maps = pixel_maps::pixel_maps(integrals);
     let ctx = page::Context { plots_dir: plots.path(), results_dir, figures: &figures, maps: &maps };
     let html = page::render(report, &ctx)?;
-    plots.write(PAGE, html.as_bytes())?;
-    index::write_overview(plots, &Overview::of(report, figures.len()))
+    plots.write(PAGE, html.as_bytes()).map(|_| ())
 }
 
 /// The per-integral rows of a results folder's `integrals.csv` or `integrals.csv.gz` (the columns the maps use; the
@@ -153,8 +152,7 @@ mod tests {
                 assert!(path.exists() || target == "../index.html", "{target} does not resolve");
             }
         }
-        let overview: Overview =
-            serde_json::from_str(&std::fs::read_to_string(plots_dir.join(OVERVIEW)).expect("overview")).expect("json");
+        let overview = index::read_overview(&html).expect("the page carries its headline");
         assert_eq!((overview.experiment.as_str(), overview.figures), ("surface-smc", figures.len() / 2 + 1));
     }
 

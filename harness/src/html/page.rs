@@ -69,6 +69,7 @@ pub fn render(report: &RunReport, ctx: &Context<'_>) -> crate::error::Result<Str
     let sections = super::groups::figures(&mut b, report, ctx)?;
     skipped(&mut b, report);
     files(&mut b, ctx);
+    b.push_str(&super::index::embed(&super::Overview::of(report, ctx.figures.len()))?);
     let mut nav = vec![("../index.html".to_string(), "all experiments".to_string())];
     for (id, text) in [("claims", "claims"), ("fits", "fits"), ("tests", "tests"), ("figures", "figures")] {
         nav.push((format!("#{id}"), text.to_string()));
