@@ -91,6 +91,9 @@ pub fn setting_report(plan: &Plan, run: &RunResults, like: &RunReport) -> RunRep
     }
 }
 
+/// The error a work ratio multiplies by rays, read from a summary row.
+type ErrorOf = fn(&crate::metrics::SummaryRow) -> f64;
+
 /// The ceiling of `claim` on one setting's report.
 pub(super) fn ceiling(
     kind: Ceiling,
@@ -104,12 +107,12 @@ pub(super) fn ceiling(
     match kind {
         Ceiling::WorkRatio => {
             // The error measure the claim's efficiency divides by, and the budget it is read at.
-            let (estimator, base, error, budget): (&str, &str, fn(&SummaryRow) -> f64, Option<u64>) = match claim {
+            let (estimator, base, error, budget): (&str, &str, ErrorOf, Option<u64>) = match claim {
                 ClaimSpec::Speedup { estimator, baseline, .. } => {
                     (estimator, baseline.as_deref().or(sweep_baseline)?, |r| r.variance, None)
                 }
                 ClaimSpec::Ratio { estimator, baseline, metric, budget, .. } => {
-                    let error: fn(&SummaryRow) -> f64 = match metric {
+                    let error: ErrorOf = match metric {
                         RatioMetric::EfficiencyMse => |r| r.mse,
                         RatioMetric::PEff => |r| r.p_err,
                         _ => return None,
