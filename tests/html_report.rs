@@ -76,7 +76,7 @@ fn a_run_writes_pages_whose_links_resolve_and_the_root_keeps_every_experiment() 
         "class=\"badge v-inconclusive\"",
         "Per-pixel z-scores and relative errors",
         "src=\"data:image/png;base64,",
-        "src=\"gradient-plane_glossy_rmse.svg\"",
+        "src=\"gradient-plane_glossy_convergence.svg\"",
         "href=\"../../results/browser-check/tests.csv\"",
         "href=\"../../results/browser-check/claims.csv\"",
         "href=\"../../results/browser-check/summary.json\"",
