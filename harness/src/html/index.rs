@@ -188,9 +188,10 @@ pub fn render_root(root: &Path) -> String {
     let mut body = String::from("<h1>mcbench results</h1>\n");
     let _ = writeln!(
         body,
-        "<p class=\"muted\">{} experiment folders. Each links to its page: every figure, per-pixel error maps of image \
-         test beds, the claims, the tests and the result files.</p>",
-        found.len()
+        "<p class=\"muted\">{} experiment folder{}. Each links to its page: every figure, per-pixel error maps of \
+         image test beds, the claims, the tests and the result files.</p>",
+        found.len(),
+        if found.len() == 1 { "" } else { "s" }
     );
     let rows = found
         .iter()
