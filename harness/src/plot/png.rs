@@ -103,21 +103,7 @@ pub(super) fn encode(rgb: &[u8], (w, h): (u32, u32)) -> std::result::Result<Vec<
 
 /// `data:image/png;base64,...` of PNG bytes, for an image embedded in an SVG.
 pub(super) fn data_uri(png: &[u8]) -> String {
-    const DIGITS: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::with_capacity(22 + png.len().div_ceil(3) * 4);
-    out.push_str("data:image/png;base64,");
-    for chunk in png.chunks(3) {
-        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
-        let n = u32::from(b[0]) << 16 | u32::from(b[1]) << 8 | u32::from(b[2]);
-        for k in 0..4 {
-            if k <= chunk.len() {
-                out.push(DIGITS[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
+    format!("data:image/png;base64,{}", crate::html::png::base64(png))
 }
 
 #[cfg(test)]
