@@ -5,7 +5,7 @@
 //! 1.5 degrees a frame about +z for F = 10 frames; an infinite ground plane at z = -1 gives
 //! `V = 1` iff `w_z >= 0`.
 //!
-//! Integral `pixel * F + frame` is `L_r` (variants `specular`, `mixed`, `moving`) or `L_ns`
+//! Integral `pixel * F + frame` is `L_r` (variants `specular`, `mixed`, `moving`, `moving-wall`) or `L_ns`
 //! (variants `specular-lns`, `mixed-lns`, `moving-lns`) of that pixel in that frame; references
 //! are exact per texel ([`super::envmap_reference`]).
 //!
@@ -14,6 +14,13 @@
 //! elevations 8 to 62 degrees over a dim background brighter on one side, so the rotation moves
 //! the target's mass (under the default sky only the sun moves it). The expected share of pixels
 //! the SMC reweighting must resample is computed exactly in [`super::envmap_ess`].
+//!
+//! `moving-wall` is `moving` with real visibility: a black wall beside the sphere (the plane
+//! `x = 1.5` from the ground up to `z = 1`, [`WALL_X`], [`WALL_TOP`]) hides, from each shading
+//! point, the sky on one side of a great circle that differs from pixel to pixel (up to about 50
+//! degrees of elevation towards +x on the pixels nearest the wall). Paper 004 §7's scenes are
+//! lit through such occlusion: every sample's visibility is a shadow ray, and the rotating lobes
+//! pass behind the wall.
 //!
 //! Parameters: `resolution` (32), `frames` (10), `rotation` (degrees per frame, 1.5), `sun` (peak
 //! radiance of the sun, or of the `moving` map's key lobe, 1e3: dynamic range > 1e4), `dawn_dusk`
@@ -42,12 +49,12 @@ const ENVMAP_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1500, 
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "envmap-sequence",
-    variants: &["specular", "mixed", "specular-lns", "mixed-lns", "moving", "moving-lns"],
+    variants: &["specular", "mixed", "specular-lns", "mixed-lns", "moving", "moving-lns", "moving-wall"],
     // Not `SURFACE`: its integrals are per-frame environment integrals reached through
     // `env_sequence()`, not the hemisphere probe the surface estimators need.
     provides: Needs::ENV_SEQUENCE,
     summary:
-        "Phong sphere under a rotating HDR sky (`moving`: narrow bright lobes that move with it), L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
+        "Phong sphere under a rotating HDR sky (`moving`: narrow bright lobes that move with it; `moving-wall`: and a wall that hides part of it), L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
     build: |variant, params, refs| Ok(Box::new(EnvmapSequence::with_references(variant, params, refs)?)),
     compute_reference: None,
     params: ParamSpec::of::<EnvmapSequenceParams>(),
@@ -64,6 +71,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "mixed-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "moving-wall", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
     ],
 };
 
@@ -128,6 +136,20 @@ const METHOD: &str = "per-texel exact solid angles; closed-form diffuse moments 
 /// Half-width of the orthographic image (inside the unit disc's inscribed square).
 const HALF_WIDTH: f64 = 0.7;
 
+/// The `moving-wall` variant's occluder: a black wall in the plane `x = WALL_X`, infinite in `y`,
+/// from the ground (`z = -1`) up to `z = WALL_TOP`: beside the sphere (radius 1) and as tall.
+pub const WALL_X: f64 = 1.5;
+/// Top edge of the `moving-wall` variant's wall.
+pub const WALL_TOP: f64 = 1.0;
+
+/// The wall's silhouette seen from `position` (below the wall's top, in front of its plane): a
+/// direction `w` above the ground is blocked iff it hits the wall's plane below the top edge,
+/// `w_x > 0` and `w_z (WALL_X - x) < (WALL_TOP - z) w_x`, that is iff `w . m < 0` for the `m`
+/// returned: the silhouette is a great circle, as the shading horizon is.
+pub fn wall_normal(position: Vec3) -> Vec3 {
+    Vec3::new(-(WALL_TOP - position.z), 0.0, WALL_X - position.x).normalize()
+}
+
 /// The scene.
 pub struct EnvmapSequence {
     variant: String,
@@ -137,6 +159,8 @@ pub struct EnvmapSequence {
     quantity: EnvQuantity,
     maps: Vec<EnvMap>,
     points: Vec<ShadingPoint>,
+    /// Per pixel, the wall's silhouette ([`wall_normal`]) in the `moving-wall` variant.
+    walls: Option<Vec<Vec3>>,
     /// Everything the exact pixel references depend on (parameters and BRDF), for the memo.
     setup: String,
     reference: Reference,
@@ -154,6 +178,7 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
         "mixed-lns" => Ok((phong(0.5, 0.5), EnvQuantity::Unoccluded)),
         "moving" => Ok((phong(0.5, 0.5), EnvQuantity::Reflected)),
         "moving-lns" => Ok((phong(0.5, 0.5), EnvQuantity::Unoccluded)),
+        "moving-wall" => Ok((phong(0.5, 0.5), EnvQuantity::Reflected)),
         _ => {
             Err(ConfigError::unknown("variant", &format!("envmap-sequence/{variant}"), ENTRY.variants.iter().copied()))
         }
@@ -207,6 +232,7 @@ impl EnvmapSequence {
                 points.push(ShadingPoint { position: p, normal: p, wo: Vec3::new(0.0, -1.0, 0.0), brdf });
             }
         }
+        let walls = (variant == "moving-wall").then(|| points.iter().map(|p| wall_normal(p.position)).collect());
         Ok(EnvmapSequence {
             variant: variant.to_string(),
             size,
@@ -215,7 +241,12 @@ impl EnvmapSequence {
             quantity,
             maps,
             points,
-            setup: format!("{p:?}|{brdf:?}|{}", if moving { "moving" } else { "sky" }),
+            setup: format!(
+                "{p:?}|{brdf:?}|{}|{}",
+                if moving { "moving" } else { "sky" },
+                if walls.is_some() { "wall" } else { "open" }
+            ),
+            walls,
             reference: empty(),
             key,
         })
@@ -236,8 +267,8 @@ impl EnvmapSequence {
             .into_par_iter()
             .map(|i| {
                 let (p, f) = (&self.points[i / self.frames], i % self.frames);
-                let env = self.environment(f);
-                table.reflect(env.map, env.rotation, env.scale, p.normal, p.wo, &p.brdf)
+                let wall = self.walls.as_ref().map(|w| w[i / self.frames]);
+                table.reflect(self.environment(f), p, wall)
             })
             .collect()
     }
@@ -326,8 +357,8 @@ impl EnvSequenceScene for EnvmapSequence {
         let map = &self.maps[frame.min(self.maps.len() - 1)];
         EnvFrame { map, rotation: frame as f64 * self.rotation, scale: 1.0 }
     }
-    fn visible(&self, _pixel: usize, wi: Vec3) -> bool {
-        wi.z >= 0.0
+    fn visible(&self, pixel: usize, wi: Vec3) -> bool {
+        wi.z >= 0.0 && self.walls.as_ref().is_none_or(|w| wi.dot(w[pixel]) >= 0.0)
     }
 }
 
