@@ -1,6 +1,7 @@
 //! Result and plot folders as a whole (SPEC §8): output paths checked before a run starts, one
-//! writer per folder at a time (a lock), stale temporary files of killed writers removed, and a
-//! folder-level commit so that a reader never mixes the files of two runs.
+//! writer per folder at a time (a lock, [`FolderLock`], whose file is there only while it is
+//! held), stale temporary files of killed writers removed, and a folder-level commit so that a
+//! reader never mixes the files of two runs.
 //!
 //! Every file a run writes goes through an [`OutputDir`], which writes it atomically (temp file +
 //! rename) and records its size and digest. When the run has written everything it writes
@@ -9,15 +10,14 @@
 //! writes, leave such a folder, and the next run of the experiment rewrites it whole.
 
 use crate::error::{HarnessError, Result};
+pub use crate::folder_lock::{read_lock, FolderLock, ReadLock};
 use serde::{Deserialize, Serialize};
-use std::fs::{File, OpenOptions, TryLockError};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 /// The commit file of a folder.
 pub const COMMIT: &str = "commit.json";
-/// The lock file of a folder.
+/// The lock file of a folder (there only while a run holds the folder: see [`FolderLock`]).
 pub const LOCK: &str = ".lock";
 /// The format of [`Commit`].
 pub const COMMIT_FORMAT: u32 = 1;
@@ -55,72 +55,6 @@ pub fn check_output_dir(field: &'static str, path: &Path) -> Result<()> {
     }
 }
 
-/// An exclusive hold on a folder: only one mcbench writes a folder at a time. Released when
-/// dropped, and by the system when the process dies (an advisory `flock` on `<dir>/.lock`).
-#[derive(Debug)]
-pub struct FolderLock {
-    _file: File,
-    dir: PathBuf,
-}
-
-impl FolderLock {
-    /// Creates `dir` if needed and takes its lock; with `wait`, blocks until the holder is done,
-    /// else refuses with [`HarnessError::Busy`] (exit 3). Then removes stale temporary files
-    /// (`.<name>.tmp-<pid>...`) that killed writers left in `dir` and in `subdirs` of it.
-    pub fn acquire(dir: &Path, wait: bool, subdirs: &[&str]) -> Result<FolderLock> {
-        std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
-        let path = dir.join(LOCK);
-        let mut file = OpenOptions::new()
-            .create(true)
-            .truncate(false)
-            .read(true)
-            .write(true)
-            .open(&path)
-            .map_err(|e| HarnessError::write(&path, e))?;
-        match file.try_lock() {
-            Ok(()) => {}
-            Err(TryLockError::WouldBlock) if wait => file.lock().map_err(|e| HarnessError::write(&path, e))?,
-            Err(TryLockError::WouldBlock) => {
-                let holder = std::fs::read_to_string(&path).unwrap_or_default().trim().to_string();
-                let holder = if holder.is_empty() { "unknown".to_string() } else { holder };
-                return Err(HarnessError::Busy { path: dir.to_path_buf(), holder });
-            }
-            Err(TryLockError::Error(e)) => return Err(HarnessError::write(&path, e)),
-        }
-        // The holder's pid, for the message of a refused second run.
-        let _ = file.set_len(0).and_then(|()| write!(file, "{}", std::process::id()));
-        remove_stale_temps(dir);
-        for s in subdirs {
-            remove_stale_temps(&dir.join(s));
-        }
-        Ok(FolderLock { _file: file, dir: dir.to_path_buf() })
-    }
-
-    /// The locked folder.
-    pub fn dir(&self) -> &Path {
-        &self.dir
-    }
-}
-
-/// A shared hold on a folder for reading: no writer can hold it meanwhile. A folder that no
-/// mcbench ever wrote (no lock file) is read without one; nothing is created.
-pub fn read_lock(dir: &Path, wait: bool) -> Result<Option<File>> {
-    let path = dir.join(LOCK);
-    let Ok(file) = File::open(&path) else { return Ok(None) };
-    match file.try_lock_shared() {
-        Ok(()) => Ok(Some(file)),
-        Err(TryLockError::WouldBlock) if wait => {
-            file.lock_shared().map_err(|e| HarnessError::bad_file(&path, e))?;
-            Ok(Some(file))
-        }
-        Err(TryLockError::WouldBlock) => {
-            let holder = std::fs::read_to_string(&path).unwrap_or_default().trim().to_string();
-            Err(HarnessError::Busy { path: dir.to_path_buf(), holder })
-        }
-        Err(TryLockError::Error(e)) => Err(HarnessError::bad_file(&path, e)),
-    }
-}
-
 /// Whether `name` is a temporary file of an atomic write (`.<name>.tmp-<pid>[...]`).
 fn is_temp(name: &str) -> bool {
     name.starts_with('.') && name.contains(".tmp-")
@@ -128,7 +62,7 @@ fn is_temp(name: &str) -> bool {
 
 /// Removes the temporary files of killed writers directly in `dir` (call with the lock held:
 /// every writer of the folder holds it, so any temporary file there is stale).
-fn remove_stale_temps(dir: &Path) {
+pub(crate) fn remove_stale_temps(dir: &Path) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         if e.file_name().to_str().is_some_and(is_temp) && e.path().is_file() {

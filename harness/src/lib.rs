@@ -77,6 +77,7 @@ pub mod declare;
 pub mod error;
 pub mod execute;
 pub mod folder;
+mod folder_lock;
 pub mod guarded;
 pub mod html;
 pub mod integrals;
