@@ -85,7 +85,7 @@ fn three_shard_processes_merged_equal_a_single_run() {
     assert_eq!(deterministic_csv(&merged.join("summary.csv")), deterministic_csv(&single.join("summary.csv")));
     assert_eq!(common::integrals_text(&merged), common::integrals_text(&single), "integrals.csv differs");
     assert!(read(merged.join("fig8_bands.csv")) == read(single.join("fig8_bands.csv")), "fig8_bands.csv differs");
-    // A shard folder is its block store, its manifest and its lock.
+    // A finished shard folder is its block store and its manifest (the lock file exists only while held).
     let mut names: Vec<String> = std::fs::read_dir(d.join("sh/results/transmittance/shard-2-of-3"))
         .expect("shard folder")
         .map(|e| e.expect("entry").file_name().to_string_lossy().to_string())
