@@ -185,7 +185,7 @@ fn outputs_and_stored_cells_are_checked_first() {
     let mut records = Store::open(&store).expect("store").records().to_vec();
     records.sort_by(|a, b| a.name.cmp(&b.name));
     records.drain(..3);
-    let corrupt = mcbench::packed::join(&mcbench::packed::Parts { meta: "{\"key\":".into(), moments: Vec::new() });
+    let corrupt = mcbench::packed::join(&mcbench::packed::Parts { meta: "{\"key\":".into(), columns: Vec::new() });
     records[2].payload = corrupt;
     let name = records[2].name.clone();
     mcbench::store::write_records(&store, &records).expect("rewrite");

@@ -1,16 +1,19 @@
 //! The payload of a store record ([`crate::store`]): a cell's statistics, compressed. Per-integral
-//! moments are most of a cell and JSON spends about 20 characters on each of their numbers, so
-//! they are packed as little-endian columns (counts, means, sums of squares and cubes, mean
-//! compensations: bit for bit, non-finite values included) after the rest of the cell as JSON, and
-//! the whole is deflated:
+//! moments and repetition blocks are most of a cell, and JSON spends about 20 characters on each
+//! of their numbers, so they are packed as little-endian columns ([`columns`]: counts, means, sums
+//! of squares and cubes, mean compensations, and each block's sums, times and costs; bit for bit,
+//! non-finite values included) after the rest of the cell as JSON, and the whole is deflated:
 //!
 //! ```text
-//! deflate( meta length: u32 LE | meta: JSON of the record with an empty `moments` |
-//!          k: u32 LE | n: k x u64 | mean: k x f64 | m2: k x f64 | m3: k x f64 | mean_comp: k x f64 )
+//! deflate( meta length: u32 LE | meta: JSON of the record with empty `moments` and `blocks` |
+//!          columns (columns::pack) )
 //! ```
 //!
-//! with `k` = integrals x 3 channels. [`encode_cell`] / [`decode_cell`] handle a finished cell,
-//! [`encode_block`] / [`decode_block`] a shard's repetition block.
+//! [`encode_cell`] / [`decode_cell`] handle a finished cell, [`encode_block`] / [`decode_block`] a
+//! shard's repetition block. Records written by earlier versions (format 1: the moments as five
+//! plain columns, the blocks in the JSON part) are still read.
+
+pub mod columns;
 
 use crate::cell::CellResult;
 use crate::shard::BlockFile;
@@ -23,17 +26,17 @@ use std::io::{Read, Write};
 /// allocate more).
 pub const MAX_INFLATED: u64 = 1 << 32;
 
-/// A record's two parts before compression: the JSON text and the packed moments (the `k` and
-/// column bytes).
+/// A record's two parts before compression: the JSON text and the binary columns.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Parts {
-    /// JSON of the record with an empty `moments`.
+    /// JSON of the record with empty `moments` (and, in format 2, empty `blocks`).
     pub meta: String,
-    /// `k: u32 LE` and the five columns.
-    pub moments: Vec<u8>,
+    /// The moments and blocks as columns ([`columns::pack`]), or a format-1 record's moments.
+    pub columns: Vec<u8>,
 }
 
-/// Packs moments into columns.
+/// Packs moments into format 1's columns (`k: u32 LE` and five plain columns), as records of
+/// earlier versions hold them.
 pub fn pack_moments(moments: &[[Moments; 3]]) -> Vec<u8> {
     let all: Vec<(u64, [f64; 4])> = moments.iter().flat_map(|m| m.iter().map(Moments::raw)).collect();
     let mut out = Vec::with_capacity(4 + all.len() * 40);
@@ -49,7 +52,7 @@ pub fn pack_moments(moments: &[[Moments; 3]]) -> Vec<u8> {
     out
 }
 
-/// Unpacks [`pack_moments`]' bytes; `Err` says what does not fit.
+/// Unpacks format 1's moment columns ([`pack_moments`]); `Err` says what does not fit.
 pub fn unpack_moments(bytes: &[u8]) -> Result<Vec<[Moments; 3]>, String> {
     let head: [u8; 4] = bytes.get(..4).and_then(|b| b.try_into().ok()).ok_or("no moment count")?;
     let k = u32::from_le_bytes(head) as usize;
@@ -68,11 +71,11 @@ pub fn unpack_moments(bytes: &[u8]) -> Result<Vec<[Moments; 3]>, String> {
 
 /// Compresses a record's parts.
 pub fn join(parts: &Parts) -> Vec<u8> {
-    let mut e = DeflateEncoder::new(Vec::new(), flate2::Compression::default());
+    let mut e = DeflateEncoder::new(Vec::new(), flate2::Compression::best());
     let written = e
         .write_all(&(parts.meta.len() as u32).to_le_bytes())
         .and_then(|()| e.write_all(parts.meta.as_bytes()))
-        .and_then(|()| e.write_all(&parts.moments));
+        .and_then(|()| e.write_all(&parts.columns));
     // Writing into a Vec cannot fail.
     written.and_then(|()| e.finish()).unwrap_or_default()
 }
@@ -88,45 +91,61 @@ pub fn split(payload: &[u8]) -> Result<Parts, String> {
     let len = u32::from_le_bytes(head) as usize;
     let meta = raw.get(4..4 + len).ok_or("its JSON part is cut short")?;
     let meta = std::str::from_utf8(meta).map_err(|_| "its JSON part is not UTF-8")?.to_string();
-    Ok(Parts { meta, moments: raw[4 + len..].to_vec() })
+    Ok(Parts { meta, columns: raw[4 + len..].to_vec() })
 }
 
 fn one_line(e: serde_json::Error) -> String {
     e.to_string().lines().next().unwrap_or("malformed").to_string()
 }
 
+/// The columns of a cell's statistics, and the cell without them (for its JSON part).
+fn take_columns(cell: &CellResult) -> (CellResult, Vec<u8>) {
+    let columns = columns::pack(&cell.moments, &cell.blocks);
+    (CellResult { moments: Vec::new(), blocks: Vec::new(), ..cell.clone() }, columns)
+}
+
+/// Puts a record's columns back into the cell its JSON part gave.
+fn put_columns(cell: &mut CellResult, bytes: &[u8]) -> Result<(), String> {
+    if !cell.moments.is_empty() {
+        return Err("moments in its JSON part".into());
+    }
+    if bytes.get(..4) == Some(&columns::FORMAT2.to_le_bytes()[..]) {
+        if !cell.blocks.is_empty() {
+            return Err("blocks in its JSON part".into());
+        }
+        (cell.moments, cell.blocks) = columns::unpack(bytes)?;
+    } else {
+        cell.moments = unpack_moments(bytes)?;
+    }
+    Ok(())
+}
+
 /// The payload of a finished cell.
 pub fn encode_cell(cell: &CellResult) -> Vec<u8> {
-    let meta = CellResult { moments: Vec::new(), ..cell.clone() };
-    join(&Parts { meta: serde_json::to_string(&meta).unwrap_or_default(), moments: pack_moments(&cell.moments) })
+    let (meta, columns) = take_columns(cell);
+    join(&Parts { meta: serde_json::to_string(&meta).unwrap_or_default(), columns })
 }
 
 /// A cell from its payload; `Err` says what is wrong.
 pub fn decode_cell(payload: &[u8]) -> Result<CellResult, String> {
     let parts = split(payload)?;
     let mut cell: CellResult = serde_json::from_str(&parts.meta).map_err(one_line)?;
-    if !cell.moments.is_empty() {
-        return Err("moments in its JSON part".into());
-    }
-    cell.moments = unpack_moments(&parts.moments)?;
+    put_columns(&mut cell, &parts.columns)?;
     Ok(cell)
 }
 
 /// The payload of a shard's repetition block.
 pub fn encode_block(block: &BlockFile) -> Vec<u8> {
-    let stats = CellResult { moments: Vec::new(), ..block.stats.clone() };
+    let (stats, columns) = take_columns(&block.stats);
     let meta = BlockFile { stats, ..block.clone() };
-    join(&Parts { meta: serde_json::to_string(&meta).unwrap_or_default(), moments: pack_moments(&block.stats.moments) })
+    join(&Parts { meta: serde_json::to_string(&meta).unwrap_or_default(), columns })
 }
 
 /// A shard's repetition block from its payload; `Err` says what is wrong.
 pub fn decode_block(payload: &[u8]) -> Result<BlockFile, String> {
     let parts = split(payload)?;
     let mut block: BlockFile = serde_json::from_str(&parts.meta).map_err(one_line)?;
-    if !block.stats.moments.is_empty() {
-        return Err("moments in its JSON part".into());
-    }
-    block.stats.moments = unpack_moments(&parts.moments)?;
+    put_columns(&mut block.stats, &parts.columns)?;
     Ok(block)
 }
 
@@ -169,8 +188,21 @@ mod tests {
             diagnostics: vec![("cells".into(), 3.0)],
             rep_dev: Moments::default(),
             rep_sq: Moments::default(),
-            blocks: Vec::new(),
+            blocks: (0..2)
+                .map(|i| crate::cell::RepBlock {
+                    reps: 2,
+                    sq: 0.3 + i as f64,
+                    display_sq: Some(0.1),
+                    ..Default::default()
+                })
+                .collect(),
         }
+    }
+
+    /// A format-1 payload, as earlier versions wrote it: the blocks in the JSON part.
+    fn format1(c: &CellResult) -> Vec<u8> {
+        let meta = CellResult { moments: Vec::new(), ..c.clone() };
+        join(&Parts { meta: serde_json::to_string(&meta).expect("json"), columns: pack_moments(&c.moments) })
     }
 
     #[test]
@@ -184,10 +216,17 @@ mod tests {
             assert_eq!(va.map(f64::to_bits), vb.map(f64::to_bits));
         }
         assert_eq!(back.moments.len(), 5);
+        assert_eq!(back.blocks, c.blocks);
         let b = BlockFile { block: 1, blocks: 3, stats: c.clone() };
         let back = decode_block(&encode_block(&b)).expect("decodes");
         assert_eq!((back.block, back.blocks, back.stats.moments.len()), (1, 3, 5));
         assert!(decode_block(&encode_cell(&c)).is_err(), "a cell is not a block");
+    }
+
+    #[test]
+    fn format_1_records_are_still_read() {
+        let c = cell();
+        assert_eq!(decode_cell(&format1(&c)).expect("decodes"), c);
     }
 
     #[test]
@@ -197,11 +236,18 @@ mod tests {
         assert!(decode_cell(&payload[..payload.len() / 2]).is_err());
         assert!(decode_cell(b"not deflate at all").is_err());
         let mut parts = split(&payload).expect("splits");
-        parts.moments.truncate(parts.moments.len() - 8);
-        assert!(decode_cell(&join(&parts)).expect_err("short").contains("bytes of moments"));
+        parts.columns.truncate(parts.columns.len() - 8);
+        assert!(decode_cell(&join(&parts)).expect_err("short").contains("cut short"));
         let mut parts = split(&payload).expect("splits");
-        parts.moments[0] = 4;
+        parts.columns[4] = 4;
         assert!(decode_cell(&join(&parts)).expect_err("count").contains("3 channels"));
+        let mut parts = split(&payload).expect("splits");
+        let block = serde_json::to_string(&crate::cell::RepBlock::default()).expect("json");
+        parts.meta = parts.meta.replace("\"blocks\":[]", &format!("\"blocks\":[{block}]"));
+        assert!(decode_cell(&join(&parts)).expect_err("blocks").contains("blocks in its JSON part"));
+        let mut v1 = split(&format1(&c)).expect("splits");
+        v1.columns.truncate(v1.columns.len() - 8);
+        assert!(decode_cell(&join(&v1)).expect_err("short").contains("bytes of moments"));
         let mut parts = split(&payload).expect("splits");
         parts.meta = parts.meta.replace("\"moments\":[]", "\"moments\":[[]]");
         assert!(decode_cell(&join(&parts)).is_err());
