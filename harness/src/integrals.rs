@@ -71,6 +71,21 @@ pub struct IntegralRow {
     pub estimator_id: String,
 }
 
+/// The SPEC §8 columns, in their order; the geometry columns and `estimator_id` follow.
+pub const COLUMNS: [&str; 11] = [
+    "testbed",
+    "variant",
+    "estimator",
+    "integral",
+    "px",
+    "py",
+    "channel",
+    "reference",
+    "reference_se",
+    "mean",
+    "std_err",
+];
+
 /// The order rows are written in: by (test bed, variant) in the order they first appear, then by
 /// integral and channel, estimators in their order within each. The rows of one integral sit
 /// together, so the estimators' values for a pixel read side by side, and the columns they share
@@ -104,19 +119,7 @@ pub fn csv_bytes(rows: &[IntegralRow]) -> Result<Vec<u8>> {
     }
     let mut w = csv::Writer::from_writer(Vec::new());
     let mut write = || -> csv::Result<()> {
-        let mut header: Vec<&str> = vec![
-            "testbed",
-            "variant",
-            "estimator",
-            "integral",
-            "px",
-            "py",
-            "channel",
-            "reference",
-            "reference_se",
-            "mean",
-            "std_err",
-        ];
+        let mut header: Vec<&str> = COLUMNS.to_vec();
         header.extend(&geo);
         header.push("estimator_id");
         w.write_record(&header)?;

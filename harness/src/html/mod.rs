@@ -48,19 +48,7 @@ pub fn read_integrals(results_dir: &Path) -> Result<Vec<IntegralRow>> {
     let mut rd = csv::Reader::from_reader(text.as_bytes());
     let header = rd.headers().map_err(|e| bad(e.to_string()))?.clone();
     let col = |name: &str| header.iter().position(|h| h == name).ok_or_else(|| bad(format!("no column {name}")));
-    let names = [
-        "testbed",
-        "variant",
-        "estimator",
-        "integral",
-        "px",
-        "py",
-        "channel",
-        "reference",
-        "reference_se",
-        "mean",
-        "std_err",
-    ];
+    let names = crate::integrals::COLUMNS;
     let idx: Vec<usize> = names.iter().map(|n| col(n)).collect::<Result<_>>()?;
     let mut out = Vec::new();
     for (line, rec) in rd.records().enumerate() {
