@@ -7,13 +7,7 @@ import json
 import pathlib
 import sys
 
-
-def verdict(c):
-    if c.get("verdict"):
-        return c["verdict"]
-    if c.get("held") is None:
-        return "reported" if c.get("our_value") is not None else "not measured"
-    return "held" if c["held"] else "not held"
+from compare_results import verdict
 
 
 def claims(root):
