@@ -107,7 +107,8 @@ fn integral_major(rows: &[IntegralRow]) -> Vec<&IntegralRow> {
 }
 
 /// The CSV text: the SPEC §8 columns, the geometry columns (the union over rows, empty where a
-/// row has none), then `estimator_id`; rows in [`integral_major`] order.
+/// row has none), then `estimator_id`; rows by integral and channel, the estimators of one side by
+/// side (see `integral_major`).
 pub fn csv_bytes(rows: &[IntegralRow]) -> Result<Vec<u8>> {
     let mut geo: Vec<&'static str> = Vec::new();
     for r in rows {
