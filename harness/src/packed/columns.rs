@@ -70,12 +70,14 @@ impl<'a> Cursor<'a> {
     }
 }
 
+/// A moment's whole state as bits, for comparing bit for bit.
+fn bits(m: &Moments) -> (u64, [u64; 4]) {
+    let (n, v) = m.raw();
+    (n, v.map(f64::to_bits))
+}
+
 /// Whether each integral's three channels hold the same moments, bit for bit.
 fn grey(moments: &[[Moments; 3]]) -> bool {
-    let bits = |m: &Moments| {
-        let (n, v) = m.raw();
-        (n, v.map(f64::to_bits))
-    };
     moments.iter().all(|m| bits(&m[0]) == bits(&m[1]) && bits(&m[0]) == bits(&m[2]))
 }
 
@@ -151,7 +153,7 @@ pub fn unpack(bytes: &[u8]) -> Result<(Vec<[Moments; 3]>, Vec<RepBlock>), String
     }
     let j = k / 3 * channels;
     let n = c.u64s(j, "moments")?;
-    let cols = [c.f64s(j, "moments")?, c.f64s(j, "moments")?, c.f64s(j, "moments")?, c.f64s(j, "moments")?];
+    let cols: Vec<Vec<f64>> = (0..4).map(|_| c.f64s(j, "moments")).collect::<Result<_, _>>()?;
     let one = |i: usize| Moments::from_raw(n[i], [cols[0][i], cols[1][i], cols[2][i], cols[3][i]]);
     let moments = (0..k / 3)
         .map(|i| if channels == 1 { [one(i), one(i), one(i)] } else { [one(3 * i), one(3 * i + 1), one(3 * i + 2)] })
@@ -200,10 +202,6 @@ mod tests {
     }
 
     fn same(a: &[[Moments; 3]], b: &[[Moments; 3]]) -> bool {
-        let bits = |m: &Moments| {
-            let (n, v) = m.raw();
-            (n, v.map(f64::to_bits))
-        };
         a.len() == b.len() && a.iter().flatten().zip(b.iter().flatten()).all(|(x, y)| bits(x) == bits(y))
     }
 

@@ -101,7 +101,20 @@ fn one_line(e: serde_json::Error) -> String {
 /// The columns of a cell's statistics, and the cell without them (for its JSON part).
 fn take_columns(cell: &CellResult) -> (CellResult, Vec<u8>) {
     let columns = columns::pack(&cell.moments, &cell.blocks);
-    (CellResult { moments: Vec::new(), blocks: Vec::new(), ..cell.clone() }, columns)
+    // Field by field, so the moments and blocks are not copied only to be dropped.
+    let meta = CellResult {
+        key: cell.key.clone(),
+        moments: Vec::new(),
+        costs: cell.costs,
+        estimates: cell.estimates,
+        time: cell.time.clone(),
+        cpu_time: cell.cpu_time.clone(),
+        diagnostics: cell.diagnostics.clone(),
+        rep_dev: cell.rep_dev.clone(),
+        rep_sq: cell.rep_sq.clone(),
+        blocks: Vec::new(),
+    };
+    (meta, columns)
 }
 
 /// Puts a record's columns back into the cell its JSON part gave.
