@@ -120,10 +120,9 @@ pub fn judge(r: &mut Row) {
     let why = r.note.clone();
     let (agrees, mut note) = match (expect, r.verdict.as_str()) {
         (_, "not-run") => (None, why),
-        ("consistent", "biased") => (
-            None,
-            format!("flagged (p = {p}): reported, not judged: the estimator is consistent, not unbiased{measured}"),
-        ),
+        ("consistent", "biased") => {
+            (None, format!("flagged (p = {p}): reported as consistent only, not judged as unbiased{measured}"))
+        }
         ("consistent", v) => (None, format!("{v} (consistent id): {why}{measured}")),
         ("either", v) => (None, format!("{v} (p = {p}): {why}{measured}")),
         ("biased", "biased") => (Some(true), format!("control flagged (p = {p}){measured}")),
