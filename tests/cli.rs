@@ -1,4 +1,4 @@
-//! Integration tests of the `mcbench` binary (SPEC §9): exit codes, one-line errors naming the
+//! Integration tests of the `mcbench` binary (book: cli.md): exit codes, one-line errors naming the
 //! field, no files written on bad input, and a small custom sweep end to end.
 
 use std::path::Path;
@@ -170,7 +170,7 @@ fn reference_command_stores_the_exact_reference() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("error bound"));
 }
 
-/// SPEC §8: a run killed (SIGKILL) mid-way and run again with the same seed reuses
+/// Runs resume: a run killed (SIGKILL) mid-way and run again with the same seed reuses
 /// the cells it had finished, leaves no corrupt file, and ends with the same summary as a run that
 /// was never interrupted (timing columns aside).
 #[test]

@@ -1,6 +1,6 @@
 //! The conformance suite: every registered estimator goes through
 //! `mcbench::conformance::Conformance` (builds, finite output or a clean refusal on the test beds'
-//! SPEC §10 stability cases, determinism for a seed, chi-square of its samplers, unbiasedness at a
+//! stability cases, determinism for a seed, chi-square of its samplers, unbiasedness at a
 //! small budget), so a new plug-in is covered without new test code.
 
 use estimators::registry;

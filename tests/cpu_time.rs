@@ -1,4 +1,4 @@
-//! CPU time per estimate (SPEC §5): measured on the estimating thread's clock beside wall time,
+//! CPU time per estimate (book: outputs.md): measured on the estimating thread's clock beside wall time,
 //! time spent sleeping or waiting not counted; cells stored before it still load (wall-clock
 //! fallback, said so); and the interleaved scheduling of the cells of one (test bed, budget) does
 //! not change any result.

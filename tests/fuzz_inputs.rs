@@ -1,4 +1,4 @@
-//! Property tests of bad input (SPEC §9): random edits of every kind of file the harness reads (a
+//! Property tests of bad input (book: cli.md): random edits of every kind of file the harness reads (a
 //! sweep file in TOML or JSON, `summary.json`, a stored cell, a shard manifest, a stored
 //! reference) never panic, and every rejection is one non-empty line that names the field (or the
 //! file, and for parse errors its position) and maps to exit code 2 (`tests/cli.rs` and

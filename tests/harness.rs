@@ -1,4 +1,4 @@
-//! Integration tests of the harness over its public API (SPEC §2, §5, §6, §8): a small sweep into a
+//! Integration tests of the harness over its public API: a small sweep into a
 //! temp dir, the result files, determinism across thread counts, resume, and the unbiasedness
 //! test's teeth.
 

@@ -1,4 +1,4 @@
-//! The promises of SPEC §8-9 and §12 under attack, through the binary: a run validates everything
+//! The promises of the book's contract chapter under attack, through the binary: a run validates everything
 //! before it writes anything (the whole plan, every bound on every input path, output paths, the
 //! stored files it will read), refuses in one line naming the field or file with the exit code of
 //! the one table, and leaves the results and plots folders byte for byte as they were; folders are

@@ -1,4 +1,4 @@
-//! Scale-out (SPEC §12): an experiment run as 3 separate `--shard i/3` processes and
+//! Scale-out (book: scale-out.md): an experiment run as 3 separate `--shard i/3` processes and
 //! merged equals a single run byte for byte (wall-clock fields aside), and bad shard sets are
 //! refused with exit code 2, one line naming what is wrong, and nothing written.
 

@@ -1,4 +1,4 @@
-//! Criterion benches of the surface radiance cache hot paths (SPEC §11): one cache sample
+//! Criterion benches of the surface radiance cache hot paths (book: benches.md): one cache sample
 //! (partial-sum tree + uniform in the cell), one record (running means, maintained sums, tree
 //! update), one refinement, one reconstruction of g, and one whole `is1_cv2` estimate.
 //! Run with `cargo bench -p estimators --bench cache`.

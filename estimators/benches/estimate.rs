@@ -1,5 +1,5 @@
 //! Criterion bench: one estimate of each registered estimator on each test bed it runs on, at a
-//! small sample budget (SPEC §11). Run with `cargo bench -p estimators`.
+//! small sample budget (book: benches.md). Run with `cargo bench -p estimators`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use estimators::budget::Budget;

@@ -1,4 +1,4 @@
-//! Criterion benches of the medium SMC hot paths (SPEC §11): one independent path in the
+//! Criterion benches of the medium SMC hot paths (book: benches.md): one independent path in the
 //! gradient box (free flights + phase sampling), one octree leaf lookup at depth 3, one path
 //! vertex of the octree cache (`is1_cv2`: leaf lookup, cell sample, `G` and the bilinear `g`, the
 //! estimate and the record; paper 000 Fig. 2) on a full octree of depth 3 (512 leaves, 65 536

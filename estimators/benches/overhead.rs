@@ -1,4 +1,4 @@
-//! Criterion benches of the adaptive estimators' overhead over their plain counterparts (SPEC §11),
+//! Criterion benches of the adaptive estimators' overhead over their plain counterparts (book: benches.md),
 //! each a pair timed in one run so their ratio is read from one report:
 //! - `overhead_media_vertex/<structure>/{is0_cv0,is1_cv2}`: one scattering vertex in
 //!   `gradient-box` albedo 0.8 with the free flight it leaves by. `is0_cv0`: phase sampling and the

@@ -1,4 +1,4 @@
-//! Criterion bench of paper 003's image-plane samplers (SPEC §11 "one PMC iteration"): a whole
+//! Criterion bench of paper 003's image-plane samplers (one PMC iteration, book: benches.md): a whole
 //! 8x8 `checker-image` at 10 spp with `pmc_ip` (2+4+4) and `uniform_image` (the pixel samples
 //! dominate both), and the adaptation overhead of one PMC-IP iteration alone (weights from the
 //! pixel statistics plus the DMS allocation) on 48x48 pixels. Run with

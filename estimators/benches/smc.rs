@@ -1,4 +1,4 @@
-//! Criterion benches of the remaining SPEC §11 hot paths: one partial-sum-tree
+//! Criterion benches of the remaining hot paths (book: benches.md): one partial-sum-tree
 //! sample and update (1024 leaves), one Metropolis-Hastings move of paper 004's mixture kernel on
 //! an environment map x Phong target, one resampling of N = 16 and N = 1024 particles (each
 //! scheme, from log weights: normalisation + ancestor draw), and one PMC-HI iteration (paper 003:

@@ -1,4 +1,4 @@
-//! Criterion benches of the null-collision hot paths (paper 002; SPEC §11):
+//! Criterion benches of the null-collision hot paths (paper 002; book: benches.md):
 //! one fetch of each medium (the floor: a tight loop of extinction evaluations along the central
 //! ray), and one
 //! transmittance estimate (16 rays) of each tracker on the full central ray s = 20 of each medium.

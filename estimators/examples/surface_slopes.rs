@@ -7,7 +7,7 @@
 //! cargo run --release -p estimators --example surface_slopes -- long [id] [spp] [variant]
 //! ```
 //! Defaults: `default 8 6 32 is0_cv0 is1_cv2` (spp 4 .. 4096 on 32x32). `long` runs one estimate
-//! of pixel 0 with a huge budget (default `is1_cv2`, 1e7 samples): the SPEC §10 stability case.
+//! of pixel 0 with a huge budget (default `is1_cv2`, 1e7 samples): the stability case.
 
 use estimators::budget::Budget;
 use estimators::params::Params;
@@ -103,7 +103,7 @@ fn main() {
     }
 }
 
-/// One estimate with a huge budget into one cache (SPEC §10: counters, precision, finiteness).
+/// One estimate with a huge budget into one cache (stability: counters, precision, finiteness).
 fn long(args: &[String]) {
     let id = args.first().map_or("is1_cv2", String::as_str);
     let spp: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(10_000_000);

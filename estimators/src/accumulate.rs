@@ -1,5 +1,4 @@
-//! Compensated running sums of RGB samples (SPEC "Numerics": compensated sums for long
-//! accumulations).
+//! Compensated running sums of RGB samples, for long accumulations (book: stability.md).
 
 use crate::math::Rgb;
 use crate::stats::NeumaierSum;

@@ -2,7 +2,7 @@
 //! and 004, and its importance sampling.
 //!
 //! `f(w_i, w_o) = kd / pi + ks (n + 2) / (2 pi) max(0, w_r . w_i)^n`, with `w_r = 2 (n . w_o) n - w_o`
-//! the mirror of the view direction about the normal (SPEC §3.1).
+//! the mirror of the view direction about the normal (book: testbeds.md).
 
 use crate::math::{Frame, Rgb, Vec3};
 use crate::samplers::{cosine_hemisphere, phong_lobe};

@@ -1,4 +1,4 @@
-//! Budgets (SPEC §2): samples per integral (the papers' spp), medium fetches, or wall time.
+//! Budgets: samples per integral (the papers' spp), medium fetches, or wall time.
 
 use crate::error::ConfigError;
 use serde::{Deserialize, Serialize};

@@ -1,4 +1,4 @@
-//! Typed errors of the library (SPEC §9: bad input names its field).
+//! Typed errors of the library (bad input names its field).
 
 use thiserror::Error;
 

@@ -1,4 +1,4 @@
-//! The estimator plug-in trait (SPEC §2).
+//! The estimator plug-in trait (book: extending.md).
 
 use crate::error::EstimateError;
 use crate::math::Rgb;

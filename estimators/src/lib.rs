@@ -5,7 +5,7 @@
 //! [`budget::Budget`]), the registries, the analytic test beds with their references, samplers,
 //! the estimator families, and the small statistics the harness and the sampler tests share.
 //!
-//! No I/O, plotting or CLI lives here (that is the `experiments` crate).
+//! No I/O, plotting or CLI lives here (that is the `mcbench` crate, in `harness/`).
 #![warn(missing_docs)]
 
 pub mod accumulate;

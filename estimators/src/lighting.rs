@@ -7,7 +7,8 @@ use rand::Rng;
 use serde::{Deserialize, Serialize};
 
 /// The gradient background of papers 000/001: `L_b(w) = c0 + c1 w_z + c2 w_x` per channel
-/// (SPEC §3.1), optionally clamped at zero per channel (SPEC §3.2, whole sphere).
+/// (book: testbeds.md), optionally clamped at zero per channel (as `gradient-box` does, over the
+/// whole sphere).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Gradient {
     /// Constant term per channel.
@@ -21,7 +22,7 @@ pub struct Gradient {
 }
 
 impl Gradient {
-    /// The SPEC §3.1 coefficients: R (1.0, 1.0, 0.5), G (0.8, 1.2, 0.0), B (0.6, 1.5, -0.4).
+    /// The default coefficients of `gradient-plane`: R (1.0, 1.0, 0.5), G (0.8, 1.2, 0.0), B (0.6, 1.5, -0.4).
     pub const fn papers() -> Gradient {
         Gradient { c0: Rgb([1.0, 0.8, 0.6]), c1: Rgb([1.0, 1.2, 1.5]), c2: Rgb([0.5, 0.0, -0.4]), clamp: false }
     }
@@ -36,7 +37,7 @@ impl Gradient {
     }
 }
 
-/// An isotropic point light (paper 002 §4.3, SPEC §3.3): radiant intensity `intensity` (power
+/// An isotropic point light (paper 002 §4.3, book: testbeds.md): radiant intensity `intensity` (power
 /// `4 pi intensity`) at `position`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PointLight {
@@ -59,7 +60,7 @@ impl PointLight {
 }
 
 /// A rectangular area light facing down (emitting towards `-z`), axis-aligned in `x` and `y`:
-/// `[x0, x1] x [y0, y1]` at height `z` with constant radiance (paper 003 Fig. 6, SPEC §3.5).
+/// `[x0, x1] x [y0, y1]` at height `z` with constant radiance (paper 003 Fig. 6, book: testbeds.md).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RectLight {
     /// Lower corner `(x0, y0)`.
@@ -94,7 +95,7 @@ impl RectLight {
 }
 
 /// Light selection probabilities proportional to power (radiance x area): the light strategy of
-/// paper 003's MIS baseline (§5.3) and of `checker-image`'s pixel samples (SPEC §3.6).
+/// paper 003's MIS baseline (§5.3) and of `checker-image`'s pixel samples (book: testbeds.md).
 pub fn light_selection(lights: &[RectLight]) -> Vec<f64> {
     let w: Vec<f64> = lights.iter().map(|l| l.radiance.mean() * l.area()).collect();
     let t: f64 = w.iter().sum();

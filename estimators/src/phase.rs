@@ -1,4 +1,4 @@
-//! Phase functions of participating media (paper 000 Eq. 5, SPEC §3.2-3.4): isotropic,
+//! Phase functions of participating media (paper 000 Eq. 5, book: testbeds.md): isotropic,
 //! Henyey-Greenstein and Rayleigh, each with an exact sampler.
 //!
 //! Convention: `cos` is the cosine between the propagation direction *before* and *after* the

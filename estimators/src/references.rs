@@ -1,4 +1,4 @@
-//! Stored references as data (SPEC §2-3): a test bed without a closed form looks its reference up
+//! Stored references as data (book: testbeds.md): a test bed without a closed form looks its reference up
 //! by a [`ReferenceKey`] (test bed, variant, and the parameters the values depend on) in a
 //! [`ReferenceSource`] that the caller provides: the harness reads a folder (`<results>/references`
 //! or `--references DIR`), a test can hand over a value. The library itself reads no file.

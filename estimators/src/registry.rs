@@ -27,7 +27,7 @@ pub struct EstimatorEntry {
     /// What it needs from a test bed.
     pub needs: Needs,
     /// The registered samplers it draws from (ids of `samplers::registry::SAMPLERS`): the
-    /// conformance suite runs their chi-square tests for it (SPEC §6). Adaptive samplers internal
+    /// conformance suite runs their chi-square tests for it (book: conformance.md). Adaptive samplers internal
     /// to the estimator (cache cells, texel tables, PMC kernels, MH moves) are tested beside their
     /// code and not listed.
     pub samplers: &'static [&'static str],
@@ -95,7 +95,7 @@ pub struct BedCase {
 /// What a [`BedCase`] is for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CaseRole {
-    /// An extreme case (SPEC §10) of the conformance suite: every estimate is finite or a clean
+    /// An extreme case (book: stability.md) of the conformance suite: every estimate is finite or a clean
     /// one-line refusal.
     Stability,
     /// A small case with an exact or stored reference for the conformance suite's quick

@@ -1,4 +1,5 @@
-//! Counter-derived random streams (SPEC §2 "Randomness").
+//! Counter-derived random streams: one per (seed, test bed, estimator, budget, repetition,
+//! integral), so results do not depend on the thread count (book: contract.md).
 //!
 //! Every (experiment seed, test bed, estimator, budget, repetition, integral) gets its own
 //! `rand_pcg` stream: the key is hashed with a fixed, versioned mixing function (FNV-1a over the

@@ -1,4 +1,5 @@
-//! The harness's counted view of a test bed for one estimate (SPEC §2 "Budget").
+//! The harness's counted view of a test bed for one estimate: it counts samples,
+//! rays and fetches against the budget.
 //!
 //! Estimators reach the scene only through a [`Task`] and its probes, and the probes count every
 //! sample, ray and fetch, so no plug-in can forget to count (the argmin `Problem` wrapper idea).

@@ -1,4 +1,4 @@
-//! The test-bed plug-in trait (SPEC §2): a deterministic scene defining integrals to estimate and
+//! The test-bed plug-in trait (book: extending.md): a deterministic scene defining integrals to estimate and
 //! their references, and what it provides to estimators.
 
 use crate::brdf::Phong;
@@ -193,7 +193,7 @@ pub trait HemisphereScene: Send + Sync {
     }
 }
 
-/// A scene whose integrals are pixel integrals over the image plane (paper 003 Eq. 2, SPEC §3.6):
+/// A scene whose integrals are pixel integrals over the image plane (paper 003 Eq. 2, book: testbeds.md):
 /// `I_p = int_{pixel p} E[S(p, u, v)] du dv` with a box filter, where one *pixel sample*
 /// `S(p, u, v)` is a random, unbiased estimate of the radiance seen through position `(u, v)` of
 /// the pixel's footprint. Image-plane samplers (PMC-IP, §4) choose how many samples each pixel
@@ -222,7 +222,7 @@ pub trait ImagePlaneScene: Send + Sync {
     fn pixel_sample(&self, pixel: usize, u: f64, v: f64, rng: &mut crate::rng::StreamRng) -> (Rgb, u64);
 }
 
-/// What integral `i` of a medium scene asks for (SPEC §3.3-3.4).
+/// What integral `i` of a medium scene asks for (book: testbeds.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MediumQuantity {
     /// `weight * T(length)`: the transmittance from `origin` along `dir` over `[0, length]`, times
@@ -318,7 +318,7 @@ pub trait MediumScene: Send + Sync {
     }
 }
 
-/// A test bed (SPEC §2). Integrals are pixels in row-major order, `i = py * width + px`.
+/// A test bed (book: extending.md). Integrals are pixels in row-major order, `i = py * width + px`.
 ///
 /// ```
 /// use estimators::registry::testbed;

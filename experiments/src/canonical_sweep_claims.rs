@@ -127,7 +127,7 @@ fn control_flagged(a: &Analysis) -> Claim {
     let flagged = rm.iter().filter(|r| r.verdict() == Some("biased")).count();
     Claim {
         testbed: TB.into(),
-        claim: "SPEC §6: the biased control (ray marching, step 0.5: two steps) is flagged in every cell where its exact bias is detectable (above the shift the test detects with 80% power)".into(),
+        claim: "harness: the biased control (ray marching, step 0.5: two steps) is flagged in every cell where its exact bias is detectable (above the shift the test detects with 80% power)".into(),
         paper_value: Some(detectable as f64),
         our_value: Some(caught as f64),
         held: Some(caught == detectable && detectable > 0),

@@ -158,7 +158,7 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
     let claim = |start: &str| out.report.paper.iter().find(|c| c.claim.starts_with(start)).unwrap().clone();
     let unbiased = claim("no unbiased cell is flagged biased");
     assert_eq!(unbiased.held, Some(true), "{}", unbiased.note);
-    let control = claim("SPEC §6: the biased control");
+    let control = claim("harness: the biased control");
     assert_eq!((control.held, control.our_value), (Some(true), Some(2.0)), "{}", control.note);
     let cells = std::fs::read_to_string(out.results_dir.join("cells.csv")).unwrap();
     assert!(cells.contains("delta_tracking.sigma_samp_ratio = 0.5: delta_tracking needs a majorant"), "{cells}");

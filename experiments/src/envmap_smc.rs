@@ -1,4 +1,4 @@
-//! `envmap-smc` (paper 004 Fig. 2-5, §7; SPEC §7): the `envmap-sequence` test bed, N = 16
+//! `envmap-smc` (paper 004 Fig. 2-5, §7; book: experiments.md): the `envmap-sequence` test bed, N = 16
 //! particles per pixel and frame.
 //!
 //! (a) Fig. 2-3: RMSE of `L_ns` (variant `mixed-lns`) against P for a single distribution with P MH

@@ -1,4 +1,4 @@
-//! The dedicated unbiasedness check of `envmap-smc` (SPEC §6): the per-integral tests of
+//! The dedicated unbiasedness check of `envmap-smc` (book: statistics.md): the per-integral tests of
 //! the main sweep have a dozen repetitions, too few for the skewed estimates of an HDR sky (a rare
 //! sun hit), so every paper 004 estimator is also run on a small `envmap-sequence` (2x2 pixels,
 //! 4 frames, N = 4 particles) with thousands of repetitions: one-sample t-tests per integral and

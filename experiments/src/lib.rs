@@ -1,6 +1,6 @@
 //! # experiments
 //!
-//! The paper suite of mcbench: the named experiments of SPEC §7 (each a sweep for quick and for
+//! The paper suite of mcbench: the named experiments (book: experiments.md; each a sweep for quick and for
 //! full mode, the paper's claims judged against what the run measured, and the figures and tables
 //! of its own), registered on top of the harness ([`mcbench`]) by [`registry`]; the `mcbench`
 //! binary is `mcbench::cli::main_with(experiments::registry())`.

@@ -1,4 +1,4 @@
-//! `mcbench`: the command-line front of the harness over the paper suite (SPEC §9). Exit codes:
+//! `mcbench`: the command-line front of the harness over the paper suite (book: cli.md). Exit codes:
 //! the table of `mcbench::error`.
 
 fn main() {

@@ -1,4 +1,4 @@
-//! `media-smc` (paper 000 Fig. 3, Table 1, §5; SPEC §7): the gradient-box test bed at albedo
+//! `media-smc` (paper 000 Fig. 3, Table 1, §5; book: experiments.md): the gradient-box test bed at albedo
 //! 1 / 0.8 / 0.5, the six cache ids (`is0_cv0` = independent path tracer, the papers' "MCMC") and
 //! the biased ray-marching control `rm_is1_cv2`, spp = 4^k. The structure report of Table 1
 //! (criterion, depth, nodes, leaves, cells, bytes) comes from the estimators' diagnostics and is

@@ -2,7 +2,7 @@
 //! nodes, leaves, cells, bytes of the octree at the largest budget, from the estimators'
 //! diagnostics) written to `structure.csv` and beside the paper's numbers in the `paper` block,
 //! and the check that the stored references are precise enough: every measured RMSE at the
-//! largest budget must be at least 3x the reference's RMS standard error (SPEC §2).
+//! largest budget must be at least 3x the reference's RMS standard error.
 
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;

@@ -13,7 +13,7 @@ pub const DISPLAY: DisplayNames = DisplayNames { estimator: Some(estimator), tes
 fn base(id: &str) -> Option<&'static str> {
     Some(match id {
         // Paper 001 (surfaces) and paper 000 (media): the SMC radiance cache.
-        // The papers call it "MCMC"; the legend says what it is (SPEC §4).
+        // The papers call it "MCMC"; the legend says what it is (book: testbeds.md).
         "is0_cv0" => "independent MC (papers' MCMC)",
         "brdf_is0_cv0" => "BRDF sampling (IS0 CV0)",
         "clamped_is0_cv0" => "clamped independent MC (biased control)",

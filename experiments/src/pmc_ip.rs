@@ -1,7 +1,7 @@
 //! `pmc-ip` (paper 003 Table 1, Fig. 4): `checker-image` (default, and `occluded` with soft
 //! shadows as in the paper's Buddha) at equal sample counts: uniform image-plane sampling at 10,
 //! 16 and 32 spp against PMC-IP 2+4+4 (`pmc_ip` at 10 spp) and 4+6+6 (`pmc_ip[initial=4]` at
-//! 16 spp), with the perceptual error `Err` and `P-Eff` of SPEC §5 beside our plain efficiency,
+//! 16 spp), with the perceptual error `Err` and `P-Eff` (book: outputs.md) beside our plain efficiency,
 //! and the threshold-stopping control of paper 003 §2 that the unbiasedness test must flag.
 
 use crate::{pmc_ip_post, ExperimentDef};

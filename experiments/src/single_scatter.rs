@@ -36,7 +36,7 @@ pub static DEF: ExperimentDef = ExperimentDef {
 /// The paper's "noise free but biased" marcher: one ray spending the budget, offsets fixed at 1/2.
 pub const NOISE_FREE: &str = "ray_marching[jitter=0]";
 
-/// The harness's biased control (SPEC §6): ray marching with a coarse fixed step, which a
+/// The harness's biased control (book: statistics.md): ray marching with a coarse fixed step, which a
 /// fetch budget buys several rays of. The Fig. 12 marcher (one ray spending the budget) is in the
 /// ranking; its bias is far below what a quick run detects on the smooth Eq. 21 medium.
 pub const CONTROL: &str = "ray_marching[step=5]";

@@ -115,7 +115,7 @@ pub fn post(
                 .collect();
             claims.push(Claim {
                 testbed: format!("{tb}/single-scatter"),
-                claim: "SPEC §6: no unbiased id is flagged by the unbiasedness test against the exact reference (count flagged)"
+                claim: "no unbiased id is flagged by the unbiasedness test against the exact reference (count flagged)"
                     .into(),
                 paper_value: Some(0.0),
                 our_value: Some(flagged.len() as f64),

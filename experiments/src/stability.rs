@@ -1,4 +1,4 @@
-//! `stability` (SPEC §10): every numerical stability case of the specification
+//! `stability` (book: stability.md): every numerical stability case
 //! with its outcome, `correct` (within error bars of an exact or stored reference, or of an
 //! error-free numeric reference) or `refused` (a typed one-line error), never a panic or a NaN.
 //!
@@ -27,7 +27,7 @@ pub const IDS: &[&str] = &["is0_cv0", "is1_cv2"];
 /// Definition.
 pub static DEF: ExperimentDef = ExperimentDef { toml: include_str!("stability.toml"), claims: None, post: Some(post) };
 
-/// The numeric cases (the same in quick and full mode: 1e8 is the SPEC's count): (id, spec item,
+/// The numeric cases (the same in quick and full mode: 1e8 values, the count the case names): (id, spec item,
 /// expected, outcome).
 fn numeric_cases() -> Vec<(&'static str, &'static str, Expect, Outcome)> {
     let n = 100_000_000;
@@ -69,7 +69,7 @@ fn params_text(p: &Params) -> String {
 struct StabilityRow {
     /// The case's short id.
     case: String,
-    /// The SPEC §10 item it checks.
+    /// The stability item it checks (book: stability.md).
     spec_item: String,
     /// The test bed (`numeric` for the numeric cases).
     testbed: String,
@@ -116,7 +116,7 @@ pub fn post(
         let expected = if expect == Expect::Correct { "correct" } else { "refused" };
         report.paper.push(Claim {
             testbed: bed.clone(),
-            claim: format!("SPEC §10 {item}: `{id}` ({est}) is {expected}"),
+            claim: format!("stability, {item}: `{id}` ({est}) is {expected}"),
             paper_value: None,
             our_value: (!o.statistic.is_nan()).then_some(o.statistic),
             held: Some(o.outcome == expected),

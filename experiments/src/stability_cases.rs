@@ -1,4 +1,4 @@
-//! The estimator cases of the `stability` experiment (SPEC §10) and their runner: each case runs
+//! The estimator cases of the `stability` experiment (book: stability.md) and their runner: each case runs
 //! one configured estimator on one (small) test-bed variant for a number of repetitions and ends
 //! in one of three outcomes:
 //! - `correct`: every estimate finite, and the harness's own unbiasedness test
@@ -47,7 +47,7 @@ pub enum Expect {
 pub struct Case {
     /// Short id (`stability.csv` column `case`).
     pub id: String,
-    /// The SPEC §10 item (or pdf-zero site) it covers.
+    /// The stability item (or pdf-zero site) it covers (book: stability.md).
     pub spec_item: String,
     /// Test bed id.
     pub testbed: String,

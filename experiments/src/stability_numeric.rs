@@ -1,4 +1,4 @@
-//! The numeric cases of the `stability` experiment (SPEC §10) that are not one estimator on one
+//! The numeric cases of the `stability` experiment (book: stability.md) that are not one estimator on one
 //! test bed: long running means against an error-free reference, one cache cell fed 1e7 records,
 //! and SMC weights that underflow or are all zero.
 //!
@@ -14,7 +14,7 @@ use estimators::math::Rgb;
 use estimators::smc::resampling::{effective_sample_size, normalise_log_weights};
 use estimators::stats::Moments;
 
-/// The relative drift a running mean of 1e8 values may show (SPEC §10).
+/// The relative drift a running mean of 1e8 values may show (book: stability.md).
 pub const MEAN_DRIFT_LIMIT: f64 = 1e-12;
 
 /// A double-double accumulator: `hi + lo` holds the running sum to about 106 bits.

@@ -1,4 +1,4 @@
-//! Coverage of the convergence-slope intervals (SPEC §5): how often the 95% interval of independent
+//! Coverage of the convergence-slope intervals (book: slope-fits.md): how often the 95% interval of independent
 //! MC's slope holds the true -1/2, over many seeds, for the whole-range and the right-end fit, by
 //! ordinary least squares of log RMSE (the fit before `summary.csv` had `mse_se`) and by the weighted fit
 //! with delta-method variances that `mcbench::analysis::fits` makes now.

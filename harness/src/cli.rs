@@ -1,4 +1,4 @@
-//! The `mcbench` command line (SPEC §9): `list`, `run`, `reference`, `merge`, `plot`, and the
+//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, and the
 //! default quick suite. Every subcommand exits by the one table of [`crate::error`]: bad input is
 //! one line on stderr naming the field or file, exit code 2, and nothing written; a results folder
 //! that another run holds is exit code 3 (or a wait, with `--wait`).
@@ -46,7 +46,7 @@ enum Command {
     },
     /// Compute and store the reference of a test bed.
     Reference(ReferenceArgs),
-    /// Merge the folders of `run --shard i/n` into the files a single run writes (SPEC §12).
+    /// Merge the folders of `run --shard i/n` into the files a single run writes.
     Merge {
         /// Shard folders (`<results>/<experiment>/shard-<i>-of-<n>`), or the experiment's results
         /// folder holding them.

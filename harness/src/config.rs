@@ -1,5 +1,5 @@
-//! Sweeps and the config files that describe or override them (SPEC §9: "a TOML or JSON config
-//! file describes custom sweeps").
+//! Sweeps and the config files that describe or override them (a TOML or JSON config file
+//! describes a custom sweep; book: config.md).
 //!
 //! ```toml
 //! name = "my-sweep"            # required when no experiment is named on the command line

@@ -3,7 +3,7 @@
 //! every built-in estimator), so a new plug-in is covered without new test code:
 //!
 //! 1. **builds** with its default parameters;
-//! 2. **finite output on the SPEC §10 stability cases** it runs on (the `Stability` cases the test
+//! 2. **finite output on the stability cases** (book: stability.md) it runs on (the `Stability` cases the test
 //!    beds declare, [`estimators::registry::BedCase`]: albedo 1 and 0, optical depth 1e4 and 0,
 //!    rays missing the medium, Phong n = 10000, an environment of dynamic range 1e6, mostly
 //!    occluded lights): every estimate finite or a clean one-line

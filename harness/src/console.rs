@@ -1,4 +1,4 @@
-//! The console summary of a finished run (SPEC §9: the run prints a summary table): fits with
+//! The console summary of a finished run (every run prints a summary table): fits with
 //! their unbiasedness verdicts, the paper's claims beside ours, and what was skipped.
 
 use crate::report::{markdown_table, sig};

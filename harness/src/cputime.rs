@@ -1,4 +1,4 @@
-//! The calling thread's CPU time (SPEC §5: time-based metrics use CPU seconds, which machine load
+//! The calling thread's CPU time (time-based metrics use CPU seconds, which machine load
 //! from other processes does not inflate the way it inflates wall-clock time).
 
 /// Seconds of CPU the calling thread has used (`CLOCK_THREAD_CPUTIME_ID`); 0 where the clock is

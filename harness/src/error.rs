@@ -1,5 +1,5 @@
-//! Harness errors and the one exit-code table every subcommand uses (SPEC §9 names 0, 1 and 2;
-//! 3 extends it).
+//! Harness errors and the one exit-code table every subcommand uses (0 success, 1 internal
+//! failure, 2 bad input, 3 busy; book: contract.md).
 //!
 //! | code | meaning | examples |
 //! |---|---|---|

@@ -1,4 +1,4 @@
-//! Result and plot folders as a whole (SPEC §8): output paths checked before a run starts, one
+//! Result and plot folders as a whole (book: outputs.md): output paths checked before a run starts, one
 //! writer per folder at a time (a lock, [`FolderLock`], whose file is there only while it is
 //! held), stale temporary files of killed writers removed, and a folder-level commit so that a
 //! reader never mixes the files of two runs.

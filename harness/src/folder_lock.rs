@@ -1,4 +1,4 @@
-//! The lock of a folder (SPEC §8): one writer at a time, or any number of readers, through an
+//! The lock of a folder (book: outputs.md): one writer at a time, or any number of readers, through an
 //! advisory `flock` on `<dir>/.lock`, a file that exists only while someone holds it.
 //!
 //! The file is removed on release (unlink, then close), so a finished folder holds no lock file.

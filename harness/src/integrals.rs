@@ -1,4 +1,4 @@
-//! `integrals.csv` (SPEC §8): per integral and channel at the largest budget, the reference, the
+//! `integrals.csv` (book: outputs.md): per integral and channel at the largest budget, the reference, the
 //! mean and standard error of the estimates and the test bed's geometry. It is most of a results
 //! folder's bytes (one row per integral, channel and estimator), so it is written gzip-compressed
 //! by default, as `integrals.csv.gz` (`zcat` reads it; pandas' and polars' `read_csv` read it as
@@ -12,7 +12,7 @@ use flate2::write::GzEncoder;
 use std::io::{Read, Write};
 use std::path::Path;
 
-/// The plain file name (SPEC §8).
+/// The plain file name (book: outputs.md).
 pub const CSV: &str = "integrals.csv";
 /// The gzip-compressed file name (the default).
 pub const GZ: &str = "integrals.csv.gz";
@@ -40,7 +40,7 @@ impl IntegralsFormat {
     }
 }
 
-/// One row of `integrals.csv` (SPEC §8) with the test bed's geometry columns appended.
+/// One row of `integrals.csv` (book: outputs.md) with the test bed's geometry columns appended.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IntegralRow {
     /// Test bed id.
@@ -71,7 +71,7 @@ pub struct IntegralRow {
     pub estimator_id: String,
 }
 
-/// The SPEC §8 columns, in their order; the geometry columns and `estimator_id` follow.
+/// The contract's columns (book: contract.md), in their order; the geometry columns and `estimator_id` follow.
 pub const COLUMNS: [&str; 11] = [
     "testbed",
     "variant",
@@ -106,7 +106,7 @@ fn integral_major(rows: &[IntegralRow]) -> Vec<&IntegralRow> {
     order.into_iter().map(|(_, _, _, i)| &rows[i]).collect()
 }
 
-/// The CSV text: the SPEC §8 columns, the geometry columns (the union over rows, empty where a
+/// The CSV text: the contract's columns, the geometry columns (the union over rows, empty where a
 /// row has none), then `estimator_id`; rows by integral and channel, the estimators of one side by
 /// side (see `integral_major`).
 pub fn csv_bytes(rows: &[IntegralRow]) -> Result<Vec<u8>> {

@@ -4,7 +4,7 @@
 //! scene whose integrals have exact or stored reference values) and get budget sweeps over
 //! repetitions run in parallel on reproducible streams, RMSE / efficiency / FoM against samples,
 //! fetches and time, convergence-slope fits with intervals, unbiasedness tests with their power,
-//! the result files of SPEC §8, log-log plots and a report, and a command line with config files,
+//! the result files of the book's contract chapter, log-log plots and a report, and a command line with config files,
 //! resume, shards and merge.
 //!
 //! Pipeline: [`config`] -> [`plan`] -> [`runner`] -> [`metrics`] / [`analysis`] -> [`output`] /

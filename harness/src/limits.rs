@@ -1,5 +1,5 @@
-//! Every bound the harness puts on a number it reads, in one place (SPEC §9: bad input is refused
-//! before anything runs). The same bounds apply on every input path: command-line flags, TOML and
+//! Every bound the harness puts on a number it reads, in one place (bad input is refused before
+//! anything runs). The same bounds apply on every input path: command-line flags, TOML and
 //! JSON config files, and the sweep stored in a shard manifest that `mcbench merge` rebuilds.
 //!
 //! | field | bound | why |

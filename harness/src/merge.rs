@@ -1,4 +1,4 @@
-//! `mcbench merge <dir>...` (SPEC §12): shard folders ([`crate::shard`]) back into the files a
+//! `mcbench merge <dir>...` (book: scale-out.md): shard folders ([`crate::shard`]) back into the files a
 //! single run writes. The shard set is checked first: one format, harness version (this binary's),
 //! experiment, seed, repetitions and config (sweep digest) throughout, every shard `1..=n` exactly
 //! once, every owned block present in its shard's block store, decodable and of the right cell.

@@ -1,4 +1,4 @@
-//! SPEC §5 metrics of one cell against its test bed's reference: RMSE (noise-corrected for
+//! The metrics of one cell (book: outputs.md) against its test bed's reference: RMSE (noise-corrected for
 //! stored references: `E[(X - R)^2] = MSE + Var R`), variance, pooled bias with its standard
 //! error, costs per estimate, efficiency and FoM. Time-based metrics (efficiency, P-Eff) use the
 //! estimating thread's CPU seconds, which load from other processes does not inflate; wall-clock
@@ -9,7 +9,7 @@ use estimators::stats::NeumaierSum;
 use estimators::testbed::Reference;
 use serde::{Deserialize, Serialize};
 
-/// One row of `summary.csv` (SPEC §8; the first 18 columns are the contract, the rest extend it).
+/// One row of `summary.csv` (the first 18 columns are the original contract, the rest extend it; book: contract.md).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SummaryRow {
     /// Test bed id.

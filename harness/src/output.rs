@@ -1,4 +1,4 @@
-//! Result files (SPEC §8, a contract): `summary.csv` and `summary.json` (`integrals.csv` is
+//! Result files (a contract, book: contract.md and outputs.md): `summary.csv` and `summary.json` (`integrals.csv` is
 //! [`crate::integrals`]'s); every write is atomic (temp file + rename) so an interrupted run never
 //! leaves a half-written file.
 
@@ -204,7 +204,7 @@ pub struct Diagnostic {
 }
 
 impl Diagnostic {
-    /// The means per estimate of a cell's diagnostics (SPEC §8 `diagnostics`).
+    /// The means per estimate of a cell's diagnostics (summary.json `diagnostics`).
     pub fn of_cell(cell: &crate::cell::CellResult) -> impl Iterator<Item = Diagnostic> + '_ {
         cell.diagnostics.iter().map(move |(name, sum)| Diagnostic {
             testbed: cell.key.testbed.clone(),
@@ -273,6 +273,10 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "free_flights",
     "target_evals",
     "cache_ops",
+    "rmse_display",
+    "fom_display",
+    "rmse_lo",
+    "rmse_hi",
 ];
 
 /// Writes `summary.json`: one value per line without indentation (a quarter smaller than

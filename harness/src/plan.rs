@@ -94,7 +94,7 @@ fn validate(bed_entry: &'static TestBedEntry, b: &PreparedBed, e: &PreparedEstim
 }
 
 impl Plan {
-    /// The summary row of a cell of this plan (SPEC §8), with the estimator's id, both parameter
+    /// The summary row of a cell of this plan (book: outputs.md), with the estimator's id, both parameter
     /// sets and the efficiency in the sweep's `renderer` cost regime.
     pub fn summary_row(&self, bi: usize, ei: usize, cell: &crate::cell::CellResult) -> crate::metrics::SummaryRow {
         let (b, e) = (&self.beds[bi], &self.estimators[ei]);

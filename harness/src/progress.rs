@@ -1,4 +1,4 @@
-//! Progress for long runs (SPEC §9): a bar with ETA when stderr is a terminal; otherwise nothing,
+//! Progress for long runs (book: cli.md): a bar with ETA when stderr is a terminal; otherwise nothing,
 //! unless `--progress` asks for plain lines (so that in a log or a pipe an error is the only line
 //! on stderr).
 

@@ -1,4 +1,4 @@
-//! The run's `report.md` (SPEC §8), a summary of at most about 100 KB: metadata and links to the
+//! The run's `report.md` (book: outputs.md), a summary of at most about 100 KB: metadata and links to the
 //! result files, the paper's claims beside ours, convergence fits, speed-ups, the tests' verdict
 //! counts with the rows that need attention, what did not run, one line per (test bed, variant),
 //! and every plot. The long tables (every test row, every claim, every cell) are CSV files in the

@@ -156,7 +156,8 @@ pub(crate) fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut
 
 /// The estimates of repetition `rep` for the sequence starting at integral `first`, exactly as a
 /// run of a sample-budget cell computes them (same stream, same tasks): for analyses that need
-/// per-repetition values the cells do not keep (`suite::unbiasedness_reps`).
+/// per-repetition values the cells do not keep (the per-seed estimates of the `calibration`
+/// experiment, [`crate::calibration`]).
 pub fn sequence_estimates(
     plan: &Plan,
     bi: usize,

@@ -1,4 +1,4 @@
-//! Scale-out (SPEC §12): `mcbench run <experiment> --shard i/n` runs a deterministic, disjoint part
+//! Scale-out (book: scale-out.md): `mcbench run <experiment> --shard i/n` runs a deterministic, disjoint part
 //! of a sweep and writes its sufficient statistics (per-integral [`Moments`] of whole repetition
 //! blocks, integer cost totals, time histograms, diagnostic sums: never averages) into
 //! `<results>/<experiment>/shard-<i>-of-<n>/`: one record per finished unit in the folder's block

@@ -9,7 +9,7 @@ default `scalar_rgb` variant needs no libLLVM). Run from the repository root:
 
 For every variant and each chosen pixel, Mitsuba renders the radiance along that pixel's centre ray
 (a 1 x 1 orthographic film whose footprint is 2e-6 wide around the pixel centre, so the film's box
-filter adds no footprint average: the stored references are pixel-centre values, SPEC 3.2), in
+filter adds no footprint average: the stored references are pixel-centre values, as the test bed defines them), in
 `--passes` independent passes whose spread gives its standard error. Printed per pixel and channel:
 z = (mitsuba - reference) / sqrt(se_m^2 + se_ref^2); per variant: the mean z, max |z| and the
 chi-square over the pixels and channels (the channels of one pixel share paths, so they are
@@ -28,7 +28,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mitsuba_gradient_box import envmap_bitmap  # noqa: E402
 
-# SPEC 3.2 variants: sigma_t, albedo, phase (None = isotropic, else HG g), resolution.
+# The gradient-box variants (docs/src/testbeds.md): sigma_t, albedo, phase (None = isotropic, else HG g), resolution.
 # `thick` (sigma_t = 1e4) is not in the default list: its mean free path 1e-4 is about Mitsuba's
 # single-precision ray epsilon (~9e-5; the pip wheels have no double-precision variant), and
 # Mitsuba renders about 0.10 there (0.20 with the scene enlarged 1000x) where the references,

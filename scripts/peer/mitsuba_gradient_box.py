@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Peer comparison: Mitsuba 3's `volpath` on mcbench's `gradient-box` (SPEC 3.2).
+"""Peer comparison: Mitsuba 3's `volpath` on mcbench's `gradient-box` (docs/src/testbeds.md).
 
 Not built or run by cargo. Setup (outside the repository):
     python3 -m venv /work/venv-mitsuba && /work/venv-mitsuba/bin/pip install mitsuba
@@ -13,11 +13,11 @@ the machine is shared, so the second is the fairer one under load), after a warm
 compiles the LLVM kernels, and the
 image mean per channel with its standard error over the passes, as one JSON line.
 
-The scene, as SPEC 3.2 defines it:
+The scene, as the test bed defines it (docs/src/testbeds.md):
 - cube [-0.5, 0.5]^3 (Mitsuba `cube` scaled by 0.5) with a `null` BSDF (index-matched boundary)
   and a `homogeneous` interior medium: sigma_t = 2, albedo a (grey), isotropic phase;
 - orthographic camera looking along +y from y = -1, covering x, z in [-0.5, 0.5], 16 x 16 pixels;
-- background L_b(w) = max(0, c0 + c1 w_z + c2 w_x) per channel (SPEC 3.1 coefficients) over the
+- background L_b(w) = max(0, c0 + c1 w_z + c2 w_x) per channel (gradient-plane's coefficients) over the
   whole sphere, w the direction of travel of the ray leaving the scene.
 Differences from mcbench (stated in docs/src/performance.md):
 - Mitsuba has no analytic-gradient emitter: the background is a lat-long `envmap` tabulated at
@@ -43,7 +43,7 @@ C2 = np.array([0.5, 0.0, -0.4])
 
 
 def background(wx, wy, wz):
-    """SPEC 3.1/3.2 gradient, clamped at 0 per channel; arrays of direction components."""
+    """The gradient background, clamped at 0 per channel; arrays of direction components."""
     return np.maximum(0.0, C0 + C1 * wz[..., None] + C2 * wx[..., None])
 
 

@@ -9,7 +9,7 @@ OUT="${OUT:-/tmp/mcbench-perf}"
 EXPERIMENTS="surface-smc media-smc transmittance particle-sweep pmc-hi pmc-ip envmap-smc single-scatter canonical-sweep"
 mkdir -p "$OUT"
 
-# Strips the timing columns (SPEC 8: seconds, efficiency, seconds_median, efficiency_mse, p_eff)
+# Strips the timing columns (docs/src/outputs.md: seconds, efficiency, seconds_median, efficiency_mse, p_eff)
 # from summary.csv so two runs can be compared byte for byte.
 strip_timing() {
   python3 - "$1" <<'PY'

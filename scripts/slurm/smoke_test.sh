@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Slurm smoke test of the scale-out route (SPEC §12), as root on a Debian machine:
+# Slurm smoke test of the scale-out route (book: scale-out.md), as root on a Debian machine:
 #   1. installs slurm-wlm and munge from Debian's packages when they are missing;
 #   2. starts a private one-node cluster on loopback (own munge key and socket, own slurm.conf,
 #      free ports, state in a temp folder; nothing under /etc is changed);

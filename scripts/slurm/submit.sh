@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Submits an mcbench sweep to Slurm as N shards (one job-array task each) and a merge job that
-# depends on all of them (afterok). SPEC §12; see docs/src/scale-out.md.
+# depends on all of them (afterok). See docs/src/scale-out.md.
 #
 #   scripts/slurm/submit.sh N NAME [mcbench run arguments...]
 #

@@ -1,4 +1,4 @@
-//! The sampler of the cache PDF over cells (paper 001 §4.2; SPEC §4.1 `is1`): a cell is drawn with
+//! The sampler of the cache PDF over cells (paper 001 §4.2; `is1`): a cell is drawn with
 //! probability proportional to its quantised PDF coefficient `q = floor(coefficient * scale) + 1`
 //! (0 for a zero coefficient), by inversion of the cumulative sums in cell order.
 //!

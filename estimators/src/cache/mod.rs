@@ -1,4 +1,4 @@
-//! Adaptive directional radiance caches (SPEC §4.1; paper 001 §4, paper 000 §4).
+//! Adaptive directional radiance caches (paper 001 §4, paper 000 §4; book: testbeds.md).
 //!
 //! One cache type, [`RadianceCache`], parameterised by its [`Domain`] (the hemisphere of a surface
 //! point now, the sphere of a medium point later) and by its cell [`Scalar`] (`f64` or `f32`):

@@ -118,7 +118,7 @@ mod tests {
     use crate::stats::chi_square_gof;
 
     /// Chi-square of the tree sampler against its reported probabilities, on a non-power-of-two
-    /// tree with weights spanning ten orders of magnitude and some zeros (SPEC §6).
+    /// tree with weights spanning ten orders of magnitude and some zeros (book: statistics.md).
     #[test]
     fn chi_square_partial_sum_tree_sampler() {
         let weights: Vec<u64> =

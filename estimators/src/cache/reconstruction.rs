@@ -141,7 +141,7 @@ mod tests {
         grid
     }
 
-    /// SPEC: `G` in closed form equals the numerically integrated `g` to 1e-12, for cv1 and cv2, on
+    /// `G` in closed form equals the numerically integrated `g` to 1e-12, for cv1 and cv2, on
     /// both domains, at several resolutions and in both storage precisions.
     #[test]
     fn closed_form_integral_matches_quadrature_of_g() {

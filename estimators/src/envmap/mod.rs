@@ -1,4 +1,4 @@
-//! Lat-long environment maps (SPEC §3.7, paper 004): a piecewise-constant table of texels
+//! Lat-long environment maps (paper 004; book: testbeds.md): a piecewise-constant table of texels
 //! tabulated from an analytic HDR [`sky::Sky`] (or [`moving_sky::MovingSky`]), its importance
 //! sampler ([`sampling::PiecewiseConstant2D`]), and one frame of a dynamic sequence ([`EnvFrame`]:
 //! a map rotated about +z and scaled).
@@ -99,7 +99,7 @@ impl LatLong {
     /// `cos(theta)` at the upper edge of row `i` (row `height` is the nadir edge).
     pub fn cos_edge(&self, i: usize) -> f64 {
         if 2 * i == self.height {
-            return 0.0; // the equator exactly (the visibility boundary of SPEC §3.7)
+            return 0.0; // the equator exactly (the visibility boundary: the ground plane z = -1)
         }
         (i as f64 * PI / self.height as f64).cos()
     }

@@ -17,7 +17,7 @@
 //!   `1 / sqrt(k)` of 1.0 to 1.6 degrees are about one texel of the default 256x128 map (1.4
 //!   degrees), the narrowest it resolves: Grace Cathedral's lamps and the sun are smaller still.
 //!   The key lobe's peak is the `sun` parameter (1e3 by default: with the ground at 0.02 the
-//!   tabulated map spans a dynamic range of 4e4, above SPEC §3.7's 1e4 and below Grace
+//!   tabulated map spans a dynamic range of 4e4, above the test bed's 1e4 and below Grace
 //!   Cathedral's of about 2e5); the other four have peaks of 100 to 300. A lobe's power is about `2 pi peak / k`:
 //!   0.4 to 0.8 of the whole background's (about 1.2) for each of the four, 2.6 times it for the
 //!   key lobe, so the lobes hold about 80% of the map's energy, as the windows and lamps do.

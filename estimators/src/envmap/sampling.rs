@@ -1,4 +1,4 @@
-//! Environment-map importance sampling by a 2D piecewise-constant CDF (SPEC §3.7, paper 004 §3
+//! Environment-map importance sampling by a 2D piecewise-constant CDF (paper 004 §3
 //! "independent proposal moves from the EM"): a marginal CDF over rows and a conditional CDF over
 //! the columns of each row. Texel mass is `value * solid angle`, the solid angle of row `i` being
 //! `(cos theta_i - cos theta_{i+1}) 2 pi / W` (the `sin theta` weighting), and a direction is

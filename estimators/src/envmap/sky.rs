@@ -1,4 +1,4 @@
-//! The analytic HDR sky of SPEC §3.7: a gradient (horizon to zenith, dim ground) plus one strong
+//! The analytic HDR sky of `envmap-sequence`: a gradient (horizon to zenith, dim ground) plus one strong
 //! sun lobe and two dim lobes, `peak * colour * exp(k (w . d - 1))` each. With the default sun
 //! peak of 1e3 the tabulated 256x128 map spans a dynamic range above 1e4; `sun = 1e5` gives 1e6.
 

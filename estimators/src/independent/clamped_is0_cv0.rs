@@ -1,6 +1,6 @@
 //! `clamped_is0_cv0`: a deliberately biased control. Uniform hemisphere sampling with every
 //! sample's contribution `f / p` clamped per channel at `clamp` (a "firefly clamp"). Its only
-//! purpose is to prove that the unbiasedness test can fail (SPEC §6 "Teeth").
+//! purpose is to prove that the unbiasedness test can fail: every run of the suite must flag it.
 
 use crate::error::{ConfigError, EstimateError};
 use crate::estimator::{Bias, Estimator};

@@ -1,9 +1,9 @@
 //! The extinction fields of paper 002 §4: the analytic medium of Eq. 21 and a 12-octave fractional
-//! Brownian motion of Perlin's improved gradient noise (SPEC §3.3-3.4).
+//! Brownian motion of Perlin's improved gradient noise (book: testbeds.md).
 
 use crate::math::Vec3;
 
-/// Paper 002 Eq. 21, the one place this formula lives (SPEC §3.3 reading, maximum 1):
+/// Paper 002 Eq. 21, the one place this formula lives (the exponent k is a parameter; maximum 1):
 /// `sigma_t = ((cos(1.5 (x + y + z)) + 1) / 2) * ((sin(z / 2) + 2) / 3)` inside the sphere.
 pub fn eq21(p: Vec3) -> f64 {
     ((1.5 * (p.x + p.y + p.z)).cos() + 1.0) / 2.0 * (((p.z / 2.0).sin() + 2.0) / 3.0)
@@ -99,7 +99,7 @@ pub fn improved_noise(x: f64, y: f64, z: f64) -> f64 {
     )
 }
 
-/// The Perlin medium's constants (SPEC §3.4): `sigma_t = clamp(BIAS + GAIN_K * fbm(FREQ p), 0, 1)`
+/// The Perlin medium's constants (book: testbeds.md): `sigma_t = clamp(BIAS + GAIN_K * fbm(FREQ p), 0, 1)`
 /// with `fbm(q) = sum_{o < OCTAVES} 0.5^o noise(2^o q + o * OFFSET)` (lacunarity 2, gain 0.5; the
 /// per-octave offset keeps octaves from sharing the lattice's zeros at the origin).
 pub mod perlin_constants {

@@ -1,6 +1,7 @@
-//! The environment lighting of the media test beds (SPEC §3.3): the §3.1 gradient over the whole
-//! sphere (clamped at zero per channel, as SPEC §3.2 does for directions below the horizon) plus
-//! a white HDR sun lobe `200 exp(100 (w . s - 1))`, `s = normalize(1, 1, 2)`.
+//! The environment lighting of the media test beds (book: testbeds.md): the `gradient-plane`
+//! gradient over the whole sphere (clamped at zero per channel, as `gradient-box` does for
+//! directions below the horizon) plus a white HDR sun lobe `200 exp(100 (w . s - 1))`,
+//! `s = normalize(1, 1, 2)`.
 
 use crate::lighting::Gradient;
 use crate::math::{Rgb, Vec3};

@@ -1,4 +1,4 @@
-//! The stored `multiple` references of `eq21-medium` and `perlin-medium` (SPEC §3.3-3.4), made by
+//! The stored `multiple` references of `eq21-medium` and `perlin-medium` (book: testbeds.md), made by
 //! an integrator that shares no code with any tracking estimator (delta, ratio, residual ratio
 //! tracking, the particle models, ray marching): those estimators are judged against these values.
 //!
@@ -163,7 +163,7 @@ impl OpticalDepth {
     }
 }
 
-/// Rayleigh `3 (1 + cos^2) / (16 pi)`, the media's phase function (SPEC §3.3).
+/// Rayleigh `3 (1 + cos^2) / (16 pi)`, the media's phase function (book: testbeds.md).
 pub fn rayleigh(cos: f64) -> f64 {
     3.0 * (1.0 + cos * cos) / (16.0 * PI)
 }

@@ -1,8 +1,8 @@
-//! Participating-media test beds of paper 002 (SPEC §3.3-3.4): `eq21-medium` and `perlin-medium`.
+//! Participating-media test beds of paper 002 (book: testbeds.md): `eq21-medium` and `perlin-medium`.
 //!
 //! Both are a sphere of radius 10 centred at (0, 0, 10) with Rayleigh scattering under the
 //! environment of [`environment`]. Variants:
-//! - `central-ray` (SPEC §3.3 camera a): the ray along +z from the origin; integral `k` is
+//! - `central-ray` (camera a): the ray along +z from the origin; integral `k` is
 //!   `T(s_k)` on the grid `s_k = 20 k / K`, `k = 1..K` (`K` = parameter `points`, default 40), one
 //!   channel replicated to RGB, so the harness's per-integral tests and `integrals.csv` (column
 //!   `s`) apply unchanged;
@@ -11,14 +11,14 @@
 //! - `multiple`: the same camera, pixel = radiance with multiple scattering (paper Fig. 6-7),
 //!   stored long-run reference made by `mcbench reference <id> --variant multiple` with an
 //!   integrator that shares no code with the tracking estimators ([`independent_reference`]);
-//! - `single-scatter`: the same camera, pixel = radiance scattered once from the point light of
-//!   SPEC §3.3 (paper 002 §4.3, Eq. 22 without the background term, Fig. 12), reference by nested
+//! - `single-scatter`: the same camera, pixel = radiance scattered once from the point light
+//!   (paper 002 §4.3, Eq. 22 without the background term, Fig. 12), reference by nested
 //!   adaptive quadrature ([`scatter_reference`]).
 //!
 //! Parameters: `resolution` (image side), `points` (central-ray grid), `scale` (multiplies the
-//! extinction and the declared majorant; SPEC §10 optical depth 1e4), `albedo` (default 0.7 / 0.9),
-//! and for `single-scatter` the light: `light_x`, `light_y`, `light_z` (default the sphere's centre
-//! (0, 0, 10)) and `intensity` (default 100, power 400 pi).
+//! extinction and the declared majorant; the stability case of optical depth 1e4), `albedo`
+//! (default 0.7 / 0.9), and for `single-scatter` the light: `light_x`, `light_y`, `light_z`
+//! (default the sphere's centre (0, 0, 10)) and `intensity` (default 100, power 400 pi).
 
 pub mod density;
 pub mod environment;
@@ -43,7 +43,7 @@ pub const CENTRE: Vec3 = Vec3::new(0.0, 0.0, 10.0);
 pub const RADIUS: f64 = 10.0;
 /// The variants of both media.
 pub const VARIANTS: &[&str] = &["central-ray", "transmittance", "multiple", "single-scatter"];
-/// The point light of SPEC §3.3: intensity 100 (power 400 pi) at the sphere's centre.
+/// The point light of the media test beds: intensity 100 (power 400 pi) at the sphere's centre.
 pub const LIGHT: PointLight = PointLight { position: CENTRE, intensity: 100.0 };
 /// Closest a pixel ray may pass the light: the single-scattered radiance grows like `1 / D`.
 pub const MIN_LIGHT_DISTANCE: f64 = 1e-9;
@@ -370,7 +370,7 @@ impl MediumScene for MediumBed {
     fn albedo(&self) -> f64 {
         self.albedo
     }
-    /// Both media scatter with the Rayleigh phase function (SPEC §3.3-3.4).
+    /// Both media scatter with the Rayleigh phase function (book: testbeds.md).
     fn phase(&self) -> crate::phase::Phase {
         crate::phase::Phase::Rayleigh
     }

@@ -1,4 +1,4 @@
-//! The parameters of `eq21-medium` and `perlin-medium` (SPEC §3.3-3.4).
+//! The parameters of `eq21-medium` and `perlin-medium` (book: testbeds.md).
 
 use super::{Field, LIGHT};
 use crate::error::ConfigError;
@@ -92,7 +92,7 @@ impl MediumParams {
         Ok(())
     }
 
-    /// The point light (SPEC §3.3 defaults).
+    /// The point light (defaults: intensity 100 at the sphere's centre).
     pub fn light(&self, field: Field) -> Result<PointLight, ConfigError> {
         let p = LIGHT.position;
         let position = Vec3::new(self.light_x.unwrap_or(p.x), self.light_y.unwrap_or(p.y), self.light_z.unwrap_or(p.z));

@@ -1,4 +1,4 @@
-//! References of the media test beds (SPEC §3.3-3.4):
+//! References of the media test beds (book: testbeds.md):
 //! - transmittance: optical depth by adaptive Gauss-Kronrod along the ray, absolute tolerance 1e-13
 //!   on the optical depth, so `T = exp(-tau)` has relative error <= 1e-12 (test below). Eq. 21: one
 //!   initial panel per unit. Perlin, along axis-aligned rays (every transmittance ray of the test
@@ -58,7 +58,7 @@ pub fn optical_depth_with(
     Quadrature { value: q.value[0], error: q.error[0], evaluations: q.evaluations }
 }
 
-/// The Perlin extinction before its clamp to [0, 1] (SPEC §3.4).
+/// The Perlin extinction before its clamp to [0, 1] (book: testbeds.md).
 fn perlin_unclamped(p: Vec3) -> f64 {
     use density::perlin_constants::{BIAS, GAIN_K, OCTAVES};
     BIAS + GAIN_K * density::fbm(p, OCTAVES)

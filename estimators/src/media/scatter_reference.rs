@@ -1,4 +1,4 @@
-//! Exact reference of the `single-scatter` variant (paper 002 §4.3 Eq. 22, SPEC §3.3): the
+//! Exact reference of the `single-scatter` variant (paper 002 §4.3 Eq. 22, book: testbeds.md): the
 //! radiance a pixel ray receives from the point light by one scattering event,
 //!
 //! `L = int_{t0}^{t1} T(t) a sigma_t(p(t)) rho(cos) I T_l(p(t)) / (D^2 + (t - t_l)^2) dt`,
@@ -31,7 +31,7 @@ use crate::quadrature::gauss_kronrod_multi;
 use crate::references::ReferenceSource;
 use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Reference, ReferenceKind, TestBed};
 
-/// Default image side of `eq21-medium/single-scatter` (SPEC §3.3 camera b, full resolution).
+/// Default image side of `eq21-medium/single-scatter` (camera b, full resolution).
 pub const EQ21_RESOLUTION: usize = 32;
 /// Default image side of `perlin-medium/single-scatter` (reduced from 32: see the module doc).
 pub const PERLIN_RESOLUTION: usize = 4;

@@ -1,4 +1,4 @@
-//! The single-scatter reference against an independent brute force (SPEC §3.3: the error bound
+//! The single-scatter reference against an independent brute force (the error bound
 //! is shown, not assumed).
 
 use super::*;

@@ -98,7 +98,7 @@ mod tests {
         for (ci, (model, samp, est)) in cases.iter().enumerate() {
             let pred = predicted(sigma, *model, *samp, &grid);
             // The first two grid points (s = 5, 10): the relative variance at s = 20 and
-            // sigma_samp = 0.4 is ~1e4 (SPEC §4.2), where a sample variance has no power.
+            // sigma_samp = 0.4 is ~1e4 (book: paper-002.md), where a sample variance has no power.
             for k in 0..2 {
                 let mut rng = stream(ci as u64 * 10 + k as u64, "eq16");
                 let (mut m, mut m4) = (Moments::default(), 0.0);

@@ -1,10 +1,10 @@
-//! Sequential Monte Carlo adaptation in participating media (paper 000 §4, SPEC §4.1 "Media"):
+//! Sequential Monte Carlo adaptation in participating media (paper 000 §4; book: testbeds.md):
 //! the 5D [`octree::Octree`] of spherical radiance caches drives the unbiased estimator of Eq. 7
 //! at every scattering vertex ([`walk::smc_path`]): `L_i = G + (f - g) / p` with `f = L Phi`,
 //! `g` the cached radiance times the isotropic phase `1 / 4 pi` and `G` its integral (§4.5),
 //! read from the snapshot before the vertex's record is added.
 //!
-//! The ids are the surface ids (SPEC §7 "same ids"): `is0_cv0`, `is0_cv1`, `is0_cv2`, `is1_cv0`,
+//! The ids are the surface ids (book: paper-000.md): `is0_cv0`, `is0_cv1`, `is0_cv2`, `is1_cv0`,
 //! `is1_cv1`, `is1_cv2` each serve both scene views through [`SurfaceOrMedium`], choosing by what
 //! the test bed provides (a hemisphere: paper 001's per-pixel cache; a medium: this module).
 //! `is0_cv0` on a medium is the independent path tracer with phase-function sampling (the papers'
@@ -172,7 +172,7 @@ impl Estimator for PathTracer {
     }
 }
 
-/// One id serving both scene views (SPEC §7 "same ids"): the surface estimator on test beds with
+/// One id serving both scene views (media and surfaces share the ids): the surface estimator on test beds with
 /// hemispherical integrals, the medium one on test beds with a medium.
 pub struct SurfaceOrMedium {
     /// Used when the test bed has a surface view.

@@ -170,7 +170,7 @@ fn unbiased_against_stored_references_and_ray_marching_flagged() {
     }
 }
 
-/// SPEC §10: the optically thick box (sigma_t = 1e4, albedo 0.8) gives finite values that agree
+/// Stability: the optically thick box (sigma_t = 1e4, albedo 0.8) gives finite values that agree
 /// with its stored reference; albedo 1 and 0 and the furnace are covered above.
 #[test]
 fn optically_thick_box_is_finite_and_agrees_with_its_reference() {

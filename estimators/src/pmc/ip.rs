@@ -38,7 +38,7 @@
 //! - `luminance_scale`: cd/m^2 per unit of radiance as the kernel's `tvi` sees it (§4.2 reads
 //!   luminance in cd/m^2, Ferwerda et al. 1996, and the paper does not give its scene units):
 //!   `L_p` and `sigma_p` are multiplied by it before weighting. The default 1 reads radiance as
-//!   cd/m^2, as the harness's `Err` does (SPEC §5).
+//!   cd/m^2, as the harness's `Err` does (book: outputs.md).
 //!
 //! Each estimate notes `alpha_perplexity` (normalised perplexity `exp(H(alpha)) / P` of the
 //! kernel weights, 1 = uniform, mean over iterations) and `ht_share` (share of pixel-iterations

@@ -1,4 +1,4 @@
-//! Stability of the paper 003 hemispherical estimators (SPEC §10) at chosen
+//! Stability of the paper 003 hemispherical estimators (book: stability.md) at chosen
 //! shading points of the checker geometry, with exact quadrature references
 //! ([`crate::testbeds::checker_reference::direct_lighting`]): a light 1e6 times brighter than the
 //! other, fully shadowed points, `n = 5000` lobes reflecting either light, and points whose

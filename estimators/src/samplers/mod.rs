@@ -1,7 +1,7 @@
 //! Direction samplers with the densities they report (per unit solid angle).
 //!
 //! Every sampler here (and the Phong BRDF mixture and the phase functions) is registered in
-//! [`registry::SAMPLERS`] with its chi-square goodness-of-fit checks (SPEC §6), built on
+//! [`registry::SAMPLERS`] with its chi-square goodness-of-fit checks (book: conformance.md), built on
 //! [`testing::sampler_chi_square`] / [`testing::interval_chi_square`]; a unit test runs them all and
 //! checks that every module of this folder is registered, and the conformance suite runs the
 //! checks of the samplers each estimator names.

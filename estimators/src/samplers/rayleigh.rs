@@ -1,4 +1,4 @@
-//! Rayleigh phase function `3/(16 pi) (1 + cos^2 theta)` (SPEC §3.3), sampled exactly by inverting
+//! Rayleigh phase function `3/(16 pi) (1 + cos^2 theta)` (book: testbeds.md), sampled exactly by inverting
 //! its cosine CDF `F(mu) = 1/2 + 3/8 (mu + mu^3 / 3)` with Cardano's formula.
 
 use crate::math::{Frame, Vec3};

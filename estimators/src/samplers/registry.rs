@@ -1,10 +1,10 @@
-//! The registry of samplers and their chi-square goodness-of-fit checks (SPEC §6):
+//! The registry of samplers and their chi-square goodness-of-fit checks (book: conformance.md):
 //! one entry per sampler module (the direction and distance samplers of this folder, the Phong
 //! BRDF mixture and the phase functions), each check drawing with a fixed seed and binning against
 //! the sampler's reported density with the helpers of [`super::testing`].
 //!
 //! The checks are the samplers' chi-square tests: `tests::every_registered_sampler_fits` runs
-//! them beside the code, and the conformance suite (`experiments::conformance`) runs the checks of
+//! them beside the code, and the conformance suite (`mcbench::conformance`) runs the checks of
 //! the samplers each estimator names. A check is deterministic, so running it twice is the same
 //! test: the Sidak family of [`super::testing::SAMPLER_TESTS`] counts each statistic once.
 

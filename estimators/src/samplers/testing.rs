@@ -1,4 +1,4 @@
-//! Chi-square goodness-of-fit support for direction samplers (SPEC §6): bin samples on a grid of
+//! Chi-square goodness-of-fit support for direction samplers (book: conformance.md): bin samples on a grid of
 //! cells in `(cos(theta), phi)` and compare with the cell probabilities obtained by integrating the
 //! sampler's reported pdf with product Gauss-Legendre quadrature.
 //!

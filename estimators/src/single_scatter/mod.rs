@@ -1,5 +1,5 @@
-//! Single scattering of a point light in a heterogeneous medium (paper 002 §4.3, Eq. 22, Fig. 12;
-//! SPEC §4.2): the radiance a pixel ray receives from the light by one scattering event,
+//! Single scattering of a point light in a heterogeneous medium (paper 002 §4.3, Eq. 22, Fig. 12):
+//! the radiance a pixel ray receives from the light by one scattering event,
 //!
 //! `L = int_{t0}^{t1} T(t) a sigma_t(t) rho(cos) I T_l(t) / r(t)^2 dt`, `r^2 = D^2 + (t - t_l)^2`,
 //!
@@ -180,7 +180,7 @@ impl ShadowRays {
 }
 
 /// One id serving point-light single-scatter integrals with `single_scatter` and every other test
-/// bed with `other` (SPEC §4.2 names `ray_marching`, `delta_tracking` and `mis` for single
+/// bed with `other` (paper 002 names `ray_marching`, `delta_tracking` and `mis` for single
 /// scattering too, and one id is one registry entry).
 pub struct SingleScatterOr {
     /// Used on single-scatter integrals.

@@ -1,4 +1,4 @@
-//! Unbiasedness (SPEC §6), stability (SPEC §10), refusals and costs of the single-scatter
+//! Unbiasedness (book: statistics.md), stability (book: stability.md), refusals and costs of the single-scatter
 //! estimators, on `eq21-medium/single-scatter` (exact references by nested quadrature).
 
 use crate::budget::{Budget, BudgetKind};
@@ -107,7 +107,7 @@ fn unbiased_ids_pass_on_the_perlin_medium() {
     }
 }
 
-/// SPEC §10 stability: the light on the sphere's boundary, inside the densest region (sigma_t = 1
+/// Stability: the light on the sphere's boundary, inside the densest region (sigma_t = 1
 /// at z = pi, x + y + z = 4 pi / 3) and 1e-4 from a pixel ray: every id returns finite values,
 /// and the source-driven and MIS estimators (whose density follows the 1 / r^2 peak) still agree
 /// with the reference at the pixel nearest the light.

@@ -1,8 +1,9 @@
-//! `bidirectional_is_sn`: a deliberately biased control for the paper 004 tests (SPEC §6
-//! "Teeth"). `L_ns` from one set of M candidates times the plain average of `(p~_c / p~) V` over
-//! N points resampled from a second, independent set of M candidates: the resampled points follow
-//! the product only as M grows (self-normalised importance resampling), so at the default M = 4
-//! the expectation is off by O(1/M). Consistent, not unbiased; the harness must flag it.
+//! `bidirectional_is_sn`: a deliberately biased control for the paper 004 tests (every
+//! unbiasedness test must flag a known biased control). `L_ns` from one set of M candidates times
+//! the plain average of `(p~_c / p~) V` over N points resampled from a second, independent set of
+//! M candidates: the resampled points follow the product only as M grows (self-normalised
+//! importance resampling), so at the default M = 4 the expectation is off by O(1/M). Consistent,
+//! not unbiased; the harness must flag it.
 
 use super::params::BidirectionalSnParams;
 use super::resampling::{normalise_log_weights, resample, Scheme};

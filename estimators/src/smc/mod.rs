@@ -1,5 +1,5 @@
 //! Paper 004 (Ghosh, Doucet and Heidrich 2006): sequential Monte Carlo sampling of the product of
-//! a dynamic environment map and the BRDF (SPEC §4.4).
+//! a dynamic environment map and the BRDF (book: testbeds.md).
 //!
 //! - [`resampling`]: multinomial, residual, stratified and systematic resampling; ESS in log space;
 //! - [`mh`]: the Metropolis-Hastings mixture kernel of Eq. 6-8;

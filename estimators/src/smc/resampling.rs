@@ -1,6 +1,6 @@
-//! Resampling schemes and the effective sample size in log space (paper 004 §3 Step 1a;
-//! SPEC §4.4): multinomial, residual, stratified and systematic resampling, each giving offspring
-//! counts with `E[count_i] = N W_i` (tested beside the code).
+//! Resampling schemes and the effective sample size in log space (paper 004 §3 Step 1a):
+//! multinomial, residual, stratified and systematic resampling, each giving offspring counts
+//! with `E[count_i] = N W_i` (tested beside the code).
 
 use rand::Rng;
 
@@ -37,7 +37,7 @@ pub fn normalise_log_weights(log_w: &[f64]) -> Option<(Vec<f64>, f64)> {
     }
     // Relative to the largest weight: `l - max` is exact (Sterbenz) for weights within a factor 2
     // in log value, so weights of log size -1e4 normalise to full precision instead of losing
-    // |l| eps to the rounding of `lse` (SPEC §10, `stability` case smc-log-weights-underflow).
+    // |l| eps to the rounding of `lse` (the `stability` case smc-log-weights-underflow).
     let sum: f64 = log_w.iter().map(|l| (l - max).exp()).sum();
     let ln_sum = sum.ln();
     Some((log_w.iter().map(|l| ((l - max) - ln_sum).exp()).collect(), max + ln_sum))

@@ -1,5 +1,5 @@
-//! Unbiasedness of the paper 004 estimators against the exact reference at a small size (SPEC
-//! §6: per-integral one-sample t-tests, Holm-Bonferroni at family-wise alpha 1e-3), with the
+//! Unbiasedness of the paper 004 estimators against the exact reference at a small size
+//! (per-integral one-sample t-tests, Holm-Bonferroni at family-wise alpha 1e-3), with the
 //! biased control flagged; and the all-weights-zero fallback.
 
 use crate::brdf::Phong;
@@ -168,7 +168,7 @@ fn every_incremental_weight_zero_falls_back_without_nan() {
     }
 }
 
-/// SPEC §10 stability: sun dynamic range above 1e6 and 30 degree rotations per frame;
+/// Stability: sun dynamic range above 1e6 and 30 degree rotations per frame;
 /// every estimator returns finite estimates, and the unbiased ones stay unbiased.
 #[test]
 fn stable_under_a_1e6_sun_and_30_degree_rotations() {

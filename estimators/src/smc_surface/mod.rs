@@ -1,4 +1,4 @@
-//! Sequential Monte Carlo adaptation on surfaces (paper 001 §4, SPEC §4.1 "Surface"): one adaptive
+//! Sequential Monte Carlo adaptation on surfaces (paper 001 §4; book: testbeds.md): one adaptive
 //! hemispherical [`RadianceCache`] per estimate (per pixel), started with one cell and adapted over
 //! the samples of that estimate.
 //!

@@ -1,4 +1,4 @@
-//! Unbiasedness tests of the surface SMC ids (SPEC §6) with teeth, and parameter handling.
+//! Unbiasedness tests of the surface SMC ids (book: statistics.md) with teeth, and parameter handling.
 
 use super::*;
 use crate::budget::Budget;
@@ -8,7 +8,7 @@ use crate::stats::{holm_bonferroni, one_sample_t, Moments};
 use crate::testbed::TestBed;
 use crate::testbeds::gradient_plane::GradientPlane;
 
-/// Family-wise level of the unbiasedness tests (SPEC §6).
+/// Family-wise level of the unbiasedness tests (book: statistics.md).
 const ALPHA: f64 = 1e-3;
 
 /// The outcome of one unbiasedness run: Holm-adjusted smallest p-value over pixels and channels,

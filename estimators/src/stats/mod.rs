@@ -1,4 +1,4 @@
-//! Statistics for the convergence harness (SPEC §5–6).
+//! Statistics for the convergence harness (book: statistics.md, slope-fits.md).
 //!
 //! - [`moments`]: compensated sums and exactly mergeable running mean/variance;
 //! - [`hypothesis`]: one-sample t, z and Welch tests, Holm–Bonferroni, Šidák, detectable bias;

@@ -77,7 +77,7 @@ impl FromIterator<f64> for NeumaierSum {
 /// The running mean is compensated: it is kept as an unevaluated sum `mean + mean_comp` and every
 /// update adds its increment with an error-free two-sum, so 1e8 pushes of a slowly drifting
 /// sequence stay within a few ulps of the exact mean (plain Welford drifts by 1.6e-9 relative
-/// there; SPEC §10, the `stability` experiment's `running-mean` cases measure both).
+/// there; the `stability` experiment's `running-mean` cases measure both).
 ///
 /// Updated one value at a time with Welford's algorithm ([`Moments::push`]) and combined with
 /// Chan, Golub and LeVeque's pairwise formula ([`Moments::merge`]), both numerically stable when the

@@ -1,5 +1,5 @@
 //! Least-squares line fits with a Student t confidence interval on the slope, used for
-//! convergence-order fits (log RMSE on log budget, SPEC §5).
+//! convergence-order fits (log RMSE on log budget, book: slope-fits.md).
 
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ContinuousCDF, StudentsT};

@@ -12,7 +12,7 @@
 //! `exp(-tau F(s_k))`. Parameters: `points`, `albedo` (default 0.7, as paper 002's Eq. 21 medium:
 //! it only matters to the single particle models, whose scattered particle leaves the ray) and
 //! `tau` (the optical depth of the whole segment, overriding `-ln t`: `tau = 0` is an empty
-//! medium, `tau = 1e4` the optically thick stability case of SPEC §10). The
+//! medium, `tau = 1e4` the optically thick stability case). The
 //! scene has no approximate extinction, so explorer points of control variates cost full fetches.
 
 use super::canonical_profiles::Profile;
@@ -46,7 +46,7 @@ pub const VARIANTS: &[&str] = grid!("constant", "cosine", "gaussian", "hole", "l
 /// (quick) or 65536 (full).
 const CANONICAL_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (16_384, 65_536) };
 
-/// The checks' cases: the SPEC §10 extremes (optical depth 1e4 and 0, albedo 0 and 1), a small
+/// The checks' cases: the stability extremes (optical depth 1e4 and 0, albedo 0 and 1), a small
 /// check, and every variant in the `unbiasedness` experiment.
 macro_rules! cases {
     ($($p:literal),*) => {

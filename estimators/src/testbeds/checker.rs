@@ -1,4 +1,4 @@
-//! `checker-direct` (paper 003 Fig. 6-8, Table 2; SPEC §3.5): an 8 x 8 checkerboard floor of
+//! `checker-direct` (paper 003 Fig. 6-8, Table 2; book: testbeds.md): an 8 x 8 checkerboard floor of
 //! diffuse and modified-Phong squares under two rectangular area lights, seen by a pinhole camera;
 //! one direct-lighting integral `int L_in f cos dw` per pixel (Eq. 4-5 without emission), with a
 //! quadrature reference (see [`super::checker_reference`]).

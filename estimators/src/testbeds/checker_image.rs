@@ -1,4 +1,4 @@
-//! `checker-image` (paper 003 §4.4, Table 1; SPEC §3.6): the `checker-direct` scene (each of its
+//! `checker-image` (paper 003 §4.4, Table 1; book: testbeds.md): the `checker-direct` scene (each of its
 //! variants: `default`, `occluded`, `soft-shadow`) with pixel integrals over each pixel's
 //! footprint (box filter, paper 003 Eq. 2),
 //! `I_p = int_{pixel p} L(x(u, v)) du dv`, where `L(x)` is the direct lighting at the floor point

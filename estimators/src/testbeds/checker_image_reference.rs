@@ -1,4 +1,4 @@
-//! The stored reference of `checker-image` (SPEC §3.6): per pixel, the mean of many pixel samples
+//! The stored reference of `checker-image` (book: testbeds.md): per pixel, the mean of many pixel samples
 //! at independent uniform footprint positions, split into [`BATCHES`] independent batches whose
 //! spread gives the standard error. Made by `mcbench reference checker-image --variant V
 //! [--samples N]`; the command, seed and sample count are stored in the file.

@@ -1,4 +1,4 @@
-//! The quadrature reference of `checker-direct` (SPEC §3.5): for each pixel, the direct lighting
+//! The quadrature reference of `checker-direct` (book: testbeds.md): for each pixel, the direct lighting
 //! `sum_k int_{A_k visible} L_k f(w(y), w_o) cos(theta_x) cos(theta_y) / |y - x|^2 dA(y)` (paper
 //! 003 Eq. 4-5 written over each light's area), by product Gauss-Legendre quadrature.
 //!

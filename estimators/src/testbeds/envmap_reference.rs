@@ -1,4 +1,4 @@
-//! Exact references of the `envmap-sequence` test bed (SPEC §3.7): for a piecewise-constant map,
+//! Exact references of the `envmap-sequence` test bed (book: testbeds.md): for a piecewise-constant map,
 //! `L = sum over texels t of T_t * integral over t of f cos (V) dw`, so each texel's geometric
 //! factor is integrated exactly or by deterministic quadrature in `(theta, phi)` with the
 //! `sin(theta)` solid-angle weight:
@@ -21,7 +21,7 @@
 //!
 //! The rigorous part of the bound is the skipped mass; the quadrature's own error is stated as
 //! 1e-7 relative, the level at which the tests check it against a brute-force quadrature with 16x
-//! more panels per texel (SPEC §3.7 asks for 1e-9: the rules used should reach it on smooth
+//! more panels per texel (the bound is 1e-9: the rules used should reach it on smooth
 //! texels, but the brute force cannot show it, so it is not claimed).
 
 use crate::brdf::Phong;

@@ -1,4 +1,4 @@
-//! `envmap-sequence` (SPEC §3.7, paper 004): an orthographic view of a unit sphere (one shading
+//! `envmap-sequence` (paper 004; book: testbeds.md): an orthographic view of a unit sphere (one shading
 //! point per pixel, default 32x32, view along +y; the image covers the square inscribed in the
 //! sphere's disc so every pixel centre hits it) with a modified-Phong BRDF, lit by a lat-long
 //! environment map (256x128 texels tabulated from [`crate::envmap::sky::Sky`]) rotating by
@@ -75,7 +75,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     ],
 };
 
-/// Parameters of `envmap-sequence` (SPEC §3.7).
+/// Parameters of `envmap-sequence` (book: testbeds.md).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
 pub struct EnvmapSequenceParams {
@@ -168,7 +168,7 @@ pub struct EnvmapSequence {
     key: ReferenceKey,
 }
 
-/// The BRDF and quantity of a variant (SPEC §3.7); the `moving` ones have the `mixed` BRDF.
+/// The BRDF and quantity of a variant (book: testbeds.md); the `moving` ones have the `mixed` BRDF.
 pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError> {
     let phong = |kd: f64, ks: f64| Phong { kd: Rgb::splat(kd), ks: Rgb::splat(ks), n: 50.0 };
     match variant {

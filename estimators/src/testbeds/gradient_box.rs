@@ -1,4 +1,4 @@
-//! `gradient-box` (paper 000 §5, SPEC §3.2): a homogeneous cube `[-0.5, 0.5]^3` of participating
+//! `gradient-box` (paper 000 §5, book: testbeds.md): a homogeneous cube `[-0.5, 0.5]^3` of participating
 //! medium (`sigma_t = 2`, index-matched boundary, no emission) under the gradient background
 //! `L_b(w) = max(0, c0 + c1 w_z + c2 w_x)` over the whole sphere, seen by an orthographic camera
 //! looking along +y whose 16 x 16 pixels cover `x, z in [-0.5, 0.5]` (row `py = 0` at the top,
@@ -8,7 +8,7 @@
 //! Variants: `albedo-1`, `albedo-0.8`, `albedo-0.5` (isotropic phase), `hg-0.1` (albedo 0.8,
 //! Henyey-Greenstein g = 0.1), `furnace` (albedo 1, `c1 = c2 = 0`: every path returns exactly `c0`,
 //! so the reference is exact), `albedo-0` (single attenuation `exp(-sigma_t) c0`, exact) and `thick`
-//! (`sigma_t = 1e4`, albedo 0.8: the optically thick stability case, SPEC §10).
+//! (`sigma_t = 1e4`, albedo 0.8: the optically thick stability case, book: stability.md).
 //!
 //! References of the other variants are stored long-run Monte Carlo values of Eq. 6 made by
 //! `mcbench reference gradient-box --variant V` with an integrator that shares no sampling code
@@ -94,7 +94,7 @@ pub struct BoxSetup {
     pub background: Gradient,
 }
 
-/// The setup of a variant (SPEC §3.2).
+/// The setup of a variant (book: testbeds.md).
 pub fn variant_setup(variant: &str) -> Result<BoxSetup, ConfigError> {
     let bg = Gradient { clamp: true, ..Gradient::papers() };
     let iso = |albedo: f64| BoxSetup { albedo, sigma_t: 2.0, phase: Phase::Isotropic, background: bg };

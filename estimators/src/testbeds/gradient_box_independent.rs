@@ -1,4 +1,4 @@
-//! The stored reference of `gradient-box` (SPEC §3.2, §2), made by an integrator that shares no
+//! The stored reference of `gradient-box` (book: testbeds.md), made by an integrator that shares no
 //! sampling code with the estimators it judges (in particular not with `is0_cv0`'s path tracer,
 //! `crate::media_smc::PathTracer`): a reference made by an estimator's own code would hide that
 //! estimator's bugs and flag the correct ones.
@@ -48,7 +48,7 @@ pub fn default_samples(_variant: &str) -> u64 {
     1 << 20
 }
 
-/// What the integrator needs of the scene (SPEC §3.2): the cube `[-0.5, 0.5]^3`.
+/// What the integrator needs of the scene (book: testbeds.md): the cube `[-0.5, 0.5]^3`.
 #[derive(Clone, Copy, Debug)]
 pub struct BoxMedium {
     /// Extinction inside the cube.
@@ -109,7 +109,7 @@ pub fn exit_distance(o: Vec3, w: Vec3) -> Option<(f64, f64)> {
     Some((lo, hi))
 }
 
-/// The pixel-centre ray of pixel `i` of a `size x size` image, from SPEC §3.2: orthographic along
+/// The pixel-centre ray of pixel `i` of a `size x size` image, from the test bed's definition: orthographic along
 /// +y, the image covering `x, z in [-0.5, 0.5]`, row 0 at the top (`z = +0.5`); origin at y = -1.
 pub fn camera_ray(size: usize, i: usize) -> (Vec3, Vec3) {
     let h = 1.0 / size as f64;
@@ -240,7 +240,7 @@ mod tests {
         BoxMedium { sigma_t: s.sigma_t, albedo: s.albedo, phase: s.phase, background: s.background }
     }
 
-    /// The camera written here from SPEC §3.2 is the bed's, and the slab code agrees with the bed's
+    /// The camera written here from the test bed's definition is the bed's, and the slab code agrees with the bed's
     /// clip on rays from outside and inside the cube.
     #[test]
     fn camera_and_intersection_match_the_scene() {

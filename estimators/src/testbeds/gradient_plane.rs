@@ -1,4 +1,4 @@
-//! `gradient-plane` (paper 001 §5, SPEC §3.1): a modified-Phong plane under a gradient sky, seen
+//! `gradient-plane` (paper 001 §5, book: testbeds.md): a modified-Phong plane under a gradient sky, seen
 //! by a pinhole camera; one hemispherical integral per pixel with an exact reference.
 //!
 //! Reference per pixel and channel: the diffuse part in closed form, `kd (c0 + 2 c1 / 3)`; the
@@ -73,7 +73,7 @@ pub struct GradientPlane {
     reference: Reference,
 }
 
-/// The BRDF of a variant (SPEC §3.1).
+/// The BRDF of a variant (book: testbeds.md).
 pub fn variant_brdf(variant: &str) -> Result<Phong, ConfigError> {
     let phong = |kd: f64, ks: f64, n: f64| Phong { kd: Rgb::splat(kd), ks: Rgb::splat(ks), n };
     match variant {

@@ -1,4 +1,4 @@
-//! The analytic test beds (SPEC §3), each with its exact or stored reference.
+//! The analytic test beds (book: testbeds.md), each with its exact or stored reference.
 
 pub mod canonical_1d;
 pub mod canonical_profiles;

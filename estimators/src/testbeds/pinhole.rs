@@ -1,4 +1,4 @@
-//! A pinhole camera through pixel centres (SPEC §3.1, §3.5).
+//! A pinhole camera through pixel centres (`gradient-plane`, `checker-direct`).
 
 use crate::math::Vec3;
 

@@ -1,4 +1,4 @@
-//! Null-collision and particle-model estimators of paper 002 (SPEC §4.2): transmittance trackers
+//! Null-collision and particle-model estimators of paper 002 (book: testbeds.md): transmittance trackers
 //! (ray marching, delta, ratio, residual ratio, double and single particle models) and particle
 //! tracing of multiple scattering (`spm_*`).
 //!
@@ -265,7 +265,7 @@ pub fn ray_moments(
 }
 
 /// Refuses a sampling extinction under which one ray's variance is not finite in f64 on `bed`
-/// (SPEC §10, `sigma_samp = 1e-6 x sigma_t`: the double and non-terminating particle models are
+/// (the stability case `sigma_samp = 1e-6 x sigma_t`: the double and non-terminating particle models are
 /// unbiased for any `sigma_samp`, but their second moment `exp(int sigma_samp ((1 - r)^2 - 1))`
 /// is `exp(7e5)` there, so no run of any length estimates anything). Checks the exact moments
 /// ([`crate::estimator::Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.

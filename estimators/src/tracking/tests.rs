@@ -1,4 +1,4 @@
-//! Unbiasedness (SPEC §6), refusal and stability (SPEC §10) tests of the trackers.
+//! Unbiasedness (book: statistics.md), refusal and stability (book: stability.md) tests of the trackers.
 
 use crate::budget::{Budget, BudgetKind};
 use crate::error::EstimateError;
@@ -154,7 +154,7 @@ fn particle_models_agree_with_delta_tracking() {
     }
 }
 
-/// SPEC §10: extreme sampling densities, optical depth 1e4, rays that miss the medium, albedo 1
+/// Stability: extreme sampling densities, optical depth 1e4, rays that miss the medium, albedo 1
 /// with non-terminating weights: finite results (or a refusal), and no endless loop.
 #[test]
 fn stability_cases_are_finite() {

@@ -1,4 +1,4 @@
-//! The SPEC §6 unbiasedness tests of one cell, and their three-way verdict.
+//! The unbiasedness tests of one cell (book: statistics.md), and their three-way verdict.
 //!
 //! Two tests, combined by a weighted Bonferroni at the family-wise `alpha` (the pooled test gets
 //! [`POOLED_SHARE`] of it, the per-integral one the rest): when the two are nearly the same test
@@ -188,7 +188,7 @@ pub(super) fn multiplicative(shift: f64) -> f64 {
     }
 }
 
-/// The SPEC §6 tests of one cell: the Holm row, the pooled row and the combined row (the
+/// The unbiasedness tests of one cell: the Holm row, the pooled row and the combined row (the
 /// decision), each with its verdict. `gate` is the independent spread and skewness (None: the
 /// cell's own, which can flag a bias but never pass); `tolerance` the relative bias a `pass`
 /// must be able to detect.

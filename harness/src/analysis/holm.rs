@@ -1,4 +1,4 @@
-//! The per-integral test of SPEC §6 (`holm_t` / `holm_welch`): per integral and channel a t-test
+//! The per-integral unbiasedness test (`holm_t` / `holm_welch`): per integral and channel a t-test
 //! (exact reference) or Welch test (stored), Holm-Bonferroni over them, and the relative bias it
 //! detects over independent groups of integrals.
 

@@ -1,4 +1,4 @@
-//! What a run concludes: convergence-slope fits (SPEC §5), unbiasedness tests (SPEC §6) and the
+//! What a run concludes: convergence-slope fits (book: slope-fits.md), unbiasedness tests (book: statistics.md) and the
 //! papers' speed-up computation (paper 000/001).
 
 pub mod bias;
@@ -13,7 +13,7 @@ use crate::metrics::SummaryRow;
 use estimators::stats::{log_log_fit, weighted_linear_fit, SlopeFit};
 use serde::{Deserialize, Serialize};
 
-/// Family-wise significance of the unbiasedness tests (SPEC §6).
+/// Family-wise significance of the unbiasedness tests (book: statistics.md).
 pub const UNBIASEDNESS_ALPHA: f64 = 1e-3;
 /// Power at which the detectable bias is reported.
 pub const POWER: f64 = 0.8;
@@ -21,7 +21,7 @@ pub const POWER: f64 = 0.8;
 /// How many of the largest budgets the right-end fit uses.
 pub const RIGHT_END_BUDGETS: usize = 3;
 
-/// A convergence-slope fit of log RMSE on log budget (SPEC §5), over the whole range of budgets and
+/// A convergence-slope fit of log RMSE on log budget (book: slope-fits.md), over the whole range of budgets and
 /// over its right end (the last [`RIGHT_END_BUDGETS`] budgets), where a method "reaches" its order.
 ///
 /// Both fits are weighted least squares with delta-method variances ([`rmse_fit`]): each budget's

@@ -1,4 +1,4 @@
-//! The pooled test of SPEC §6 (`pooled_t`): one observation per repetition, its summed deviation
+//! The pooled unbiasedness test (`pooled_t`): one observation per repetition, its summed deviation
 //! from the reference over every integral and channel.
 
 use super::bias::{multiplicative, spread_upper, Gate};

@@ -53,7 +53,7 @@ pub fn seeds(mode: Mode) -> usize {
 pub fn experiment() -> Experiment {
     Experiment {
         name: NAME.into(),
-        reproduces: "SPEC §6: size, power and detectable bias of the unbiasedness tests, measured".into(),
+        reproduces: "size, power and detectable bias of the unbiasedness tests, measured".into(),
         summary: "the unbiasedness tests over many seeds with injected biases: false-flag rate, power, detectable bias, controls".into(),
         sweeps: Sweeps::Derived(first_sweep),
         claims: None,

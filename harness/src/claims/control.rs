@@ -96,7 +96,9 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
     };
     Claim {
         testbed: decisive.first().map(|t| t.testbed.clone()).unwrap_or_default(),
-        claim: format!("harness (SPEC §6): the biased control {control} is flagged on every variant it runs on"),
+        claim: format!(
+            "harness: the biased control {control} is flagged by the unbiasedness test (family-wise alpha 1e-3) on every variant it runs on"
+        ),
         paper_value: None,
         our_value: (!decisive.is_empty()).then_some(max_p),
         held: match verdict {

@@ -160,7 +160,7 @@ pub fn diagnostic_claim(
     }
 }
 
-/// SPEC §2: a stored reference is precise enough when every measured RMSE at the largest budget is
+/// A stored reference is precise enough when every measured RMSE at the largest budget is
 /// at least 3x the reference's RMS standard error. One claim per test bed with a stored reference.
 pub fn reference_precision(plan: &crate::plan::Plan, report: &RunReport) -> Vec<Claim> {
     let last = plan.sweep.budgets.last().map_or(0, |b| b.amount);
@@ -180,7 +180,7 @@ pub fn reference_precision(plan: &crate::plan::Plan, report: &RunReport) -> Vec<
             .fold(f64::INFINITY, f64::min);
         out.push(Claim {
             testbed: b.label(),
-            claim: "SPEC §2: every measured RMSE at the largest budget is >= 3x the stored reference's RMS standard error".into(),
+            claim: "stored reference: every measured RMSE at the largest budget is >= 3x the stored reference's RMS standard error".into(),
             paper_value: Some(3.0),
             our_value: Some(min_rmse / ref_rms),
             held: Some(min_rmse >= 3.0 * ref_rms),

@@ -1,4 +1,4 @@
-//! Plots of a run (SPEC §8), written as SVG and PNG, atomically, in one style ([`style`]): per
+//! Plots of a run (book: outputs.md), written as SVG and PNG, atomically, in one style ([`style`]): per
 //! (test bed, variant) one figure of log-log panels ([`testbed`]): RMSE against the budget with a
 //! bootstrap band and a slope -1/2 guide, efficiency against the budget, RMSE against CPU time
 //! and, with speed-ups, the speed-up against the cost of a ray ([`ray_cost`]); one series per

@@ -1,4 +1,4 @@
-//! The `unbiasedness` experiment (SPEC §6): every registered estimator on every test-bed case it
+//! The `unbiasedness` experiment (book: unbiasedness.md): every registered estimator on every test-bed case it
 //! runs on, each cell tested by [`crate::analysis::unbiasedness`] (per-integral Holm t / Welch and
 //! the pooled per-repetition t-test, combined by Bonferroni) behind the gate of a pilot on its own
 //! seed, with the biased controls in the same run and required to be flagged (except where their
@@ -32,7 +32,7 @@ pub const NAME: &str = "unbiasedness";
 pub fn experiment() -> Experiment {
     Experiment {
         name: NAME.into(),
-        reproduces: "SPEC §6 over every estimator x test bed".into(),
+        reproduces: "the unbiasedness tests over every estimator x test bed".into(),
         summary: "every estimator on every test-bed case it runs on: Holm t / pooled z / Welch, detectable bias, the biased controls flagged".into(),
         sweeps: Sweeps::Derived(first_part),
         claims: None,

@@ -1,4 +1,4 @@
-//! The table of `unbiasedness`: one row per (estimator, test bed, variant) from the cell's SPEC §6
+//! The table of `unbiasedness`: one row per (estimator, test bed, variant) from the cell's unbiasedness
 //! tests, judged against what the paper claims (registry [`Bias`]); `unbiasedness.csv`, the
 //! per-row `paper` entries and the per-control claims of summary.json.
 
@@ -60,7 +60,7 @@ pub struct Row {
     pub exempt: Option<&'static str>,
 }
 
-/// The row of one cell from its SPEC §6 tests ([`crate::analysis::unbiasedness`], the
+/// The row of one cell from its unbiasedness tests ([`crate::analysis::unbiasedness`], the
 /// `combined` row decides).
 pub fn row_from_tests(cell: &CellResult, bias: Bias, tests: &[TestRow], exempt: Option<&'static str>) -> Row {
     let k = &cell.key;
@@ -121,7 +121,7 @@ pub fn judge(r: &mut Row) {
     let (agrees, mut note) = match (expect, r.verdict.as_str()) {
         (_, "not-run") => (None, why),
         ("consistent", "biased") => {
-            (None, format!("flagged (p = {p}): reported as consistent only (SPEC §6){measured}"))
+            (None, format!("flagged (p = {p}): reported as consistent only, not judged as unbiased{measured}"))
         }
         ("consistent", v) => (None, format!("{v} (consistent id): {why}{measured}")),
         ("either", v) => (None, format!("{v} (p = {p}): {why}{measured}")),
@@ -212,7 +212,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
         out.push(Claim {
             testbed: "all".into(),
             claim: format!(
-                "harness (SPEC §6): the biased control {c} is flagged on every test bed where it is a control"
+                "harness: the biased control {c} is flagged by the unbiasedness test (family-wise alpha 1e-3) on every test bed where it is a control"
             ),
             paper_value: None,
             our_value: Some(mine.len() as f64 - missed.len() as f64),
@@ -235,7 +235,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
     let inconclusive = unbiased.len() - passed - failed.len();
     out.push(Claim {
         testbed: "all".into(),
-        claim: "papers: every estimator they call unbiased passes the SPEC §6 test on every test bed".into(),
+        claim: "papers: every estimator they call unbiased passes the unbiasedness test on every test bed".into(),
         paper_value: None,
         our_value: Some(passed as f64),
         // Held only when every row passes; a flag fails it; inconclusive rows leave it open.
