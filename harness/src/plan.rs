@@ -1,6 +1,7 @@
 //! Turning a [`Sweep`] into built test beds and estimators, before anything is written: every
-//! bad name or value is found here (exit 2, no files touched), and pairs that cannot run are
-//! listed with their reason.
+//! bad name or value is found here (exit 2, no files touched), including a claim naming a test
+//! bed, estimator or budget the plan does not run ([`crate::claim_check`]), and pairs that cannot
+//! run are listed with their reason.
 
 use crate::config::{EstimatorSpec, Sweep, TestBedSpec};
 use crate::error::Result;
@@ -182,7 +183,26 @@ impl Plan {
                 );
             }
         }
-        Ok(Plan { sweep, beds, estimators, pairs, skipped })
+        let plan = Plan { sweep, beds, estimators, pairs, skipped };
+        plan.check_claims()?;
+        Ok(plan)
+    }
+
+    /// Checks every claim of the sweep against what the plan runs
+    /// ([`crate::claim_spec::ClaimSpec::check_against`]).
+    fn check_claims(&self) -> Result<()> {
+        let ran = crate::claim_check::Ran {
+            beds: self.beds.iter().map(PreparedBed::label).collect(),
+            estimators: self.estimators.iter().map(|e| e.name.as_str()).collect(),
+            pairs: &self.pairs,
+            skipped: &self.skipped,
+            budgets: self.sweep.budgets.iter().map(|b| b.amount).collect(),
+            baseline: self.sweep.baseline.as_deref(),
+        };
+        for (i, c) in self.sweep.claims.iter().enumerate() {
+            c.check_against(&ran).map_err(|e| crate::claim_check::config_error(i, c, e))?;
+        }
+        Ok(())
     }
 }
 
