@@ -117,6 +117,12 @@ fn claims_of_a_config_are_checked_before_anything_is_written() {
     let json = r#"{"name":"tiny","budgets":[4,16],"testbeds":[{"id":"gradient-plane"}],"estimators":[{"id":"is0_cv0"}],"claims":[{"kind":"control_flagged","estimator":"is0_cv1"}]}"#;
     std::fs::write(d.join("claims.json"), json).expect("write");
     assert_bad_input(d, &["run", "--config", "claims.json"], "claims.json: invalid claims[0].estimator = is0_cv1");
+    // A config's claims replace a named experiment's, and are checked as strictly (the
+    // experiment's own, kept by a config that reshapes it without claims, are not: see shards.rs).
+    std::fs::write(d.join("reshape.toml"), "[[claims]]\nkind = 'control_flagged'\nestimator = 'no_such'\n")
+        .expect("write");
+    let args = ["run", "surface-smc", "--config", "reshape.toml"];
+    assert_bad_input(d, &args, "reshape.toml: invalid claims[0].estimator = no_such: names no estimator");
     // The same sweep with its claims right runs (and names them in its summary).
     std::fs::write(d.join("right.toml"), format!("{sweep}{good}{}", ratio("budget = 16\n"))).expect("write");
     let o = mcbench(d, &["run", "--config", "right.toml", "--no-plots"]);

@@ -326,7 +326,14 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         if let Some(r) = args.reps {
             sweep.reps = r as usize;
         }
-        prepared.push((def, execute::prepare(sweep, registry).map_err(|e| in_config(e, args, file_claims))?));
+        // A config that reshapes a named experiment without claims of its own keeps the
+        // experiment's, judged `not measured` where the reshaped sweep lacks their cells.
+        let plan = if def.is_some() && args.config.is_some() && !file_claims {
+            execute::prepare_reshaped(sweep, registry)?
+        } else {
+            execute::prepare(sweep, registry).map_err(|e| in_config(e, args, file_claims))?
+        };
+        prepared.push((def, plan));
         times.push(crate::phases::take());
     }
     let progress = Progress::new(args.progress);
