@@ -239,8 +239,13 @@ impl ClaimSpec {
         let testbed = self.testbed();
         if let Some(t) = testbed {
             if !ran.beds.iter().any(|b| b == t) {
-                let mut runs = ran.beds.clone();
-                runs.dedup();
+                let runs: Vec<&str> = ran
+                    .beds
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, b)| !ran.beds[..*i].contains(b))
+                    .map(|(_, b)| b.as_str())
+                    .collect();
                 return Err(err("testbed", t, ClaimProblem::UnknownTestbed(runs.join(", "))));
             }
         }
@@ -267,10 +272,7 @@ impl ClaimSpec {
     /// for `control_flagged`.
     pub fn describe(&self) -> String {
         match self.text() {
-            Some(t) => {
-                let one_line: String = t.chars().map(|c| if c.is_control() { ' ' } else { c }).collect();
-                format!("\"{}\"", crate::report::shorten(&one_line, 60))
-            }
+            Some(t) => format!("\"{}\"", crate::report::shorten(&one_line(t), 60)),
             None => "control_flagged".to_string(),
         }
     }
@@ -292,13 +294,18 @@ enum Range {
     NotNegative,
 }
 
+/// `text` with every control character (a line break among them) as a space.
+fn one_line(text: &str) -> String {
+    text.chars().map(|c| if c.is_control() { ' ' } else { c }).collect()
+}
+
 /// The error of the claim at `index` of a sweep, as bad input: one line naming the claim, its
 /// text and the field.
 pub fn config_error(index: usize, claim: &ClaimSpec, e: ClaimError) -> estimators::error::ConfigError {
     estimators::error::ConfigError::invalid(
         format!("claims[{index}].{}", e.field),
-        &e.value,
-        format!("{} (the claim: {})", e.problem, claim.describe()),
+        one_line(&e.value),
+        one_line(&format!("{} (the claim: {})", e.problem, claim.describe())),
     )
 }
 

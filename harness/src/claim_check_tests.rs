@@ -126,4 +126,11 @@ fn the_error_names_the_claim_its_text_and_the_field_on_one_line() {
     let c = claim("kind = 'slope'\ntestbed = 'a/b'\nestimator = 'e'\nvalue = nan\ntext = \"\"\"two\nlines\"\"\"");
     let e = config_error(3, &c, c.check().expect_err("nan")).to_string();
     assert_eq!(e, "invalid claims[3].value = NaN: not a finite number (the claim: \"two lines\")");
+    let bed = claim("kind = 'slope'\ntestbed = \"t/a\\nt/c\"\nestimator = 'e'\nvalue = -0.5\ntext = 't'");
+    let (pairs, skipped) = ([(0, 0), (1, 0)], []);
+    let e = config_error(0, &bed, bed.check_against(&ran(&pairs, &skipped, None)).expect_err("no such bed"));
+    assert_eq!(
+        e.to_string(),
+        "invalid claims[0].testbed = t/a t/c: the sweep runs no such test bed (it runs: t/a, t/b) (the claim: \"t\")"
+    );
 }
