@@ -15,8 +15,9 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
 }
 
-/// Exit code 2, exactly one line on stderr containing `needle`, and nothing under results/ or plots/.
-fn assert_bad_input(dir: &Path, args: &[&str], needle: &str) {
+/// Exit code 2, exactly one line on stderr containing `needle`, and nothing under results/ or plots/;
+/// the line.
+fn assert_bad_input(dir: &Path, args: &[&str], needle: &str) -> String {
     let o = mcbench(dir, args);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
@@ -24,6 +25,7 @@ fn assert_bad_input(dir: &Path, args: &[&str], needle: &str) {
     assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
     assert!(!err.contains("panicked"), "{err}");
     assert!(!dir.join("results").exists() && !dir.join("plots").exists(), "{args:?} wrote files");
+    err
 }
 
 const SMALL: &str = "name = 'tiny'\nreps = 3\nbudgets = [4, 16, 64]\n[[testbeds]]\nid = 'gradient-plane'\nparams = { resolution = 4 }\n[[estimators]]\nid = 'is0_cv0'\n[[estimators]]\nid = 'clamped_is0_cv0'\nparams = { clamp = 1.5 }\n";
@@ -66,6 +68,66 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
         assert_bad_input(d, &["run", "--config", path.to_str().expect("utf8")], needle);
     }
     assert_bad_input(d, &["run", "--config", "missing.toml"], "missing.toml");
+}
+
+/// A config's `[[claims]]` are checked with the rest of the plan: a claim naming a test bed,
+/// estimator or budget the sweep does not run, or a number that is not finite, is bad input (exit
+/// 2, one line naming the file, the claim and the field, nothing written), not a verdict.
+#[test]
+fn claims_of_a_config_are_checked_before_anything_is_written() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let sweep = SMALL.replace(
+        "[[estimators]]\nid = 'is0_cv0'\n",
+        "[[estimators]]\nid = 'is0_cv0'\n[[estimators]]\nid = 'delta_tracking'\n",
+    );
+    let slope = |estimator: &str, value: &str| {
+        format!("[[claims]]\nkind = 'slope'\ntestbed = 'gradient-plane/default'\nestimator = '{estimator}'\nvalue = {value}\ntext = 'converges'\n")
+    };
+    let ratio = |extra: &str| {
+        format!("[[claims]]\nkind = 'ratio'\ntestbed = 'gradient-plane/default'\nestimator = 'clamped_is0_cv0[clamp=1.5]'\nbaseline = 'is0_cv0'\ntext = 'lower error'\n{extra}")
+    };
+    let good = slope("is0_cv0", "-0.5");
+    let cases = [
+        (slope("is0_cv", "-0.5"), "claims[0].estimator = is0_cv: names no estimator of the sweep"),
+        (format!("{good}{}", slope("clamped_is0_cv0[clamp=2]", "-0.5")), "claims[1].estimator = clamped_is0_cv0[clamp=2]"),
+        (slope("is0_cv0", "nan"), "claims[0].value = NaN: not a finite number"),
+        (slope("is0_cv0", "-inf"), "claims[0].value = -inf"),
+        (good.replace("gradient-plane/default", "gradient-plane/glossy"), "claims[0].testbed = gradient-plane/glossy"),
+        (good.replace("gradient-plane/default", "gradient-plane"), "claims[0].testbed = gradient-plane:"),
+        (slope("delta_tracking", "-0.5"), "claims[0].estimator = delta_tracking: does not run on gradient-plane/default"),
+        (ratio("threshold = inf\n"), "claims[0].threshold = inf"),
+        (ratio("value = nan\n"), "claims[0].value = NaN"),
+        (ratio("budget = 8\n"), "claims[0].budget = 8: not a budget of the sweep"),
+        (ratio("").replace("'is0_cv0'", "'is0_cv0[clamp=1.5]'"), "claims[0].baseline = is0_cv0[clamp=1.5]"),
+        (
+            "[[claims]]\nkind = 'speedup'\ntestbed = 'gradient-plane/default'\nestimator = 'is0_cv0'\nvalue = 2.0\ntext = 'x'\n".into(),
+            "claims[0].baseline = (none)",
+        ),
+        ("[[claims]]\nkind = 'control_flagged'\nestimator = 'clamped'\n".into(), "claims[0].estimator = clamped"),
+        (ratio("range = 'right'\n"), "unknown field `range`"),
+        (good.replace("value = -0.5\n", ""), "missing field `value`"),
+    ];
+    for (i, (claims, needle)) in cases.iter().enumerate() {
+        let path = d.join(format!("claims_{i}.toml"));
+        std::fs::write(&path, format!("{sweep}{claims}")).expect("write config");
+        let err = assert_bad_input(d, &["run", "--config", path.to_str().expect("utf8")], needle);
+        assert!(err.contains(&format!("claims_{i}.toml: ")), "the file is not named: {err}");
+    }
+    let json = r#"{"name":"tiny","budgets":[4,16],"testbeds":[{"id":"gradient-plane"}],"estimators":[{"id":"is0_cv0"}],"claims":[{"kind":"control_flagged","estimator":"is0_cv1"}]}"#;
+    std::fs::write(d.join("claims.json"), json).expect("write");
+    assert_bad_input(d, &["run", "--config", "claims.json"], "claims.json: invalid claims[0].estimator = is0_cv1");
+    // A config's claims replace a named experiment's, and are checked as strictly (the
+    // experiment's own, kept by a config that reshapes it without claims, are not: see shards.rs).
+    std::fs::write(d.join("reshape.toml"), "[[claims]]\nkind = 'control_flagged'\nestimator = 'no_such'\n")
+        .expect("write");
+    let args = ["run", "surface-smc", "--config", "reshape.toml"];
+    assert_bad_input(d, &args, "reshape.toml: invalid claims[0].estimator = no_such: names no estimator");
+    // The same sweep with its claims right runs (and names them in its summary).
+    std::fs::write(d.join("right.toml"), format!("{sweep}{good}{}", ratio("budget = 16\n"))).expect("write");
+    let o = mcbench(d, &["run", "--config", "right.toml", "--no-plots"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("lower error"));
 }
 
 /// Every file under `root` with its bytes (an absent root is empty).

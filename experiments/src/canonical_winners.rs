@@ -12,7 +12,7 @@ use crate::canonical_sweep_post::{short, Analysis};
 use estimators::estimator::Bias;
 use estimators::testbeds::canonical_1d::TARGETS;
 use estimators::testbeds::canonical_profiles::Profile;
-use mcbench::report::{markdown_table, sig};
+use mcbench::report::{markdown_table, md_text, sig};
 use serde::Serialize;
 
 /// Whether a family subtracts a control variate (explorer fetches; exact on some profiles).
@@ -176,7 +176,7 @@ pub fn tables(a: &Analysis) -> (Vec<WinnerRow>, String) {
                 table.push(line);
             }
             let header: Vec<&str> = header.iter().map(String::as_str).collect();
-            md.push_str(&format!("\n## {}\n\n{}", p.name(), markdown_table(&header, &table)));
+            md.push_str(&format!("\n## {}\n\n{}", md_text(p.name()), markdown_table(&header, &table)));
         }
     }
     (rows, md)

@@ -86,8 +86,9 @@
 //! estimator = "clamped_is0_cv0"
 //! ```
 //!
-//! A claim never compares an estimator with itself: [`ClaimSpec::check`] refuses such a claim when
-//! its file is read, and [`ClaimSpec::judge`] refuses it too (verdict `not measured`).
+//! A claim is checked before anything runs ([`crate::claim_check`]): every number finite, every
+//! test bed, estimator and budget it names one the sweep runs, no estimator compared with itself
+//! (which [`ClaimSpec::judge`] refuses too, verdict `not measured`).
 
 use crate::analysis::SlopeRange;
 use crate::claims::{self, Family, RatioMetric, RatioSpec};
@@ -353,30 +354,6 @@ impl ClaimSpec {
             ClaimSpec::RatioOfRatios { numerator, denominator, .. } => {
                 numerator.iter().chain(denominator).map(String::as_str).collect()
             }
-        }
-    }
-
-    /// Refuses a claim that compares an estimator with itself, or an ordering or optimum with an
-    /// empty side: the error names it.
-    pub fn check(&self) -> Result<(), String> {
-        let same = |names: &[&str]| claims::ordering::repeated(names).map(String::from);
-        let clash = match self {
-            ClaimSpec::Speedup { estimator, baseline: Some(b), .. } if estimator == b => Some(b.clone()),
-            ClaimSpec::Ratio { estimator, baseline, .. } if estimator == baseline => Some(baseline.clone()),
-            ClaimSpec::Ordering { estimators: a, others: b, .. } | ClaimSpec::Optimum { inside: a, outside: b, .. } => {
-                if a.is_empty() || b.is_empty() {
-                    return Err("an ordering or optimum needs estimators on both sides".into());
-                }
-                same(&self.estimators())
-            }
-            ClaimSpec::RatioOfRatios { numerator: n, denominator: d, .. } => {
-                [n, d].into_iter().find(|p| p[0] == p[1]).map(|p| p[0].clone())
-            }
-            _ => None,
-        };
-        match clash {
-            Some(n) => Err(format!("a claim compares {n} with itself")),
-            None => Ok(()),
         }
     }
 

@@ -294,6 +294,8 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     let mode = args.mode();
     crate::phases::track();
     let file = args.config.as_deref().map(SweepFile::read).transpose()?;
+    // A config's claims replace the experiment's: an error in one of them names the file too.
+    let file_claims = file.as_ref().is_some_and(|f| f.claims.is_some());
     // Build every plan first: any bad name or value stops here, before a file is written.
     let mut plans = Vec::new();
     if names.is_empty() {
@@ -324,7 +326,14 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         if let Some(r) = args.reps {
             sweep.reps = r as usize;
         }
-        prepared.push((def, execute::prepare(sweep, registry)?));
+        // A config that reshapes a named experiment without claims of its own keeps the
+        // experiment's, judged `not measured` where the reshaped sweep lacks their cells.
+        let plan = if def.is_some() && args.config.is_some() && !file_claims {
+            execute::prepare_reshaped(sweep, registry)?
+        } else {
+            execute::prepare(sweep, registry).map_err(|e| in_config(e, args, file_claims))?
+        };
+        prepared.push((def, plan));
         times.push(crate::phases::take());
     }
     let progress = Progress::new(args.progress);
@@ -383,6 +392,18 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `e` naming the `--config` file when it is about a claim and the claims came from that file.
+fn in_config(e: HarnessError, args: &RunArgs, file_claims: bool) -> HarnessError {
+    match (&e, args.config.as_deref()) {
+        (HarnessError::Config(estimators::error::ConfigError::InvalidValue { field, .. }), Some(path))
+            if file_claims && field.starts_with("claims[") =>
+        {
+            HarnessError::bad_file(path, e)
+        }
+        _ => e,
+    }
 }
 
 /// `mcbench conformance`: every check on the named estimators (all when none is named); one line

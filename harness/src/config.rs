@@ -263,7 +263,8 @@ impl SweepFile {
 
 impl Sweep {
     /// Checks what can be checked without building anything: the name, every count against
-    /// [`crate::limits`], duplicate entries, and that a `baseline` names one of the estimators.
+    /// [`crate::limits`], duplicate entries, that a `baseline` names one of the estimators, and
+    /// each claim on its own ([`ClaimSpec::check`]).
     pub fn validate(&self) -> Result<()> {
         use crate::limits::{max_budget, MAX_BUDGETS, MAX_ENTRIES, MAX_REPS};
         let name_ok = !self.experiment.is_empty()
@@ -350,8 +351,8 @@ impl Sweep {
                 .into());
             }
         }
-        for c in &self.claims {
-            c.check().map_err(|why| ConfigError::invalid("claims", c.testbed().unwrap_or("-"), why))?;
+        for (i, c) in self.claims.iter().enumerate() {
+            c.check().map_err(|e| crate::claim_check::config_error(i, c, e))?;
         }
         Ok(())
     }

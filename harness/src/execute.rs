@@ -52,6 +52,12 @@ pub fn prepare(sweep: Sweep, registry: &Registry) -> Result<Plan> {
     Plan::prepare(sweep, registry)
 }
 
+/// [`prepare`] for a named experiment's sweep reshaped by a config that gives no claims: the
+/// experiment's claims are not checked against the reshaped plan ([`Plan::prepare_unchecked`]).
+pub fn prepare_reshaped(sweep: Sweep, registry: &Registry) -> Result<Plan> {
+    Plan::prepare_unchecked(sweep, registry)
+}
+
 /// What a run reads before it writes anything: the stored cells it will resume from, checked.
 pub struct Preflight {
     stored: Vec<Option<CellResult>>,

@@ -65,6 +65,7 @@ pub mod analysis;
 mod budget_pilot;
 pub mod calibration;
 pub mod cell;
+pub mod claim_check;
 pub mod claim_spec;
 pub mod claims;
 pub mod cli;

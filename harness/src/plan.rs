@@ -1,6 +1,7 @@
 //! Turning a [`Sweep`] into built test beds and estimators, before anything is written: every
-//! bad name or value is found here (exit 2, no files touched), and pairs that cannot run are
-//! listed with their reason.
+//! bad name or value is found here (exit 2, no files touched), including a claim naming a test
+//! bed, estimator or budget the plan does not run ([`crate::claim_check`]), and pairs that cannot
+//! run are listed with their reason.
 
 use crate::config::{EstimatorSpec, Sweep, TestBedSpec};
 use crate::error::Result;
@@ -108,8 +109,18 @@ impl Plan {
     }
 
     /// Validates and builds everything (computing exact references), looking names up in
-    /// `registry`.
+    /// `registry`, and checks every claim of the sweep against what the plan runs.
     pub fn prepare(sweep: Sweep, registry: &Registry) -> Result<Plan> {
+        let plan = Plan::prepare_unchecked(sweep, registry)?;
+        plan.check_claims()?;
+        Ok(plan)
+    }
+
+    /// [`Plan::prepare`] without checking the sweep's claims against the plan (each is still
+    /// checked on its own): for the claims a named experiment brings to a sweep a `--config` has
+    /// reshaped, which are `not measured` where the reshaped sweep lacks their cells, and for a
+    /// merge, whose shards were checked when they ran.
+    pub fn prepare_unchecked(sweep: Sweep, registry: &Registry) -> Result<Plan> {
         let _phase = crate::phases::enter(crate::phases::Phase::Build);
         sweep.validate()?;
         let mut beds = Vec::new();
@@ -183,6 +194,23 @@ impl Plan {
             }
         }
         Ok(Plan { sweep, beds, estimators, pairs, skipped })
+    }
+
+    /// Checks every claim of the sweep against what the plan runs
+    /// ([`crate::claim_spec::ClaimSpec::check_against`]).
+    fn check_claims(&self) -> Result<()> {
+        let ran = crate::claim_check::Ran {
+            beds: self.beds.iter().map(PreparedBed::label).collect(),
+            estimators: self.estimators.iter().map(|e| e.name.as_str()).collect(),
+            pairs: &self.pairs,
+            skipped: &self.skipped,
+            budgets: self.sweep.budgets.iter().map(|b| b.amount).collect(),
+            baseline: self.sweep.baseline.as_deref(),
+        };
+        for (i, c) in self.sweep.claims.iter().enumerate() {
+            c.check_against(&ran).map_err(|e| crate::claim_check::config_error(i, c, e))?;
+        }
+        Ok(())
     }
 }
 

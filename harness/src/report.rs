@@ -3,13 +3,14 @@
 //! counts with the rows that need attention, what did not run, one line per (test bed, variant),
 //! and every plot. The long tables (every test row, every claim, every cell) are CSV files in the
 //! results folder ([`tables`]) that the summary links to; `index.html` beside it ([`crate::html`])
-//! shows the same run in a browser.
+//! shows the same run in a browser. Every text that comes from a config, a label, a registry entry
+//! or a stored file is escaped ([`md_text`]): no HTML tag of it reaches a markdown viewer.
 
 pub mod digest;
 mod format;
 pub mod tables;
 
-pub use format::{count, interval, markdown_table, md_target, opt, relative_path, shorten, sig};
+pub use format::{count, interval, markdown_table, md_target, md_text, opt, relative_path, shorten, sig};
 pub use tables::write_tables;
 
 use crate::error::Result;
@@ -50,14 +51,14 @@ fn table_link(plots_dir: &Path, results_dir: &Path, name: &str) -> String {
     match [name, "summary.json"].into_iter().map(|n| results_dir.join(n)).find(|p| p.is_file()) {
         Some(file) => {
             let shown = file.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            format!("[{shown}]({})", md_target(plots_dir, &file))
+            format!("[{}]({})", md_text(&shown), md_target(plots_dir, &file))
         }
         None => format!("`{name}` (not in the results folder)"),
     }
 }
 
 fn counts_line(counts: &[(String, usize)]) -> String {
-    counts.iter().map(|(w, n)| format!("{n} {w}")).collect::<Vec<_>>().join(", ")
+    counts.iter().map(|(w, n)| format!("{n} {}", md_text(w))).collect::<Vec<_>>().join(", ")
 }
 
 fn heading(out: &mut String, title: &str) {
@@ -83,15 +84,15 @@ fn more(out: &mut String, shown: usize, total: usize, what: &str, link: &str) {
 /// result files it links to.
 pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, results_dir: &Path) -> String {
     let m = &report.meta;
-    let mut out = format!("# mcbench report: {}\n\n", m.experiment);
+    let mut out = format!("# mcbench report: {}\n\n", md_text(&m.experiment));
     out.push_str(
         "A summary of the run. [index.html](index.html) shows it in a browser with every figure (and per-pixel \
          error maps of image test beds); every row of the long tables is in the result files.\n\n",
     );
-    let _ = writeln!(out, "- **mode**: {} ({} repetitions)", m.mode, m.reps);
+    let _ = writeln!(out, "- **mode**: {} ({} repetitions)", md_text(&m.mode), m.reps);
     let _ = writeln!(out, "- **seed**: {}", m.seed);
-    let _ = writeln!(out, "- **commit**: {} (mcbench {})", m.git_commit, m.version);
-    let _ = writeln!(out, "- **threads**: {}; **cpu**: {}", m.threads, m.cpu);
+    let _ = writeln!(out, "- **commit**: {} (mcbench {})", md_text(&m.git_commit), md_text(&m.version));
+    let _ = writeln!(out, "- **threads**: {}; **cpu**: {}", m.threads, md_text(&m.cpu));
     let cpu = digest::estimator_cpu_seconds(&report.rows);
     let _ = writeln!(
         out,
@@ -101,14 +102,16 @@ pub fn render_report(report: &RunReport, plots: &[PathBuf], plots_dir: &Path, re
     );
     let files: Vec<String> = digest::result_files(results_dir)
         .iter()
-        .filter_map(|(p, _)| p.file_name().map(|n| format!("[{}]({})", n.to_string_lossy(), md_target(plots_dir, p))))
+        .filter_map(|(p, _)| {
+            p.file_name().map(|n| format!("[{}]({})", md_text(&n.to_string_lossy()), md_target(plots_dir, p)))
+        })
         .collect();
     if !files.is_empty() {
         let _ = writeln!(out, "- **result files**: {}", files.join(", "));
     }
     let _ = writeln!(out, "- **notes**:{}", if m.notes.is_empty() { " none" } else { "" });
     m.notes.iter().take(NOTE_LINES).for_each(|n| {
-        let _ = writeln!(out, "  - {}", shorten(n, NOTE_CHARS));
+        let _ = writeln!(out, "  - {}", md_text(&shorten(n, NOTE_CHARS)));
     });
     if m.notes.len() > NOTE_LINES {
         let _ = writeln!(out, "  - ... {} more in summary.json (`meta.notes`)", m.notes.len() - NOTE_LINES);
@@ -355,7 +358,7 @@ fn results_section(out: &mut String, report: &RunReport, plots_dir: &Path, resul
 
 fn embed(out: &mut String, f: &FigureFiles, plots_dir: &Path) {
     let shown = f.png.as_deref().unwrap_or(f.shown());
-    let _ = write!(out, "\n![{}]({})", f.stem, md_target(plots_dir, shown));
+    let _ = write!(out, "\n![{}]({})", md_text(&f.stem), md_target(plots_dir, shown));
     if let (Some(svg), Some(_)) = (&f.svg, &f.png) {
         let _ = write!(out, "\n([SVG]({}))", md_target(plots_dir, svg));
     }
@@ -370,7 +373,7 @@ fn plots_section(out: &mut String, report: &RunReport, figures: &[FigureFiles], 
         out.push_str("No plots.\n");
     }
     for ((t, v), figs) in groups.iter().zip(&by_group).filter(|(_, f)| !f.is_empty()) {
-        let _ = writeln!(out, "### {t} / {v}");
+        let _ = writeln!(out, "### {} / {}", md_text(t), md_text(v));
         figs.iter().for_each(|f| embed(out, f, plots_dir));
         out.push('\n');
     }

@@ -225,9 +225,10 @@ fn mark(x: Option<bool>) -> &'static str {
     }
 }
 
-/// `calibration.md`: the table with the checks.
+/// `calibration.md`: the table with the checks (names escaped, [`md_text`]).
 pub fn markdown(rows: &[Row], header: &str) -> String {
-    let mut s = format!("# calibration\n\n{header}\n\n");
+    use crate::report::md_text;
+    let mut s = format!("# calibration\n\n{}\n\n", md_text(header));
     s.push_str("| test bed | estimator | claim | reps | seeds | tested % | false flags % at 5% [95% CI] | flagged % | pass % | power 1% | power 1% on pass | power 3% | detectable % | measured 80% point % | firefly bias % / flagged % | checks |\n");
     s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
@@ -240,10 +241,10 @@ pub fn markdown(rows: &[Row], header: &str) -> String {
         );
         s.push_str(&format!(
             "| {}/{} | {} | {} | {} | {} | {} | {} [{}, {}] | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} |\n",
-            r.testbed,
-            r.variant,
-            r.estimator,
-            r.claim,
+            md_text(&r.testbed),
+            md_text(&r.variant),
+            md_text(&r.estimator),
+            md_text(&r.claim),
             r.reps,
             r.seeds,
             pct(r.tested_fraction),
@@ -360,6 +361,21 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn calibration_md_escapes_names_and_claims() {
+        let r = Row {
+            testbed: "t<script>".into(),
+            variant: "v|w".into(),
+            estimator: "<img src=x onerror=alert(1)>".into(),
+            claim: "a & b".into(),
+            ..Row::default()
+        };
+        let md = markdown(&[r], "seeds <b>");
+        assert!(!md.contains('<') && !md.contains('>'), "{md}");
+        assert!(md.contains("| t&lt;script&gt;/v\\|w | &lt;img src=x onerror=alert(1)&gt; | a &amp; b |"), "{md}");
+        assert!(md.contains("seeds &lt;b&gt;"), "{md}");
+    }
 
     #[test]
     fn wilson_interval_matches_known_values() {

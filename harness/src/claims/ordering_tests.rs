@@ -121,7 +121,7 @@ fn self_comparisons_are_refused() {
     ] {
         let spec: ClaimSpec = toml::from_str(&format!("testbed = 'gradient-plane/default'\ntext = 't'\n{text}"))
             .unwrap_or_else(|e| panic!("{e}"));
-        let err = spec.check().expect_err(text);
+        let err = spec.check().expect_err(text).to_string();
         assert!(err.contains("compares a with itself"), "{err}");
         let c = spec.judge(&r);
         assert_eq!((c.verdict.as_str(), c.held), ("not measured", None), "{c:?}");

@@ -55,16 +55,33 @@ pub fn shorten(text: &str, max: usize) -> String {
     }
 }
 
-fn cell(text: &str) -> String {
-    text.replace('|', "\\|").replace(['\n', '\r'], " ")
+/// Text from outside the harness's own words (a claim, a label, a note, a name read from a config,
+/// a registry entry or a stored file) made safe to put in markdown, in a table cell or in prose:
+/// `&`, `<` and `>` become character references, so no HTML tag reaches a viewer; `|` and `\` are
+/// backslash-escaped, so a table cell cannot be split; line breaks become spaces. Backticks are
+/// kept, so an id in backticks stays code.
+pub fn md_text(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '|' => out.push_str("\\|"),
+            '\\' => out.push_str("\\\\"),
+            '\n' | '\r' => out.push(' '),
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 /// A GitHub-flavoured markdown table with padded columns (readable as plain text too). Rows
-/// shorter than the header are padded with empty cells; `|` in cells is escaped.
+/// shorter than the header are padded with empty cells; every cell is escaped ([`md_text`]).
 pub fn markdown_table(header: &[&str], rows: &[Vec<String>]) -> String {
     let ncol = header.len().max(rows.iter().map(Vec::len).max().unwrap_or(0));
-    let grid: Vec<Vec<String>> = std::iter::once(header.iter().map(|h| cell(h)).collect::<Vec<_>>())
-        .chain(rows.iter().map(|r| r.iter().map(|c| cell(c)).collect()))
+    let grid: Vec<Vec<String>> = std::iter::once(header.iter().map(|h| md_text(h)).collect::<Vec<_>>())
+        .chain(rows.iter().map(|r| r.iter().map(|c| md_text(c)).collect()))
         .map(|mut r| {
             r.resize(ncol, String::new());
             r
@@ -103,10 +120,11 @@ pub fn relative_path(from: &Path, to: &Path) -> String {
     rel.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect::<Vec<_>>().join("/")
 }
 
-/// [`relative_path`] as a markdown link target (in `<>` when it holds a space or bracket).
+/// [`relative_path`] as a markdown link target: `%`, `<` and `>` percent-encoded (a file name
+/// cannot open an HTML tag), in `<>` when it holds a space or bracket.
 pub fn md_target(from: &Path, to: &Path) -> String {
-    let s = relative_path(from, to);
-    if s.contains([' ', '(', ')', '<', '>']) {
+    let s = relative_path(from, to).replace('%', "%25").replace('<', "%3C").replace('>', "%3E");
+    if s.contains([' ', '(', ')']) {
         format!("<{s}>")
     } else {
         s
@@ -137,6 +155,24 @@ mod tests {
         assert!(lines.iter().all(|l| l.chars().count() == lines[0].chars().count()), "{t}");
         assert!(t.contains("x\\|y"));
         assert!(lines[1].starts_with("|---"));
+    }
+
+    #[test]
+    fn text_is_escaped_for_markdown_and_ids_stay_readable() {
+        let raw = "<script>alert(1)</script> & <img src=x onerror=alert(1)> a|b c\\|d\nnext `is0_cv0`";
+        let safe = md_text(raw);
+        assert_eq!(
+            safe,
+            "&lt;script&gt;alert(1)&lt;/script&gt; &amp; &lt;img src=x onerror=alert(1)&gt; a\\|b c\\\\\\|d next `is0_cv0`"
+        );
+        let t = markdown_table(&["claim"], &[vec![raw.to_string()]]);
+        assert!(!t.contains('<') && !t.contains('>') && t.lines().count() == 3, "{t}");
+        assert_eq!(
+            md_text("spm_adaptive[sigma_samp=0.8] on eq21-medium/multiple"),
+            "spm_adaptive[sigma_samp=0.8] on eq21-medium/multiple"
+        );
+        assert_eq!(md_target(Path::new("/a"), Path::new("/a/<img src=x>.svg")), "<%3Cimg src=x%3E.svg>");
+        assert_eq!(md_target(Path::new("/a"), Path::new("/a/50%.csv")), "50%25.csv");
     }
 
     #[test]

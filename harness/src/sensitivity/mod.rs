@@ -173,7 +173,7 @@ impl Part {
                 self.vary
             ));
         }
-        self.claim.check()
+        self.claim.check().map_err(|e| e.to_string())
     }
 
     /// The mode's repetitions and budgets.

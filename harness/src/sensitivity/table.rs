@@ -85,8 +85,10 @@ fn num(x: Option<f64>) -> String {
     x.map_or("-".into(), |v| format!("{v:.4}"))
 }
 
-/// `sensitivity.md`: the outcome table, then per part its settings.
+/// `sensitivity.md`: the outcome table, then per part its settings (every text of the file and of
+/// the verdicts escaped, [`md_text`]).
 pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
+    use crate::report::md_text;
     let mut s = String::from(
         "# Where each claim holds\n\n| paper | claim | against | at our default | at the paper-like setting | outcome |\n|---|---|---|---|---|---|\n",
     );
@@ -95,20 +97,21 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
             v.and_then(|v| rows.iter().find(|r| r.part == p.id && r.setting == setting_text(v)))
                 .map_or("-".to_string(), |r| format!("{} = {}: {} ({})", p.vary, r.setting, num(r.value), r.verdict))
         };
-        let (default, paper_like) = (at(Some(&p.default)), at(p.paper_like.as_ref()));
-        let outcome = o.sentence().replace('|', "/");
-        let _ = writeln!(s, "| {} | {} | {} | {default} | {paper_like} | {outcome} |", p.paper, p.headline, p.vary);
+        let (default, paper_like) = (md_text(&at(Some(&p.default))), md_text(&at(p.paper_like.as_ref())));
+        let outcome = md_text(&o.sentence());
+        let (paper, headline, vary) = (md_text(&p.paper), md_text(&p.headline), md_text(&p.vary));
+        let _ = writeln!(s, "| {paper} | {headline} | {vary} | {default} | {paper_like} | {outcome} |");
     }
     for (p, o) in outcomes {
         let _ = write!(
             s,
             "\n## {} (paper {}) against {}\n\n{}\n\n**{}.** {}\n\n",
-            p.headline,
-            p.paper,
-            p.vary,
-            p.open,
-            o.kind(),
-            o.sentence()
+            md_text(&p.headline),
+            md_text(&p.paper),
+            md_text(&p.vary),
+            md_text(&p.open),
+            md_text(o.kind()),
+            md_text(&o.sentence())
         );
         s.push_str("| setting | role | ours | interval | paper | verdict | ceiling | reason |\n|---|---|---|---|---|---|---|---|\n");
         for r in rows.iter().filter(|r| r.part == p.id) {
@@ -119,14 +122,14 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
             let _ = writeln!(
                 s,
                 "| {} | {} | {} | {} | {} | {} | {} | {} |",
-                r.setting,
-                r.role,
+                md_text(&r.setting),
+                md_text(&r.role),
                 num(r.value),
                 interval,
                 num(r.paper_value),
-                r.verdict,
+                md_text(&r.verdict),
                 num(r.ceiling),
-                r.reason.replace('|', "/")
+                md_text(&r.reason)
             );
         }
     }

@@ -153,3 +153,21 @@ fn the_work_ratio_ceiling_divides_error_times_rays_by_the_claims_own_error() {
     // an error ratio has no work ratio.
     assert_eq!(ceiling(Ceiling::WorkRatio, &spec(&format!("{r}metric = 'rmse'")), None, &report), None);
 }
+
+#[test]
+fn sensitivity_md_escapes_the_files_text_and_the_reasons() {
+    let tag = "<img src=x onerror=alert(1)>";
+    let f = file_with(("open = \"o\"", "open = \"<script>alert(1)</script>\"")).unwrap();
+    let mut p = f.parts[0].clone();
+    p.headline = format!("h {tag}");
+    let mut a = row("1", "paper-like", 4.0, "not held", Some(5.0));
+    a.reason = format!("because {tag} | and\nmore");
+    let b = row("5", "default", 2.0, "not held", Some(3.0));
+    let outcome = classify(&p, &[&a, &b]);
+    let md = super::table::markdown(&[(&p, outcome)], &[a, b]);
+    assert!(!md.contains('<') && !md.contains('>'), "{md}");
+    assert!(
+        md.contains("&lt;script&gt;alert(1)&lt;/script&gt;") && md.contains("h &lt;img src=x onerror=alert(1)&gt;")
+    );
+    assert!(md.contains("| because &lt;img src=x onerror=alert(1)&gt; \\| and more |"), "{md}");
+}
