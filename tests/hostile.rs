@@ -91,7 +91,7 @@ fn finished() -> tempfile::TempDir {
     dir
 }
 
-/// Item 1: a lock file that is a symbolic link (to a real file, or dangling) is refused with exit
+/// A lock file that is a symbolic link (to a real file, or dangling) is refused with exit
 /// 2 naming it, by every command that locks a folder, for results, plots and references folders;
 /// the link stays, the file it points to keeps its bytes, a dangling one's target is not created.
 #[test]
@@ -123,7 +123,7 @@ fn a_linked_lock_file_is_refused_and_left_alone() {
     ok(d, &["plot", "results/tiny"]);
 }
 
-/// Item 2: a refusal that comes once a lock is taken, or at a lock, leaves no folder behind:
+/// A refusal that comes once a lock is taken, or at a lock, leaves no folder behind:
 /// `merge` into a folder whose cell store is a folder, and runs refused because another holds
 /// the plots folder or the results folder (exit 3), into roots that did not exist.
 #[test]
@@ -148,7 +148,7 @@ fn refusals_leave_no_new_folder() {
     ok(d, &run);
 }
 
-/// Item 3: an experiment's results or plots folder (or a shard's, or the references folder
+/// An experiment's results or plots folder (or a shard's, or the references folder
 /// below a results root) that is a symbolic link, dangling or to a folder elsewhere, is refused
 /// with exit 2 naming it, and nothing is written there. A root the user names may be a link.
 #[test]
@@ -191,7 +191,7 @@ fn links_in_place_of_an_experiment_folder_are_refused() {
     assert!(d.join("outside/empty/tiny/summary.csv").is_file());
 }
 
-/// Item 4: a stored reference whose standard errors or values would make a metric infinite or
+/// A stored reference whose standard errors or values would make a metric infinite or
 /// NaN (1e308: the MSE subtracts their squares), that holds a NaN or a negative standard error,
 /// or whose resolution is not the test bed's, is refused with exit 2 naming the file and the
 /// field; nothing is written.
