@@ -307,7 +307,8 @@ fn edited_manifests_never_panic_and_fail_in_one_line() {
 
 /// Random edits of a stored reference (the gradient-box file of the repository): parsing and
 /// checking it against its test bed never panics, and every reference that passes has the test
-/// bed's shape, finite values and non-negative standard errors.
+/// bed's shape and resolution, finite values and non-negative standard errors, all small enough
+/// that their squares, which the metrics sum, stay finite.
 #[test]
 fn edited_references_never_panic_and_pass_only_when_well_formed() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/references/gradient-box_albedo-0.8.json");
@@ -316,16 +317,18 @@ fn edited_references_never_panic_and_pass_only_when_well_formed() {
         .run(&edits(), |edits| {
             let text = mutate(&original, &edits);
             let outcome = catch_unwind(AssertUnwindSafe(|| {
-                let doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| e.to_string())?;
-                let r: estimators::testbed::Reference =
-                    serde_json::from_value(doc["reference"].clone()).map_err(|e| e.to_string())?;
-                r.check(256).map(|()| r)
+                let s: estimators::references::StoredReference =
+                    serde_json::from_str(&text).map_err(|e| e.to_string())?;
+                s.check(256, (16, 16)).map(|()| s)
             }));
             match outcome {
                 Err(_) => prop_assert!(false, "panicked"),
-                Ok(Ok(r)) => {
-                    prop_assert!(r.value.len() == 256 && r.std_err.len() == 256);
-                    prop_assert!(r.std_err.iter().all(|s| s.0.iter().all(|&x| x >= 0.0 && x.is_finite())));
+                Ok(Ok(s)) => {
+                    let r = &s.reference;
+                    prop_assert!(s.resolution == (16, 16) && r.value.len() == 256 && r.std_err.len() == 256);
+                    let squared = |x: f64| (x * x * 768.0).is_finite();
+                    prop_assert!(r.value.iter().all(|v| v.0.iter().all(|&x| squared(x))));
+                    prop_assert!(r.std_err.iter().all(|s| s.0.iter().all(|&x| x >= 0.0 && squared(x))));
                 }
                 Ok(Err(why)) => prop_assert!(!why.is_empty() && why.lines().count() == 1, "{why}"),
             }

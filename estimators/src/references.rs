@@ -83,6 +83,22 @@ impl StoredReference {
     pub fn matches(&self, key: &ReferenceKey) -> bool {
         self.testbed == key.testbed && self.variant == key.variant && self.params == key.params
     }
+
+    /// Checks a stored reference read back for a test bed of `integrals` integrals at
+    /// `resolution`: its `resolution` is the test bed's, and its [`Reference::check`] passes (one
+    /// value and one standard error per integral, each bounded). `Err` says what is wrong, naming
+    /// the field.
+    pub fn check(&self, integrals: usize, resolution: (usize, usize)) -> Result<(), String> {
+        if self.resolution != resolution {
+            let ((w, h), (bw, bh)) = (self.resolution, resolution);
+            return Err(format!(
+                "resolution [{w}, {h}] is not the test bed's [{bw}, {bh}] ({} values and {} standard errors)",
+                self.reference.value.len(),
+                self.reference.std_err.len()
+            ));
+        }
+        self.reference.check(integrals)
+    }
 }
 
 /// Where test beds find stored references.
@@ -107,9 +123,9 @@ impl StoredReference {
 ///     reference,
 /// };
 /// let source = InMemory(vec![stored]);
-/// assert_eq!(load(&source, &key, 1).unwrap().value[0][0], 0.5);
+/// assert_eq!(load(&source, &key, 1, (1, 1)).unwrap().value[0][0], 0.5);
 /// let other = ReferenceKey::new("my-bed", "default", &[("resolution", 2.into())], false);
-/// assert!(load(&source, &other, 4).unwrap_err().to_string().contains("--param resolution=2"));
+/// assert!(load(&source, &other, 4, (2, 2)).unwrap_err().to_string().contains("--param resolution=2"));
 /// assert!(source.stored(&other).unwrap().is_none());
 /// ```
 pub trait ReferenceSource: Send + Sync {
@@ -146,9 +162,14 @@ impl ReferenceSource for InMemory {
     }
 }
 
-/// The reference of `key` from `source`, checked against the `integrals` of the test bed: absent
-/// is an error that says how to make it.
-pub fn load(source: &dyn ReferenceSource, key: &ReferenceKey, integrals: usize) -> Result<Reference, ConfigError> {
+/// The reference of `key` from `source`, checked against the `integrals` and `resolution` of the
+/// test bed ([`StoredReference::check`]): absent is an error that says how to make it.
+pub fn load(
+    source: &dyn ReferenceSource,
+    key: &ReferenceKey,
+    integrals: usize,
+    resolution: (usize, usize),
+) -> Result<Reference, ConfigError> {
     let field = format!("{}/{} reference", key.testbed, key.variant);
     let stored = source.stored(key)?.ok_or_else(|| {
         ConfigError::invalid(
@@ -162,8 +183,7 @@ pub fn load(source: &dyn ReferenceSource, key: &ReferenceKey, integrals: usize) 
         )
     })?;
     stored
-        .reference
-        .check(integrals)
+        .check(integrals, resolution)
         .map_err(|e| ConfigError::invalid(field, key.file_name(), format!("malformed ({e})")))?;
     Ok(stored.reference)
 }
@@ -171,22 +191,22 @@ pub fn load(source: &dyn ReferenceSource, key: &ReferenceKey, integrals: usize) 
 /// The stored exact reference of `key` in `source` when there is one made by `method` (a
 /// quadrature worth storing: it is then read instead of computed at every build; a stored one of
 /// another method is ignored, so a change of the quadrature never reads stale values); checked
-/// against the `integrals` of the test bed.
+/// against the `integrals` and `resolution` of the test bed ([`StoredReference::check`]).
 pub fn stored_exact(
     source: &dyn ReferenceSource,
     key: &ReferenceKey,
     method: &str,
     integrals: usize,
+    resolution: (usize, usize),
 ) -> Result<Option<Reference>, ConfigError> {
     let Some(stored) = source.stored(key)? else { return Ok(None) };
-    let r = stored.reference;
-    if !matches!(&r.kind, crate::testbed::ReferenceKind::Exact { method: m, .. } if m == method) {
+    if !matches!(&stored.reference.kind, crate::testbed::ReferenceKind::Exact { method: m, .. } if m == method) {
         return Ok(None);
     }
-    r.check(integrals).map_err(|e| {
+    stored.check(integrals, resolution).map_err(|e| {
         ConfigError::invalid(format!("{} reference", key.describe()), key.file_name(), format!("malformed ({e})"))
     })?;
-    Ok(Some(r))
+    Ok(Some(stored.reference))
 }
 
 /// The repository's stored references (`results/references`), for the library's own tests.
@@ -209,5 +229,57 @@ pub(crate) mod repository {
         fn location(&self) -> String {
             "results/references".into()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Rgb;
+    use crate::testbed::ReferenceKind;
+
+    fn stored(value: f64, std_err: f64) -> StoredReference {
+        StoredReference {
+            testbed: "bed".into(),
+            variant: "default".into(),
+            params: Default::default(),
+            command: "made".into(),
+            resolution: (2, 2),
+            reference: Reference {
+                kind: ReferenceKind::Stored { command: "made".into(), samples: 64 },
+                value: vec![Rgb([value; 3]); 4],
+                std_err: vec![Rgb([std_err; 3]); 4],
+            },
+        }
+    }
+
+    #[test]
+    fn stored_references_whose_numbers_break_a_metric_are_refused_naming_the_field() {
+        assert_eq!(stored(0.5, 0.01).check(4, (2, 2)), Ok(()));
+        assert_eq!(stored(-3.0, 0.0).check(4, (2, 2)), Ok(()), "negative values and zero errors are fine");
+        assert_eq!(stored(Reference::LARGEST, Reference::LARGEST).check(4, (2, 2)), Ok(()));
+        for (value, std_err, field) in [
+            (0.5, 1e308, "std_err[0]"),
+            (0.5, 1e151, "std_err[0]"),
+            (0.5, f64::NAN, "std_err[0]"),
+            (0.5, f64::INFINITY, "std_err[0]"),
+            (0.5, -0.01, "std_err[0]"),
+            (1e300, 0.01, "value[0]"),
+            (f64::NAN, 0.01, "value[0]"),
+            (-f64::INFINITY, 0.01, "value[0]"),
+        ] {
+            let e = stored(value, std_err).check(4, (2, 2)).expect_err("refused");
+            assert!(e.starts_with(field), "{value} {std_err}: {e}");
+        }
+        // The standard error of the last integral alone.
+        let mut s = stored(0.5, 0.01);
+        s.reference.std_err[3].0[2] = 1e200;
+        assert!(s.check(4, (2, 2)).expect_err("refused").starts_with("std_err[3]"));
+        // The resolution is the test bed's, and the values are one per integral.
+        let e = stored(0.5, 0.01).check(4, (4, 1)).expect_err("refused");
+        assert!(e.starts_with("resolution [2, 2] is not the test bed's [4, 1]"), "{e}");
+        let mut s = stored(0.5, 0.01);
+        s.reference.std_err.pop();
+        assert!(s.check(4, (2, 2)).expect_err("refused").contains("3 standard errors"));
     }
 }

@@ -104,10 +104,16 @@ impl Reference {
         matches!(self.kind, ReferenceKind::Exact { .. })
     }
 
+    /// The largest magnitude of a value or standard error a reference read back may hold
+    /// ([`Reference::check`]): squares and their sums over any test bed stay finite, so every
+    /// metric computed against it (the MSE subtracts the squared standard errors) does.
+    pub const LARGEST: f64 = 1e150;
+
     /// Checks a reference read back from a file against the test bed it is for: `integrals`
-    /// values and as many standard errors, every number finite, standard errors non-negative
-    /// (and zero for an exact reference, whose bound must be finite and non-negative), a stored
-    /// reference made of at least two samples. `Err` says what is wrong.
+    /// values and as many standard errors, every number finite and at most [`Reference::LARGEST`]
+    /// in magnitude, standard errors non-negative (and zero for an exact reference, whose bound
+    /// must be finite and non-negative), a stored reference made of at least two samples. `Err`
+    /// says what is wrong, naming the field (`value`, `std_err`, with the index).
     pub fn check(&self, integrals: usize) -> Result<(), String> {
         if self.value.len() != integrals || self.std_err.len() != integrals {
             return Err(format!(
@@ -116,11 +122,20 @@ impl Reference {
                 self.std_err.len()
             ));
         }
-        if let Some(i) = self.value.iter().position(|v| !v.is_finite()) {
-            return Err(format!("value {i} is not finite"));
+        let bounded = |x: f64| x.is_finite() && x.abs() <= Self::LARGEST;
+        if let Some(i) = self.value.iter().position(|v| !v.0.iter().all(|&x| bounded(x))) {
+            return Err(format!(
+                "value[{i}] = {:?} is not finite or beyond {:e} in magnitude",
+                self.value[i].0,
+                Self::LARGEST
+            ));
         }
-        if let Some(i) = self.std_err.iter().position(|s| !s.is_finite() || s.0.iter().any(|&x| x < 0.0)) {
-            return Err(format!("standard error {i} is negative or not finite"));
+        if let Some(i) = self.std_err.iter().position(|s| !s.0.iter().all(|&x| bounded(x) && x >= 0.0)) {
+            return Err(format!(
+                "std_err[{i}] = {:?}: a standard error is finite, not negative and at most {:e}",
+                self.std_err[i].0,
+                Self::LARGEST
+            ));
         }
         match &self.kind {
             ReferenceKind::Exact { bound, .. } => {

@@ -456,7 +456,7 @@ fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, regi
     let _read = crate::folder::read_lock(results_dir, wait)?;
     let report = crate::output::read_results(results_dir)?;
     let dir = plots.join(&name);
-    crate::folder::check_output_dir("--plots", &dir)?;
+    crate::folder::check_own_dir("--plots", &dir)?;
     let _lock = crate::folder::FolderLock::acquire(&dir, wait, &[])?;
     execute::draw(&report, &dir, results_dir, registry.display_names())?;
     println!("plots, report.md and index.html written to {}", dir.display());
@@ -471,10 +471,19 @@ fn reference(args: ReferenceArgs, registry: &Registry) -> Result<()> {
     let entry = registry.test_bed(&args.testbed)?;
     let variant = args.variant.clone().unwrap_or_else(|| entry.variants[0].to_string());
     let params = param_pairs(&args.params)?;
-    let field = if args.references.is_some() { "--references" } else { "--results" };
-    let folder =
-        crate::references::ReferenceDir::new(args.references.unwrap_or_else(|| args.results.join("references")));
-    crate::folder::check_output_dir(field, folder.path())?;
+    // A folder named with --references is used as named; `<results>/references` must be a folder
+    // of its own, not a symbolic link.
+    let folder = match args.references {
+        Some(dir) => {
+            crate::folder::check_output_dir("--references", &dir)?;
+            crate::references::ReferenceDir::new(dir)
+        }
+        None => {
+            let dir = args.results.join("references");
+            crate::folder::check_own_dir("--results", &dir)?;
+            crate::references::ReferenceDir::new(dir)
+        }
+    };
     let t0 = Instant::now();
     let made = crate::references::make(entry, &variant, &params, args.samples, &folder, args.wait)?;
     let r = &made.stored.reference;

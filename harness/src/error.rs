@@ -5,7 +5,7 @@
 //! |---|---|---|
 //! | 0 | success | |
 //! | 1 | failure while running or writing, or a failed check | an estimator failed, the disk filled up, an estimator failed `mcbench conformance` |
-//! | 2 | bad input: nothing was run or written | unknown names, values out of bounds, a config, stored cell, reference, manifest or summary file that is malformed or inconsistent, an output path that is not a writable folder |
+//! | 2 | bad input: nothing was run or written | unknown names, values out of bounds, a config, stored cell, reference, manifest or summary file that is malformed or inconsistent, an output path that is not a writable folder, a symbolic link in place of a lock file or of an experiment's folder |
 //! | 3 | busy: another mcbench holds the results folder | a second run into the same folder (`--wait` waits instead) |
 
 use estimators::error::ConfigError;

@@ -5,7 +5,7 @@ use crate::analysis::{self, TestRow};
 use crate::cell::CellResult;
 use crate::config::Sweep;
 use crate::error::Result;
-use crate::folder::{check_output_dir, FolderLock, OutputDir};
+use crate::folder::{check_own_dir, FolderLock, OutputDir};
 use crate::integrals::{IntegralRow, IntegralsFormat};
 use crate::metrics::SummaryRow;
 use crate::output::{self, Diagnostic, Meta, RunReport};
@@ -67,9 +67,9 @@ pub struct Preflight {
 /// output folders are folders or can be made, and every stored cell it will read is well formed.
 pub fn preflight(plan: &Plan, def: Option<&Experiment>, opts: &ExecOptions<'_>) -> Result<Preflight> {
     let results_dir = opts.results_root.join(&plan.sweep.experiment);
-    check_output_dir("--results", &results_dir)?;
+    check_own_dir("--results", &results_dir)?;
     if opts.plots {
-        check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
+        check_own_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
     }
     let cells = results_dir.join(crate::store::CELLS);
     let stored = runner::preload(plan, Some(&cells))?;

@@ -55,6 +55,21 @@ pub fn check_output_dir(field: &'static str, path: &Path) -> Result<()> {
     }
 }
 
+/// Checks a folder mcbench names below a root the user gave (`<results>/<experiment>`, a shard
+/// folder, `<plots>/<experiment>`, `<results>/references`): as [`check_output_dir`], and it is not
+/// a symbolic link (dangling or not), which would have the run write outside the folders named.
+/// `field` names the flag of the root.
+pub fn check_own_dir(field: &'static str, path: &Path) -> Result<()> {
+    if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+        return Err(HarnessError::bad_output(
+            field,
+            path,
+            "is a symbolic link; mcbench writes into real folders below the one named, never through a link: remove it",
+        ));
+    }
+    check_output_dir(field, path)
+}
+
 /// Whether `name` is a temporary file of an atomic write (`.<name>.tmp-<pid>[...]`).
 fn is_temp(name: &str) -> bool {
     name.starts_with('.') && name.contains(".tmp-")
@@ -65,7 +80,9 @@ fn is_temp(name: &str) -> bool {
 pub(crate) fn remove_stale_temps(dir: &Path) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
-        if e.file_name().to_str().is_some_and(is_temp) && e.path().is_file() {
+        // A symbolic link by that name goes too (the link, not what it points to).
+        let plain = e.file_type().is_ok_and(|t| t.is_file() || t.is_symlink());
+        if e.file_name().to_str().is_some_and(is_temp) && plain {
             let _ = std::fs::remove_file(e.path());
         }
     }
@@ -262,6 +279,49 @@ mod tests {
         drop(lock);
         assert!(FolderLock::acquire(&d, false, &[]).is_ok());
         assert!(read_lock(&d, false).expect("free").is_some());
+    }
+
+    #[test]
+    #[cfg(unix)]
+    fn temp_files_are_never_written_through_a_link() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let d = dir.path().join("r");
+        std::fs::create_dir(&d).expect("folder");
+        let outside = dir.path().join("outside");
+        std::fs::write(&outside, b"precious").expect("file");
+        // A link where this process's next temp file goes, and a dangling one a killed writer's
+        // name: the write replaces the first, the lock removes the second, neither is followed.
+        let tmp = d.join(format!(".a.csv.tmp-{}", std::process::id()));
+        std::os::unix::fs::symlink(&outside, &tmp).expect("link");
+        crate::output::write_atomic(&d.join("a.csv"), b"x,y\n").expect("written");
+        assert_eq!(std::fs::read(&outside).expect("outside"), b"precious");
+        assert!(std::fs::symlink_metadata(&tmp).is_err(), "the temp name is free again");
+        let stale = d.join(".b.csv.tmp-4242");
+        std::os::unix::fs::symlink(dir.path().join("gone"), &stale).expect("link");
+        drop(FolderLock::acquire(&d, false, &[]).expect("free"));
+        assert!(std::fs::symlink_metadata(&stale).is_err(), "removed");
+        assert!(!dir.path().join("gone").exists());
+    }
+
+    #[test]
+    #[cfg(unix)]
+    fn folders_below_a_root_are_not_links() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let elsewhere = dir.path().join("elsewhere");
+        std::fs::create_dir(&elsewhere).expect("folder");
+        let root = dir.path().join("results");
+        std::fs::create_dir(&root).expect("root");
+        std::os::unix::fs::symlink(&elsewhere, root.join("to-folder")).expect("link");
+        std::os::unix::fs::symlink(dir.path().join("gone"), root.join("dangling")).expect("link");
+        for name in ["to-folder", "dangling"] {
+            let e = check_own_dir("--results", &root.join(name)).expect_err("a link");
+            assert!(e.exit_code() == 2 && e.to_string().contains("is a symbolic link"), "{e}");
+        }
+        assert!(check_own_dir("--results", &root.join("new")).is_ok());
+        // The root itself may be a link: the user named it.
+        let linked_root = dir.path().join("linked");
+        std::os::unix::fs::symlink(&elsewhere, &linked_root).expect("link");
+        assert!(check_own_dir("--results", &linked_root.join("x")).is_ok());
     }
 
     #[test]

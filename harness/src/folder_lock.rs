@@ -11,31 +11,61 @@
 
 use crate::error::{HarnessError, Result};
 use crate::folder::LOCK;
+use crate::made_dirs::MadeDirs;
 use std::fs::{File, OpenOptions, TryLockError};
-use std::io::{Read, Write};
+use std::io::{ErrorKind, Read, Write};
 use std::path::{Path, PathBuf};
+
+/// How often a writer starts again when a folder it made or found vanished before it opened the
+/// lock file in it (another writer removed the empty folder it had made as it let go).
+const RETRIES: usize = 100;
 
 /// An exclusive hold on a folder: only one mcbench writes a folder at a time. Released when
 /// dropped (the lock file is removed, then closed), and by the system when the process dies (the
-/// file of a killed holder stays until the next holder releases it).
+/// file of a killed holder stays until the next holder releases it). The folders it made are
+/// removed again on release when they are still empty, so a refused command leaves none behind.
 #[derive(Debug)]
 pub struct FolderLock {
     _file: File,
     #[cfg_attr(not(unix), allow(dead_code))]
     path: PathBuf,
     dir: PathBuf,
+    _made: MadeDirs,
 }
 
 impl FolderLock {
     /// Creates `dir` if needed and takes its lock; with `wait`, blocks until the holder is done,
     /// else refuses with [`HarnessError::Busy`] (exit 3). Then removes stale temporary files
-    /// (`.<name>.tmp-<pid>...`) that killed writers left in `dir` and in `subdirs` of it.
+    /// (`.<name>.tmp-<pid>...`) that killed writers left in `dir` and in `subdirs` of it. A lock
+    /// file that is a symbolic link, or not a plain file of one link, is refused (exit 2) and left
+    /// as it is: the lock never opens a file outside `dir`, nor writes one. On a refusal the
+    /// folders it made are removed again.
     pub fn acquire(dir: &Path, wait: bool, subdirs: &[&str]) -> Result<FolderLock> {
-        std::fs::create_dir_all(dir).map_err(|e| HarnessError::write(dir, e))?;
         let path = dir.join(LOCK);
         let io = |e: std::io::Error| HarnessError::write(&path, e);
+        let mut made = MadeDirs::default();
+        let mut retries = 0;
         let mut file = loop {
-            let file = open(&path).map_err(io)?;
+            match MadeDirs::create(dir) {
+                Ok(m) => made.absorb(m),
+                Err(e) if e.kind() == ErrorKind::NotFound && retries < RETRIES => {
+                    retries += 1;
+                    continue;
+                }
+                Err(e) => return Err(HarnessError::write(dir, e)),
+            }
+            let file = match open(&path, true) {
+                Ok(f) => f,
+                Err(e) if e.kind() == ErrorKind::NotFound && is_link(dir) => {
+                    return Err(HarnessError::bad_file(dir, "is a symbolic link to nothing"));
+                }
+                Err(e) if e.kind() == ErrorKind::NotFound && retries < RETRIES => {
+                    retries += 1;
+                    continue;
+                }
+                Err(e) => return Err(refusal(&path, e, |p, e| HarnessError::write(p, e))),
+            };
+            check_plain(&path, &file)?;
             match file.try_lock() {
                 Ok(()) => {}
                 Err(TryLockError::WouldBlock) if wait => file.lock().map_err(io)?,
@@ -53,7 +83,7 @@ impl FolderLock {
         for s in subdirs {
             crate::folder::remove_stale_temps(&dir.join(s));
         }
-        Ok(FolderLock { _file: file, path, dir: dir.to_path_buf() })
+        Ok(FolderLock { _file: file, path, dir: dir.to_path_buf(), _made: made })
     }
 
     /// The locked folder.
@@ -66,7 +96,8 @@ impl FolderLock {
 #[cfg(unix)]
 impl Drop for FolderLock {
     fn drop(&mut self) {
-        // Removed while still held; closing the file (dropping the field, after this) unlocks it.
+        // Removed while still held; closing the file (dropping the field, after this) unlocks it,
+        // then the folders it made go if nothing else is in them.
         let _ = std::fs::remove_file(&self.path);
     }
 }
@@ -96,13 +127,21 @@ impl Drop for ReadLock {
 /// until the writer is done, else refuses with [`HarnessError::Busy`] (exit 3). The reader creates
 /// the lock file if no one holds the folder now, and the last holder out removes it again. A
 /// folder that does not exist is read without a lock and stays missing (nothing is created); so
-/// is a folder the reader cannot write that has no lock file.
+/// is a folder the reader cannot write that has no lock file. A lock file that is a symbolic link
+/// or not a plain file is refused (exit 2) and left as it is.
 pub fn read_lock(dir: &Path, wait: bool) -> Result<Option<ReadLock>> {
     let path = dir.join(LOCK);
     let io = |e: std::io::Error| HarnessError::bad_file(&path, e);
     loop {
         // Read-write (and created) where it can be; read-only, for an existing file, where not.
-        let Ok(file) = open(&path).or_else(|_| File::open(&path)) else { return Ok(None) };
+        let file = match open(&path, true).or_else(|_| open(&path, false)) {
+            Ok(f) => f,
+            Err(e) if std::fs::symlink_metadata(&path).is_ok_and(|m| !m.is_file()) => {
+                return Err(refusal(&path, e, |p, e| HarnessError::bad_file(p, e)))
+            }
+            Err(_) => return Ok(None),
+        };
+        check_plain(&path, &file)?;
         match file.try_lock_shared() {
             Ok(()) => {}
             Err(TryLockError::WouldBlock) if wait => file.lock_shared().map_err(io)?,
@@ -116,20 +155,74 @@ pub fn read_lock(dir: &Path, wait: bool) -> Result<Option<ReadLock>> {
     }
 }
 
-/// Opens (creating it if needed) the lock file at `path`, read-write.
-fn open(path: &Path) -> std::io::Result<File> {
-    OpenOptions::new().create(true).truncate(false).read(true).write(true).open(path)
+/// Opens the lock file at `path` without following a symbolic link there (the open fails on
+/// one): read-write and created if needed with `write`, else read-only. Non-blocking, so that a
+/// FIFO in its place cannot hang the open (a lock file is a regular file, where the flag changes
+/// nothing: `flock` blocks or not by its own flag).
+fn open(path: &Path, write: bool) -> std::io::Result<File> {
+    let mut o = OpenOptions::new();
+    o.read(true);
+    if write {
+        o.write(true).create(true).truncate(false);
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        o.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+    }
+    o.open(path)
+}
+
+/// Whether `path` is a symbolic link (dangling or not).
+fn is_link(path: &Path) -> bool {
+    std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink())
+}
+
+/// The error of a lock file that could not be opened: a symbolic link or a folder in its place is
+/// refused (exit 2) naming it; anything else is `other`'s.
+fn refusal(path: &Path, e: std::io::Error, other: fn(&Path, std::io::Error) -> HarnessError) -> HarnessError {
+    match std::fs::symlink_metadata(path).map(|m| m.file_type()) {
+        Ok(t) if t.is_symlink() => HarnessError::bad_file(
+            path,
+            "is a symbolic link; mcbench does not follow it (a lock file is a plain file it creates): remove it",
+        ),
+        Ok(t) if !t.is_file() => HarnessError::bad_file(path, NOT_PLAIN),
+        _ => other(path, e),
+    }
+}
+
+/// Why a lock file that is not a regular file is refused.
+const NOT_PLAIN: &str = "is not a plain file (mcbench creates it as one): remove it";
+
+/// Refuses (exit 2) an opened lock file that is not a regular file, or that has other hard links
+/// (its content would be written through them): mcbench creates it as a plain file of one link.
+fn check_plain(path: &Path, file: &File) -> Result<()> {
+    let m = file.metadata().map_err(|e| HarnessError::bad_file(path, e))?;
+    if !m.is_file() {
+        return Err(HarnessError::bad_file(path, NOT_PLAIN));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if m.nlink() > 1 {
+            return Err(HarnessError::bad_file(
+                path,
+                format!("has {} hard links (mcbench creates it with one): remove it", m.nlink()),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Whether `path` still names the open `file` (same device and inode): false once a releaser
-/// removed it, or replaced it with a fresh one.
+/// removed it, or replaced it with a fresh one (or anything else, a symbolic link included).
 #[cfg(unix)]
 fn names(path: &Path, file: &File) -> std::io::Result<bool> {
     use std::os::unix::fs::MetadataExt;
     let held = file.metadata()?;
-    match std::fs::metadata(path) {
+    match std::fs::symlink_metadata(path) {
         Ok(now) => Ok(now.dev() == held.dev() && now.ino() == held.ino()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(false),
+        Err(e) if e.kind() == ErrorKind::NotFound => Ok(false),
         Err(e) => Err(e),
     }
 }
@@ -151,96 +244,5 @@ fn busy(dir: &Path, mut file: &File) -> HarnessError {
 
 // The removal of the file is what they check, and it happens on unix only.
 #[cfg(all(test, unix))]
-mod tests {
-    use super::*;
-    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-
-    #[test]
-    fn a_released_lock_leaves_no_file() {
-        let dir = tempfile::tempdir().expect("tempdir");
-        let d = dir.path().join("r");
-        let lock = FolderLock::acquire(&d, false, &[]).expect("free");
-        let pid = std::fs::read_to_string(d.join(LOCK)).expect("held: the file is there");
-        assert_eq!(pid, std::process::id().to_string());
-        let e = FolderLock::acquire(&d, false, &[]).expect_err("held");
-        assert_eq!(e.exit_code(), 3, "{e}");
-        assert!(e.to_string().contains(&format!("(pid {pid})")), "{e}");
-        drop(lock);
-        assert!(!d.join(LOCK).exists(), "released");
-        assert!(std::fs::read_dir(&d).expect("folder").next().is_none(), "nothing left in the folder");
-        drop(FolderLock::acquire(&d, false, &[]).expect("free again"));
-        assert!(!d.join(LOCK).exists());
-    }
-
-    #[test]
-    fn the_last_reader_out_removes_the_file_and_a_missing_folder_stays_missing() {
-        let dir = tempfile::tempdir().expect("tempdir");
-        let missing = dir.path().join("missing");
-        assert!(read_lock(&missing, false).expect("no folder").is_none());
-        assert!(!missing.exists(), "nothing is created");
-        let d = dir.path().join("r");
-        std::fs::create_dir(&d).expect("folder");
-        let first = read_lock(&d, false).expect("free").expect("created");
-        let second = read_lock(&d, false).expect("readers share").expect("opened");
-        let e = FolderLock::acquire(&d, false, &[]).expect_err("readers hold it");
-        assert_eq!(e.exit_code(), 3, "{e}");
-        drop(first);
-        assert!(d.join(LOCK).exists(), "another reader still holds it");
-        drop(second);
-        assert!(!d.join(LOCK).exists(), "the last reader out removes it");
-        // A stale file (a killed holder's, whose flock the system released) is taken over and
-        // removed on release, by a writer or by a lone reader.
-        std::fs::write(d.join(LOCK), b"12345").expect("stale");
-        let lock = FolderLock::acquire(&d, false, &[]).expect("free");
-        assert_eq!(std::fs::read_to_string(d.join(LOCK)).expect("held"), std::process::id().to_string());
-        drop(lock);
-        assert!(!d.join(LOCK).exists());
-        std::fs::write(d.join(LOCK), b"12345").expect("stale");
-        drop(read_lock(&d, false).expect("free").expect("opened"));
-        assert!(!d.join(LOCK).exists());
-    }
-
-    #[test]
-    fn writers_never_overlap_each_other_or_readers() {
-        const WRITERS: usize = 4;
-        const READERS: usize = 2;
-        const ROUNDS: usize = 100;
-        let dir = tempfile::tempdir().expect("tempdir");
-        let d = dir.path().join("r");
-        std::fs::create_dir(&d).expect("folder");
-        let writing = AtomicBool::new(false);
-        let reading = AtomicUsize::new(0);
-        let count = AtomicUsize::new(0);
-        std::thread::scope(|s| {
-            for _ in 0..WRITERS {
-                s.spawn(|| {
-                    for _ in 0..ROUNDS {
-                        let lock = FolderLock::acquire(&d, true, &[]).expect("waits");
-                        assert!(!writing.swap(true, Ordering::SeqCst), "two writers inside");
-                        assert_eq!(reading.load(Ordering::SeqCst), 0, "a reader inside with a writer");
-                        // A read-modify-write that loses counts if two writers interleave.
-                        let n = count.load(Ordering::SeqCst);
-                        std::thread::yield_now();
-                        count.store(n + 1, Ordering::SeqCst);
-                        writing.store(false, Ordering::SeqCst);
-                        drop(lock);
-                    }
-                });
-            }
-            for _ in 0..READERS {
-                s.spawn(|| {
-                    for _ in 0..ROUNDS {
-                        let lock = read_lock(&d, true).expect("waits").expect("the folder exists");
-                        reading.fetch_add(1, Ordering::SeqCst);
-                        assert!(!writing.load(Ordering::SeqCst), "a writer inside with a reader");
-                        std::thread::yield_now();
-                        reading.fetch_sub(1, Ordering::SeqCst);
-                        drop(lock);
-                    }
-                });
-            }
-        });
-        assert_eq!(count.load(Ordering::SeqCst), WRITERS * ROUNDS);
-        assert!(!d.join(LOCK).exists(), "the last one out removed the lock file");
-    }
-}
+#[path = "folder_lock_tests.rs"]
+mod tests;

@@ -85,6 +85,7 @@ pub mod integrals;
 pub mod interleave;
 pub mod limits;
 pub mod listing;
+mod made_dirs;
 pub mod merge;
 pub mod metrics;
 pub mod output;

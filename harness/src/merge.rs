@@ -134,10 +134,12 @@ pub fn merge(dirs: &[PathBuf], opts: &ExecOptions<'_>) -> Result<Outcome> {
     }
     let blocks = runner::rep_blocks(plan.sweep.reps);
     let results_dir = opts.results_root.join(&plan.sweep.experiment);
-    crate::folder::check_output_dir("--results", &results_dir)?;
+    crate::folder::check_own_dir("--results", &results_dir)?;
     if opts.plots {
-        crate::folder::check_output_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
+        crate::folder::check_own_dir("--plots", &opts.plots_root.join(&plan.sweep.experiment))?;
     }
+    // The results folder's cell store, appended to below, is read (and refused) before any lock.
+    Store::open(&results_dir.join(crate::store::CELLS))?;
     let stores = shards.iter().map(|(d, _)| Store::open(&d.join(crate::store::BLOCKS))).collect::<Result<Vec<_>>>()?;
     let mut cells = Vec::with_capacity(plan.pairs.len() * plan.sweep.budgets.len());
     for (c, cell_units) in units.chunks(blocks).enumerate() {

@@ -192,7 +192,8 @@ pub fn preflight(plan: &Plan, shard: ShardSpec, results_root: &Path) -> Result<S
         .into());
     }
     let dir = results_root.join(&plan.sweep.experiment).join(shard.dir_name());
-    crate::folder::check_output_dir("--results", &dir)?;
+    crate::folder::check_own_dir("--results", &results_root.join(&plan.sweep.experiment))?;
+    crate::folder::check_own_dir("--results", &dir)?;
     let all = units(plan);
     let blocks = runner::rep_blocks(plan.sweep.reps);
     let store = Store::open(&dir.join(crate::store::BLOCKS))?;

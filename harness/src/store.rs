@@ -168,8 +168,12 @@ pub struct Store {
 
 impl Store {
     /// Reads the store at `path` (none there: an empty store). A torn tail is dropped; a corrupt
-    /// record or a file that is not a store is bad input naming the file.
+    /// record, a file that is not a store, or a symbolic link in its place (mcbench writes its
+    /// stores itself, never through a link) is bad input naming the file.
     pub fn open(path: &Path) -> Result<Store> {
+        if std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink()) {
+            return Err(HarnessError::bad_file(path, "is a symbolic link; mcbench does not follow it: remove it"));
+        }
         let bytes = match std::fs::read(path) {
             Ok(b) => b,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => Vec::new(),
@@ -241,8 +245,15 @@ impl StoreWriter {
             let kept: Vec<Record> = last.into_iter().map(|(_, r)| r.clone()).collect();
             write_records(path, &kept)?;
         }
-        let mut file =
-            OpenOptions::new().read(true).write(true).open(path).map_err(|e| HarnessError::write(path, e))?;
+        let mut options = OpenOptions::new();
+        options.read(true).write(true);
+        #[cfg(unix)]
+        {
+            // Appended to as it is, never through a link that took its place since it was read.
+            use std::os::unix::fs::OpenOptionsExt;
+            options.custom_flags(libc::O_NOFOLLOW);
+        }
+        let mut file = options.open(path).map_err(|e| HarnessError::write(path, e))?;
         if store.torn_bytes() > 0 && !store.has_duplicates() && store.len >= HEADER_LEN {
             file.set_len(store.valid as u64).map_err(|e| HarnessError::write(path, e))?;
         }

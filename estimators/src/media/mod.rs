@@ -153,7 +153,7 @@ impl MediumBed {
     pub fn new(field: Field, variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let mut bed = Self::without_reference(field, variant, params)?;
         bed.reference = match variant {
-            "multiple" => crate::references::load(refs, &bed.reference_key(), bed.integrals())?,
+            "multiple" => crate::references::load(refs, &bed.reference_key(), bed.integrals(), bed.resolution())?,
             "single-scatter" => scatter_reference::reference(&bed, refs)?,
             _ => reference::transmittance_reference_of(&bed, refs)?,
         };

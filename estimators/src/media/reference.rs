@@ -150,7 +150,9 @@ pub fn transmittance_method() -> String {
 /// values are the same bits.
 pub fn transmittance_reference_of(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Reference, ConfigError> {
     let key = bed.reference_key();
-    if let Some(r) = crate::references::stored_exact(refs, &key, &transmittance_method(), bed.integrals())? {
+    if let Some(r) =
+        crate::references::stored_exact(refs, &key, &transmittance_method(), bed.integrals(), bed.resolution())?
+    {
         return Ok(r);
     }
     static COMPUTED: crate::memo::Memo<Reference> = crate::memo::Memo::new();

@@ -189,16 +189,15 @@ pub fn compute(bed: &MediumBed, s: &Settings) -> Reference {
 fn load_stored(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Option<Reference>, ConfigError> {
     let key = bed.reference_key();
     let Some(stored) = refs.stored(&key)? else { return Ok(None) };
-    let r = stored.reference;
-    let same_method =
-        matches!(&r.kind, ReferenceKind::Exact { method, .. } if *method == Settings::of(bed.field()).method());
+    let same_method = matches!(&stored.reference.kind,
+        ReferenceKind::Exact { method, .. } if *method == Settings::of(bed.field()).method());
     if !same_method {
         return Ok(None);
     }
-    r.check(bed.integrals()).map_err(|e| {
+    stored.check(bed.integrals(), bed.resolution()).map_err(|e| {
         ConfigError::invalid(format!("{} reference", key.describe()), key.file_name(), format!("malformed ({e})"))
     })?;
-    Ok(Some(r))
+    Ok(Some(stored.reference))
 }
 
 #[cfg(test)]

@@ -94,7 +94,7 @@ impl CheckerImage {
     /// sample change its variance, not its expectation).
     pub fn new(variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let bed = Self::without_reference(variant, params)?;
-        let reference = crate::references::load(refs, &bed.reference_key(), bed.size * bed.size)?;
+        let reference = crate::references::load(refs, &bed.reference_key(), bed.size * bed.size, bed.resolution())?;
         Ok(CheckerImage { reference, ..bed })
     }
 

@@ -196,7 +196,13 @@ impl EnvmapSequence {
     /// over every texel takes seconds per setup at every run), else computed.
     pub fn with_references(variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let mut bed = Self::without_reference(variant, params)?;
-        bed.reference = match crate::references::stored_exact(refs, &bed.key, METHOD, bed.points.len() * bed.frames)? {
+        bed.reference = match crate::references::stored_exact(
+            refs,
+            &bed.key,
+            METHOD,
+            bed.points.len() * bed.frames,
+            bed.resolution(),
+        )? {
             Some(r) => r,
             None => bed.compute_reference(),
         };

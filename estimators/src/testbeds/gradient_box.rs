@@ -135,7 +135,7 @@ impl GradientBox {
                 let t = (-bed.setup.sigma_t).exp();
                 bed.exact(bed.setup.background.c0 * t, "no scattering: exp(-sigma_t) L_b(+y)")
             }
-            _ => crate::references::load(refs, &bed.reference_key(), bed.size * bed.size)?,
+            _ => crate::references::load(refs, &bed.reference_key(), bed.size * bed.size, bed.resolution())?,
         };
         Ok(GradientBox { reference, ..bed })
     }
