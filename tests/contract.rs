@@ -31,7 +31,7 @@ id = "clamped_is0_cv0"
 params = { clamp = 1.5 }
 [[claims]]
 kind = "control_flagged"
-estimator = "clamped_is0_cv0"
+estimator = "clamped_is0_cv0[clamp=1.5]"
 "#;
 
 fn chapter() -> String {

@@ -47,7 +47,7 @@ text = "independent MC converges at -1/2"
 
 [[claims]]
 kind = "control_flagged"
-estimator = "clamped_is0_cv0"
+estimator = "clamped_is0_cv0[clamp=1.5]"
 "#;
 
 fn mcbench(dir: &Path, args: &[&str]) -> Output {
