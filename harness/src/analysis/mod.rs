@@ -2,12 +2,15 @@
 //! papers' speed-up computation (paper 000/001).
 
 pub mod bias;
+mod direct;
 mod holm;
 mod pooled;
 pub mod speedup;
+pub mod spread;
 
 pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE, POOLED_SHARE};
 pub use speedup::{speedups, SpeedUp};
+pub use spread::Spread;
 
 use crate::metrics::SummaryRow;
 use estimators::stats::{log_log_fit, weighted_linear_fit, SlopeFit};

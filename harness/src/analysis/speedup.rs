@@ -293,6 +293,7 @@ mod tests {
             rmse_display: None,
             rmse_lo: None,
             rmse_hi: None,
+            rmse_roundoff: f64::NAN,
             fom_display: None,
             rep_blocks: Default::default(),
         };

@@ -47,6 +47,7 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         rmse_display: None,
         rmse_lo: None,
         rmse_hi: None,
+        rmse_roundoff: f64::NAN,
         fom_display: None,
         rep_blocks: Default::default(),
     }
