@@ -129,6 +129,7 @@ pub fn synthetic_report() -> RunReport {
             speedup_renderer_ci_low: 16.0 / 0.2f64.exp(),
             speedup_renderer_ci_high: 16.0 * 0.2f64.exp(),
             interval_method: "delta method".into(),
+            outcome: Default::default(),
         }],
         skipped: vec![Skipped {
             testbed: "gradient-plane".into(),
