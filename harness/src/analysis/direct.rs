@@ -176,3 +176,7 @@ pub(super) fn rows(base: &RowBase<'_>, reference: &Reference, zero: &ZeroChannel
     combined.reason = reason;
     vec![holm, pooled, combined]
 }
+
+#[cfg(test)]
+#[path = "direct_tests.rs"]
+mod tests;
