@@ -333,7 +333,7 @@ fn summary_files_report_target_evaluations_and_cache_operations() {
         csv.lines()
             .next()
             .unwrap_or_default()
-            .ends_with(",free_flights,target_evals,cache_ops,rmse_display,fom_display,rmse_lo,rmse_hi"),
+            .ends_with(",free_flights,target_evals,cache_ops,rmse_display,fom_display,rmse_lo,rmse_hi,rmse_roundoff"),
         "{csv}"
     );
     for row in &out.report.rows {

@@ -74,3 +74,42 @@ fn speedup_claims_are_judged_on_their_interval_in_their_regime() {
     )
     .is_err());
 }
+
+/// Claims on an estimator that is exact (its error round-off) are not judged on numbers made of
+/// rounding errors: a slope claim is inconclusive (no slope), a speed-up over the baseline is
+/// unbounded (held), and a ratio with the exact cell is zero or unbounded.
+#[test]
+fn claims_on_an_exact_estimator_are_not_judged_on_round_off() {
+    let mut report = crate::plot::tests::synthetic_report();
+    let f = report.fits.iter_mut().find(|f| f.estimator == "is1_cv2").expect("fit");
+    (f.slope, f.slope_ci_low, f.slope_ci_high) = (f64::NAN, f64::NAN, f64::NAN);
+    f.outcome = crate::analysis::SlopeOutcome::Exact;
+    let slope = spec("", "slope").judge(&report);
+    assert_eq!((slope.verdict(), slope.held, slope.our_value), ("inconclusive", None, None), "{slope:?}");
+    assert!(slope.reason.starts_with("exact at every budget"), "{}", slope.reason);
+    let s = &mut report.speedups[0];
+    (s.speedup, s.speedup_renderer, s.sample_ratio) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    s.outcome = crate::analysis::SpeedUpOutcome::Unbounded;
+    let text = "kind = 'speedup'\ntestbed = 'gradient-plane/default'\nestimator = 'is1_cv2'\nvalue = 1e6\ntext = 't'";
+    let speedup = toml::from_str::<ClaimSpec>(text).expect("parses").judge(&report);
+    assert_eq!((speedup.verdict.as_str(), speedup.held, speedup.our_value), ("held", Some(true), None), "{speedup:?}");
+    assert!(speedup.reason.contains("unbounded"), "{}", speedup.reason);
+    // RMSE of is1_cv2 over is0_cv0 at 64 with is1_cv2 exact there: zero, below 1.
+    for r in report.rows.iter_mut().filter(|r| r.estimator == "is1_cv2") {
+        r.rmse_roundoff = r.rmse;
+    }
+    let spec = |above: bool| crate::claims::RatioSpec {
+        tb: ("gradient-plane", "default"),
+        estimator: "is1_cv2",
+        baseline: "is0_cv0",
+        budget: 64,
+        metric: crate::claims::RatioMetric::Rmse,
+        threshold: 1.0,
+        above,
+        paper: None,
+    };
+    let below = crate::claims::ratio_claim(&report, &spec(false), "lower error", "");
+    assert_eq!((below.verdict.as_str(), below.our_value), ("held", None), "{below:?}");
+    assert!(below.reason.starts_with("exact: the ratio is zero"), "{}", below.reason);
+    assert_eq!(crate::claims::ratio_claim(&report, &spec(true), "", "").verdict, "not held");
+}

@@ -28,12 +28,8 @@ pub fn print_summary(r: &crate::output::RunReport, seconds: f64) {
             vec![
                 format!("{}/{}", f.testbed, f.variant),
                 f.estimator.clone(),
-                format!("{:.3} [{:.3}, {:.3}]", f.slope, f.slope_ci_low, f.slope_ci_high),
-                if f.slope_right.is_finite() {
-                    format!("{:.3} [{:.3}, {:.3}]", f.slope_right, f.slope_right_ci_low, f.slope_right_ci_high)
-                } else {
-                    "-".into()
-                },
+                f.describe(crate::analysis::SlopeRange::Whole),
+                f.describe(crate::analysis::SlopeRange::Right),
                 p(holm),
                 holm.map(|t| format!("{} ({})", t.verdict, t.claim)).unwrap_or_else(|| "-".into()),
                 p(pooled),

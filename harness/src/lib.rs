@@ -99,6 +99,7 @@ pub mod registry;
 pub mod report;
 pub mod resume;
 pub mod rmse_band;
+pub mod roundoff;
 pub mod runner;
 pub mod sensitivity;
 pub mod shard;

@@ -140,11 +140,25 @@ pub struct SummaryRow {
     /// High end of that interval.
     #[serde(default)]
     pub rmse_hi: Option<f64>,
+    /// The RMSE the cell may show through floating-point round-off and its exact reference's
+    /// stated error alone ([`crate::roundoff::rmse_bound`]): a row whose `rmse` is at most this is
+    /// exact ([`SummaryRow::at_roundoff`]). NaN against a stored reference with a standard error
+    /// (its noise dwarfs round-off) and in files written before it.
+    #[serde(default = "crate::output::nan")]
+    pub rmse_roundoff: f64,
     /// The cell's repetition blocks, for the bootstrap intervals of ratio claims: carried in memory
     /// only (neither `summary.csv` nor `summary.json` has them), so rows read back from files, and
     /// rows of cells stored before blocks were kept, have none and fall back to the delta method.
     #[serde(skip)]
     pub rep_blocks: RowBlocks,
+}
+
+impl SummaryRow {
+    /// Whether the row's error is round-off: its `rmse` at most `rmse_roundoff` (never for rows
+    /// without that bound: stored references with a standard error, files written before it).
+    pub fn at_roundoff(&self) -> bool {
+        self.rmse <= self.rmse_roundoff
+    }
 }
 
 /// A cell's repetition blocks ([`crate::cell::RepBlock`]) with what turns a resample of them into
@@ -311,6 +325,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
         fom_display: display_mse.filter(|_| fetches > 0.0).and_then(|m| inverse(m * fetches)),
         rmse_lo: band.map(|b| b.0),
         rmse_hi: band.map(|b| b.1),
+        rmse_roundoff: crate::roundoff::rmse_bound(cell, reference),
         rep_blocks,
     }
 }

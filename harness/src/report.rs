@@ -168,13 +168,14 @@ fn fits_section(out: &mut String, report: &RunReport) {
     let fits = report.fits.iter().take(FIT_ROWS).map(|f| {
         let budgets: Vec<String> = f.budgets.iter().map(u64::to_string).collect();
         let right = f.slope_right.is_finite();
+        let exact = f.outcome == crate::analysis::SlopeOutcome::Exact;
         vec![
             f.testbed.clone(),
             f.variant.clone(),
             name(report, &f.estimator),
-            format!("{:.3}", f.slope),
-            format!("[{:.3}, {:.3}]", f.slope_ci_low, f.slope_ci_high),
-            format!("{:.4}", f.r2),
+            if exact { "exact at every budget".into() } else { format!("{:.3}", f.slope) },
+            if exact { "-".into() } else { format!("[{:.3}, {:.3}]", f.slope_ci_low, f.slope_ci_high) },
+            if exact { "-".into() } else { format!("{:.4}", f.r2) },
             budgets.join(", "),
             if right { format!("{:.3}", f.slope_right) } else { "-".into() },
             if right { format!("[{:.3}, {:.3}]", f.slope_right_ci_low, f.slope_right_ci_high) } else { "-".into() },
@@ -200,17 +201,22 @@ fn fits_section(out: &mut String, report: &RunReport) {
 fn speedups_section(out: &mut String, report: &RunReport) {
     heading(out, "Speed-ups");
     let rows = report.speedups.iter().take(FIT_ROWS).map(|s| {
+        let unbounded = s.outcome == crate::analysis::SpeedUpOutcome::Unbounded;
         vec![
             s.testbed.clone(),
             s.variant.clone(),
             name(report, &s.estimator),
             s.baseline.clone(),
             s.budget.to_string(),
-            sig(s.sample_ratio, 4),
+            if unbounded { "unbounded".into() } else { sig(s.sample_ratio, 4) },
             sig(s.overhead, 4),
-            sig(s.speedup, 4),
-            format!("[{}, {}]", sig(s.speedup_ci_low, 4), sig(s.speedup_ci_high, 4)),
-            sig(s.speedup_renderer, 4),
+            s.describe(crate::cost_model::Regime::Measured),
+            if unbounded {
+                "-".into()
+            } else {
+                format!("[{}, {}]", sig(s.speedup_ci_low, 4), sig(s.speedup_ci_high, 4))
+            },
+            s.describe(crate::cost_model::Regime::Renderer),
             sig(s.break_even_ray_ns, 4),
         ]
     });

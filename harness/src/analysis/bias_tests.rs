@@ -60,7 +60,7 @@ pub(crate) fn exact(values: &[[f64; 3]]) -> Reference {
 }
 
 /// `reps` repetitions of `n` integrals of value `mean + noise` (normal noise of `sd`), seeded.
-fn normal_reps(seed: u64, n: usize, reps: usize, mean: f64, sd: f64) -> Vec<Vec<[f64; 3]>> {
+pub(crate) fn normal_reps(seed: u64, n: usize, reps: usize, mean: f64, sd: f64) -> Vec<Vec<[f64; 3]>> {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let mut normal = || {
         let (u, v): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
@@ -69,7 +69,7 @@ fn normal_reps(seed: u64, n: usize, reps: usize, mean: f64, sd: f64) -> Vec<Vec<
     (0..reps).map(|_| (0..n).map(|_| [0; 3].map(|_| mean + sd * normal())).collect()).collect()
 }
 
-fn decision(rows: &[TestRow]) -> &TestRow {
+pub(crate) fn decision(rows: &[TestRow]) -> &TestRow {
     rows.iter().find(|t| t.test == "combined").expect("combined row")
 }
 

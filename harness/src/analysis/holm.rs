@@ -3,6 +3,7 @@
 //! detects over independent groups of integrals.
 
 use super::bias::{multiplicative, spread_upper, Gate};
+use super::spread::{Spread, ZeroChannels};
 use super::POWER;
 use crate::cell::CellResult;
 use estimators::stats::{detectable_shift_t, holm_bonferroni, t_test, t_test_skewness_limit};
@@ -22,6 +23,11 @@ pub(super) struct Holm {
     pub(super) dof: f64,
     /// Upper 95% bound over the estimate of the ratio of true to estimated standard errors.
     pub(super) spread_upper: f64,
+    /// Zero-variance integral-channels of a mixed cell (not t-tested).
+    pub(super) direct: usize,
+    /// How many of those lie off the reference beyond round-off, an exact reference's bound and
+    /// three of a stored reference's standard errors (left untested).
+    pub(super) direct_beyond: usize,
 }
 
 impl Holm {
@@ -47,7 +53,16 @@ impl Holm {
     }
 }
 
-pub(super) fn holm(cell: &CellResult, reference: &Reference, gate: Option<&Gate>, alpha: f64) -> Holm {
+/// The per-integral test of a cell at family level `alpha`; in a mixed cell (`zero` and `spread`)
+/// its zero-variance integral-channels are not t-tested: within an exact reference's bound they
+/// join the family as agreements (p = 1), otherwise they are left untested.
+pub(super) fn holm(
+    cell: &CellResult,
+    reference: &Reference,
+    gate: Option<&Gate>,
+    alpha: f64,
+    (zero, spread): (&ZeroChannels, Spread),
+) -> Holm {
     let reps = cell.key.reps as u64;
     let m = cell.moments.len() * 3;
     let (stored_n, bound) = match &reference.kind {
@@ -56,13 +71,11 @@ pub(super) fn holm(cell: &CellResult, reference: &Reference, gate: Option<&Gate>
     };
     let per_test_alpha = alpha / m.max(1) as f64;
     let limit = t_test_skewness_limit(reps, per_test_alpha);
-    // An estimator with no spread at all (and none in its gate) is deterministic: any deviation is
-    // a bias. One whose gate saw spread only missed its tail in this cell.
-    let deterministic = reps >= 2
-        && cell.moments.iter().flatten().all(|m| m.std_err() == 0.0)
-        && gate.is_none_or(|g| g.rep_sd.is_nan() || g.rep_sd <= 0.0);
+    // A cell with no spread at all is compared directly before it gets here
+    // ([`super::direct::rows`]); one whose gate saw spread only missed its tail in this cell.
     let (mut ps, mut max_t, mut detect, mut untested) = (Vec::new(), 0.0f64, Vec::new(), 0);
-    if gate.is_none() && !deterministic {
+    let (mut direct, mut direct_beyond) = (0, 0);
+    if gate.is_none() {
         // The cell's own skewness would choose which integrals to test: no test.
         let name = if stored_n.is_some() { "holm_welch" } else { "holm_t" };
         return Holm {
@@ -74,6 +87,8 @@ pub(super) fn holm(cell: &CellResult, reference: &Reference, gate: Option<&Gate>
             strengths: Vec::new(),
             dof: f64::NAN,
             spread_upper: f64::NAN,
+            direct: 0,
+            direct_beyond: 0,
         };
     }
     // The integrals of one test bed share their sampling process, and a pixel's sample skewness
@@ -112,11 +127,26 @@ pub(super) fn holm(cell: &CellResult, reference: &Reference, gate: Option<&Gate>
                 detect
                     .push(detectable_shift_t(se_total, per_test_alpha, POWER, reps.saturating_sub(1) as f64) / r.abs());
             }
+            if let Some(u) = zero.direct(spread, i, c) {
+                // No spread beyond round-off in the cell or its gate while other integrals vary:
+                // not t-tested (its spread is rounding), and no evidence by itself (a rare value
+                // that the cell and its gate both missed looks the same). A mean within an exact
+                // reference's bound joins the family as an agreement, as an exactly constant
+                // integral always did; any other is left untested, and counted when it lies off
+                // the reference beyond round-off.
+                direct += 1;
+                let d = mc.mean() - r;
+                if stored_n.is_none() && d.abs() <= bound {
+                    ps.push(1.0);
+                } else {
+                    untested += 1;
+                    direct_beyond += usize::from(d.abs() > u + bound + 3.0 * rse);
+                }
+                continue;
+            }
             let gate_skew = gate.and_then(|g| g.integral_skew.get(i)).map_or(0.0, |s| s[c].abs());
             let skew = mc.skewness().abs().max(if gate_skew.is_nan() { 0.0 } else { gate_skew });
             let t = match stored_n {
-                None if se == 0.0 && mc.mean() == r_test => t_test(0.0, 0.0, f64::INFINITY),
-                None if deterministic => t_test(1.0, 0.0, f64::INFINITY),
                 _ if heavy || se == 0.0 || skew > limit => {
                     untested += 1;
                     continue;
@@ -152,5 +182,7 @@ pub(super) fn holm(cell: &CellResult, reference: &Reference, gate: Option<&Gate>
         strengths,
         dof: (reps as f64 - 1.0).max(1.0),
         spread_upper: spread_upper(spread_dof),
+        direct,
+        direct_beyond,
     }
 }

@@ -2,12 +2,15 @@
 //! papers' speed-up computation (paper 000/001).
 
 pub mod bias;
+mod direct;
 mod holm;
 mod pooled;
 pub mod speedup;
+pub mod spread;
 
 pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE, POOLED_SHARE};
-pub use speedup::{speedups, SpeedUp};
+pub use speedup::{speedups, SpeedUp, SpeedUpOutcome};
+pub use spread::Spread;
 
 use crate::metrics::SummaryRow;
 use estimators::stats::{log_log_fit, weighted_linear_fit, SlopeFit};
@@ -71,9 +74,27 @@ pub struct Fit {
     #[serde(default)]
     pub budgets_right: Vec<u64>,
     /// `wls` (weighted least squares with delta-method variances) or `ols` (ordinary least squares,
-    /// where the rows carry no usable `mse_se`); empty in files written before it.
+    /// where the rows carry no usable `mse_se`); `none` for an exact series (no fit); empty in
+    /// files written before it.
     #[serde(default)]
     pub method: String,
+    /// `fitted`, or `exact`: every budget's RMSE at round-off ([`SummaryRow::at_roundoff`]), so
+    /// there is no slope to fit (`slope` and its interval, `r2`, `intercept` and the right-end
+    /// fit are NaN, `null` in summary.json). `fitted` in files written before it.
+    #[serde(default)]
+    pub outcome: SlopeOutcome,
+}
+
+/// What the convergence fit of a series found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SlopeOutcome {
+    /// A slope fitted to the RMSEs.
+    #[default]
+    Fitted,
+    /// Every budget's RMSE at round-off: the estimator is exact at every budget, and a slope
+    /// fitted to rounding errors would describe the arithmetic, not the estimator.
+    Exact,
 }
 
 impl Fit {
@@ -82,6 +103,17 @@ impl Fit {
         match range {
             SlopeRange::Whole => (self.slope, self.slope_ci_low, self.slope_ci_high),
             SlopeRange::Right => (self.slope_right, self.slope_right_ci_low, self.slope_right_ci_high),
+        }
+    }
+
+    /// The slope over `range` with its 95% interval as tables print it, or "exact at every
+    /// budget" (`-` without a slope over that range).
+    pub fn describe(&self, range: SlopeRange) -> String {
+        let (slope, lo, hi) = self.range(range);
+        match self.outcome {
+            SlopeOutcome::Exact => "exact at every budget".into(),
+            SlopeOutcome::Fitted if slope.is_finite() => format!("{slope:.3} [{lo:.3}, {hi:.3}]"),
+            SlopeOutcome::Fitted => "-".into(),
         }
     }
 
@@ -144,10 +176,31 @@ pub fn rmse_fit(rows: &[&SummaryRow]) -> Option<(SlopeFit, &'static str)> {
 }
 
 /// Fits every (test bed, variant, estimator) series of rows with at least 3 budgets with RMSE > 0,
-/// over the whole range and over its right end ([`rmse_fit`]).
+/// over the whole range and over its right end ([`rmse_fit`]); a series of at least 3 budgets
+/// whose every RMSE is round-off ([`SummaryRow::at_roundoff`]) is reported exact, without a slope.
 pub fn fits(rows: &[SummaryRow]) -> Vec<Fit> {
     let mut out = Vec::new();
     for series in group(rows) {
+        if series.len() >= 3 && series.iter().all(|r| r.at_roundoff()) {
+            out.push(Fit {
+                testbed: series[0].testbed.clone(),
+                variant: series[0].variant.clone(),
+                estimator: series[0].estimator.clone(),
+                slope: f64::NAN,
+                slope_ci_low: f64::NAN,
+                slope_ci_high: f64::NAN,
+                r2: f64::NAN,
+                intercept: f64::NAN,
+                budgets: series.iter().map(|r| r.budget).collect(),
+                slope_right: f64::NAN,
+                slope_right_ci_low: f64::NAN,
+                slope_right_ci_high: f64::NAN,
+                budgets_right: Vec::new(),
+                method: "none".into(),
+                outcome: SlopeOutcome::Exact,
+            });
+            continue;
+        }
         let pts: Vec<&SummaryRow> = series.into_iter().filter(|r| r.rmse > 0.0).collect();
         let Some((f, method)) = rmse_fit(&pts) else { continue };
         let right = &pts[pts.len().saturating_sub(RIGHT_END_BUDGETS)..];
@@ -167,6 +220,7 @@ pub fn fits(rows: &[SummaryRow]) -> Vec<Fit> {
             slope_right_ci_high: r.as_ref().map_or(f64::NAN, |r| r.slope_ci_high),
             budgets_right: if r.is_some() { right.iter().map(|r| r.budget).collect() } else { Vec::new() },
             method: method.to_string(),
+            outcome: SlopeOutcome::Fitted,
         });
     }
     out
@@ -260,6 +314,43 @@ mod tests {
                 r
             })
             .collect()
+    }
+
+    /// A series whose every RMSE is round-off is exact at every budget, not a slope fitted to
+    /// rounding errors; with one budget above round-off, or without a bound (files written before
+    /// it), it is fitted as before.
+    #[test]
+    fn a_series_at_round_off_is_exact_at_every_budget() {
+        let series = |rmse: [f64; 4], bound: f64| -> Vec<SummaryRow> {
+            (0..4u32)
+                .map(|k| {
+                    let mut r = crate::plot::tests::row("x", 4u64.pow(k + 1), rmse[k as usize], 1.0);
+                    (r.rmse_roundoff, r.mse_se) = (bound, 0.1 * r.mse);
+                    r
+                })
+                .collect()
+        };
+        // Rounding errors of longer sums grow with the budget: a slope near +1 if fitted.
+        let roundoff = [6e-17, 7e-17, 5.6e-16, 2e-15];
+        let f = &fits(&series(roundoff, 1e-14))[0];
+        assert_eq!((f.outcome, f.method.as_str()), (SlopeOutcome::Exact, "none"), "{f:?}");
+        assert!(f.slope.is_nan() && f.slope_ci_low.is_nan() && f.slope_right.is_nan(), "{f:?}");
+        assert_eq!(f.budgets, vec![4, 16, 64, 256]);
+        assert_eq!(f.describe(SlopeRange::Whole), "exact at every budget");
+        // An RMSE of exactly zero everywhere: no fit at all before, exact now.
+        let f = &fits(&series([0.0; 4], 1e-14))[0];
+        assert_eq!(f.outcome, SlopeOutcome::Exact);
+        // One budget above round-off: fitted.
+        let f = &fits(&series([6e-17, 7e-17, 5.6e-16, 2e-13], 1e-14))[0];
+        assert_eq!(f.outcome, SlopeOutcome::Fitted);
+        assert!(f.slope.is_finite() && f.describe(SlopeRange::Whole).starts_with(&format!("{:.3}", f.slope)));
+        let f = &fits(&series(roundoff, f64::NAN))[0];
+        assert!(f.outcome == SlopeOutcome::Fitted && f.slope > 0.5, "{f:?}");
+        // summary.json keeps the outcome; files written before it read as fitted.
+        let text = serde_json::to_string(&fits(&series(roundoff, 1e-14))[0]).expect("serialises");
+        assert!(text.contains("\"outcome\":\"exact\"") && text.contains("\"slope\":null"), "{text}");
+        let old = text.replace(",\"outcome\":\"exact\"", "");
+        assert_eq!(serde_json::from_str::<Fit>(&old).expect("reads").outcome, SlopeOutcome::Fitted);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! The papers' speed-up (paper 000 §5, 001 §5) with its 95% interval, in both cost regimes
 //! ([`crate::cost_model`]), and as a function of the cost of a ray.
 
-use super::{group, Fit};
+use super::{group, Fit, SlopeOutcome};
 use crate::claims::bootstrap::{self, Bootstrap};
 use crate::claims::Ratio;
 use crate::cost_model::{CostModel, RayCostCurve, Regime};
@@ -106,9 +106,28 @@ pub struct SpeedUp {
     #[serde(default = "crate::output::nan", deserialize_with = "crate::output::f64_or_nan")]
     pub speedup_renderer_ci_high: f64,
     /// How the intervals were made: "bootstrap over 16 blocks of repetitions, paired (expanded
-    /// percentile, 2000 resamples)" or "delta method" (empty in files written before it: the delta method).
+    /// percentile, 2000 resamples)" or "delta method" (empty in files written before it: the delta method;
+    /// `none` for an unbounded speed-up).
     #[serde(default)]
     pub interval_method: String,
+    /// `measured`, or `unbounded`: the method's RMSE at the budget is round-off
+    /// ([`SummaryRow::at_roundoff`]), so no baseline budget reaches it. The sample ratio, the
+    /// speed-ups and their intervals are then infinite (`null` in summary.json), the overheads as
+    /// measured. `measured` in files written before it.
+    #[serde(default)]
+    pub outcome: SpeedUpOutcome,
+}
+
+/// What a speed-up found.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpeedUpOutcome {
+    /// A finite speed-up from the baseline's fitted slope.
+    #[default]
+    Measured,
+    /// The method is exact at the budget (its error is round-off): the baseline reaches its error at
+    /// no budget, and a ratio to rounding errors would be a number about the arithmetic.
+    Unbounded,
 }
 
 impl SpeedUp {
@@ -135,8 +154,20 @@ impl SpeedUp {
         }
     }
 
-    /// The speed-up as a function of the cost of a ray (None in files written before it).
+    /// The speed-up in `regime` as tables print it: `unbounded (exact)` for an exact method.
+    pub fn describe(&self, regime: Regime) -> String {
+        match self.outcome {
+            SpeedUpOutcome::Unbounded => "unbounded (exact)".into(),
+            SpeedUpOutcome::Measured => crate::report::sig(self.in_regime(regime), 4),
+        }
+    }
+
+    /// The speed-up as a function of the cost of a ray (None in files written before it, and for
+    /// an unbounded speed-up).
     pub fn curve(&self) -> Option<RayCostCurve> {
+        if self.outcome == SpeedUpOutcome::Unbounded {
+            return None;
+        }
         let (t, r) = (self.cpu_seconds?, self.rays?);
         Some(RayCostCurve { sample_ratio: self.sample_ratio, method: (t.0, r.0), baseline: (t.1, r.1) })
     }
@@ -162,6 +193,14 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str, model: &CostM
         ) else {
             continue;
         };
+        if fit.outcome == SlopeOutcome::Exact {
+            // An exact baseline: no method reaches its error sooner.
+            continue;
+        }
+        if last.at_roundoff() {
+            out.push(unbounded(last, base, baseline, model));
+            continue;
+        }
         if last.rmse <= 0.0 || fit.slope >= 0.0 {
             continue;
         }
@@ -240,78 +279,44 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str, model: &CostM
             speedup_renderer_ci_low: ci_renderer.0,
             speedup_renderer_ci_high: ci_renderer.1,
             interval_method,
+            outcome: SpeedUpOutcome::Measured,
         });
     }
     out
 }
 
-#[cfg(test)]
-mod tests {
-    use super::super::fits;
-    use super::*;
-
-    #[test]
-    fn speedup_uses_the_baseline_fit() {
-        let mk = |est: &str, budget: u64, rmse: f64, seconds: f64| SummaryRow {
-            testbed: "t".into(),
-            variant: "v".into(),
-            estimator: est.into(),
-            budget_kind: "samples".into(),
-            budget,
-            reps: 2,
-            integrals: 1,
-            rmse,
-            mse: rmse * rmse,
-            variance: rmse * rmse,
-            bias: 0.0,
-            bias_se: 0.0,
-            samples: budget as f64,
-            fetches: 0.0,
-            rays: 0.0,
-            seconds,
-            efficiency: None,
-            fom: None,
-            rel_rmse: 0.0,
-            reference_var: 0.0,
-            cheap_fetches: 0.0,
-            seconds_median: seconds,
-            efficiency_mse: None,
-            p_err: 0.0,
-            p_eff: None,
-            estimator_id: String::new(),
-            params: String::new(),
-            testbed_params: String::new(),
-            mse_se: f64::NAN,
-            cpu_seconds: if est == "fast" { 0.75 * seconds } else { seconds },
-            efficiency_wall: None,
-            time_clock: "cpu".into(),
-            shadow_rays: 0.0,
-            efficiency_renderer: None,
-            free_flights: 0.0,
-            target_evals: 0.0,
-            cache_ops: 0.0,
-            rmse_display: None,
-            rmse_lo: None,
-            rmse_hi: None,
-            fom_display: None,
-            rep_blocks: Default::default(),
-        };
-        let mut rows = Vec::new();
-        for b in [4u64, 16, 64] {
-            rows.push(mk("base", b, 1.0 / (b as f64).sqrt(), b as f64));
-            rows.push(mk("fast", b, 1.0 / b as f64, 2.0 * b as f64));
-        }
-        let f = fits(&rows);
-        let s = speedups(&rows, &f, "base", &CostModel::default());
-        // At 64 spp the fast method's RMSE 1/64 needs 4096 baseline samples: 64x; overhead 1.5x
-        // in CPU time, 2x on the wall clock.
-        assert_eq!(s.len(), 1);
-        assert!((s[0].sample_ratio - 64.0).abs() < 1e-6 && (s[0].overhead - 1.5).abs() < 1e-12);
-        assert!((s[0].speedup - 64.0 / 1.5).abs() < 1e-6);
-        assert!((s[0].overhead_wall - 2.0).abs() < 1e-12 && (s[0].speedup_wall - 32.0).abs() < 1e-6);
-        // Rows read from files written before CPU time: the wall clock, as then.
-        rows.iter_mut().for_each(|r| r.cpu_seconds = f64::NAN);
-        let s = speedups(&rows, &f, "base", &CostModel::default());
-        assert!((s[0].overhead - 2.0).abs() < 1e-12 && (s[0].speedup - 32.0).abs() < 1e-6);
+/// The speed-up of a method whose error at its budget is round-off: unbounded, with the overheads
+/// as measured.
+fn unbounded(last: &SummaryRow, base: &SummaryRow, baseline: &str, model: &CostModel) -> SpeedUp {
+    let inf = f64::INFINITY;
+    SpeedUp {
+        testbed: last.testbed.clone(),
+        variant: last.variant.clone(),
+        estimator: last.estimator.clone(),
+        baseline: baseline.to_string(),
+        budget: last.budget,
+        sample_ratio: inf,
+        overhead: model.seconds(Regime::Measured, last) / model.seconds(Regime::Measured, base),
+        speedup: inf,
+        overhead_wall: last.seconds / base.seconds,
+        speedup_wall: inf,
+        log_se: f64::NAN,
+        speedup_ci_low: inf,
+        speedup_ci_high: inf,
+        overhead_renderer: model.seconds(Regime::Renderer, last) / model.seconds(Regime::Renderer, base),
+        speedup_renderer: inf,
+        speedup_ray_limit: inf,
+        break_even_ray_ns: 0.0,
+        cpu_seconds: Some((last.metric_seconds(), base.metric_seconds())),
+        rays: Some((last.rays, base.rays)),
+        reps: last.reps,
+        speedup_renderer_ci_low: inf,
+        speedup_renderer_ci_high: inf,
+        interval_method: "none".into(),
+        outcome: SpeedUpOutcome::Unbounded,
     }
 }
+
+#[cfg(test)]
+#[path = "speedup_tests.rs"]
+mod tests;

@@ -136,8 +136,10 @@ pub fn row(family: &Family, m: &Measured, name: &str) -> Row {
     let tested_fraction = frac(tested.len(), n);
     let flag_rate = frac(s.iter().filter(|o| o.null.verdict == "biased").count(), n);
     let unbiased = family.bias == Bias::Unbiased;
-    // A zero-variance estimator is compared exactly: no size to measure, any bias is flagged.
-    let deterministic = detectable == 0.0;
+    // A zero-variance estimator is compared exactly: no size to measure, any bias is flagged (its
+    // reported detectable bias is its round-off allowance, far below the smallest injected bias).
+    let zero = s.iter().filter(|o| o.null.spread == crate::analysis::Spread::ZeroVariance).count();
+    let deterministic = n > 0 && 2 * zero > n;
     let ok_false_flag = (unbiased && !deterministic && tested.len() >= 50).then(|| within_band(ff, tested.len()));
     let ok_detectable = (unbiased && tested_fraction >= 0.8).then(|| {
         if deterministic {

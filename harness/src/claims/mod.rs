@@ -4,6 +4,7 @@
 
 pub mod bootstrap;
 pub mod control;
+pub mod exact_ratio;
 pub mod ordering;
 pub mod ratio;
 pub mod slope;
@@ -16,7 +17,7 @@ pub use slope::{
     SLOPE_TOLERANCE,
 };
 
-use crate::analysis::{Fit, SpeedUp};
+use crate::analysis::{Fit, SpeedUp, SpeedUpOutcome};
 use crate::cost_model::Regime;
 use crate::output::{Claim, RunReport};
 
@@ -69,6 +70,27 @@ pub fn speedup_claim(
         let why = format!("no speed-up for {estimator} against {base} (not available, skipped, or no fit)");
         return Claim { regime: regime.name().into(), ..not_measured(tb.0, &text, paper, why) };
     };
+    if s.outcome == SpeedUpOutcome::Unbounded {
+        return Claim {
+            testbed: format!("{}/{}", tb.0, tb.1),
+            claim: text,
+            paper_value: Some(paper),
+            our_value: None,
+            held: Some(true),
+            note: format!(
+                "{estimator} against {} at {} spp: exact (RMSE at round-off), speed-up unbounded; overhead {:.3}x in \
+                 CPU time, {:.3}x (renderer)",
+                s.baseline, s.budget, s.overhead, s.overhead_renderer
+            ),
+            verdict: "held".into(),
+            interval: None,
+            pair: format!("{estimator} vs {}", s.baseline),
+            regime: regime.name().into(),
+            reason: "exact: the method's error is round-off, which no budget of the baseline reaches, so the \
+                     speed-up is unbounded and above any finite factor"
+                .into(),
+        };
+    }
     let value = s.in_regime(regime);
     // The speed-up's interval (bootstrap or delta method) judged by the verdict rule of ratios.
     let ratio = s.ratio(regime);

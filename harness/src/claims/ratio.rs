@@ -15,11 +15,15 @@
 //! taken as exact, and the quantile is Student's t with one less degree of freedom than the
 //! smaller cell's repetitions, since each `mse_se` is itself estimated from them.
 //!
+//! A cell whose error is round-off ([`SummaryRow::at_roundoff`]) makes the ratio zero or unbounded
+//! rather than a number about rounding errors ([`ExactRatio`]); the claim is judged on that side.
+//!
 //! A claim holds when the interval clears its threshold, does not when it lies on the other side,
 //! and is `inconclusive`, with the repetitions that would decide, when it straddles; its note says
 //! which method made the interval.
 
 use super::bootstrap::{self, Bootstrap, CellSample};
+use super::exact_ratio::ExactRatio;
 use crate::cost_model::Regime;
 use crate::metrics::SummaryRow;
 use crate::output::{Claim, RunReport};
@@ -106,6 +110,12 @@ impl RatioMetric {
     /// The cost regime of a time-based metric (the CPU seconds it divides by).
     fn regime(self) -> Option<Regime> {
         matches!(self, RatioMetric::EfficiencyMse | RatioMetric::PEff).then_some(Regime::Measured)
+    }
+
+    /// Whether the metric is an error (it vanishes for an exact cell) rather than an inverse error
+    /// (it is unbounded there).
+    pub(crate) fn is_error(self) -> bool {
+        matches!(self, RatioMetric::Rmse | RatioMetric::Mse | RatioMetric::PErr | RatioMetric::RmseDisplay)
     }
 
     /// The power of the MSE the metric scales with (an RMSE is its square root).
@@ -277,6 +287,21 @@ pub fn ratio_claim(report: &RunReport, spec: &RatioSpec<'_>, claim: &str, note: 
             ..base
         };
     };
+    if let Some(exact) = ExactRatio::of(metric, a, b) {
+        let (verdict, held, reason) = exact.verdict(threshold, above);
+        return Claim {
+            held,
+            note: format!(
+                "{} {estimator} / {baseline} at {budget} {}: {}; {note}",
+                metric.name(),
+                a.budget_kind,
+                exact.describe()
+            ),
+            verdict: verdict.into(),
+            reason,
+            ..base
+        };
+    }
     let Some(r) = Ratio::of(metric, a, b) else {
         return Claim {
             verdict: "not measured".into(),

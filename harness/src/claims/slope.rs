@@ -2,7 +2,7 @@
 //! the whole budget range or its right end (where a paper's "reaches" is judged).
 
 use super::{fit, not_measured};
-use crate::analysis::SlopeRange;
+use crate::analysis::{SlopeOutcome, SlopeRange};
 use crate::output::{Claim, RunReport};
 
 /// The log-log slope between the last two budgets of a series (the local order at the right end).
@@ -23,7 +23,8 @@ pub const SLOPE_TOLERANCE: f64 = 0.05;
 
 /// A claim judged on an estimator's slope over `range`: `judge` gets (CI low, CI high, slope) and
 /// gives (held, note), `None` for inconclusive; not measured without a fit or without a slope over
-/// that range (a right-end slope needs 3 budgets).
+/// that range (a right-end slope needs 3 budgets); inconclusive for an estimator exact at every
+/// budget ([`SlopeOutcome::Exact`]).
 fn slope_claim(
     report: &RunReport,
     tb: (&str, &str),
@@ -34,6 +35,19 @@ fn slope_claim(
 ) -> Claim {
     match fit(report, tb.0, tb.1, estimator) {
         None => not_measured(tb.0, claim, paper, format!("{estimator} did not run (not available or skipped)")),
+        Some(f) if f.outcome == SlopeOutcome::Exact => Claim {
+            testbed: format!("{}/{}", tb.0, tb.1),
+            claim: claim.into(),
+            paper_value: Some(paper),
+            our_value: None,
+            held: None,
+            note: format!("{estimator} is exact at every budget ({:?}): its RMSE is round-off", f.budgets),
+            verdict: "inconclusive".into(),
+            reason: "exact at every budget: no slope to judge, an error of rounding alone has no order of \
+                     convergence"
+                .into(),
+            ..Default::default()
+        },
         Some(f) => {
             let (slope, lo, hi) = f.range(range);
             if !(slope.is_finite() && lo.is_finite() && hi.is_finite()) {

@@ -176,18 +176,19 @@ fn fits(b: &mut String, report: &RunReport) {
             .fits
             .iter()
             .map(|f| {
-                let right = if f.slope_right.is_finite() {
-                    format!("{:.3} [{:.3}, {:.3}]", f.slope_right, f.slope_right_ci_low, f.slope_right_ci_high)
-                } else {
-                    "-".into()
-                };
+                let right = f.describe(crate::analysis::SlopeRange::Right);
+                let exact = f.outcome == crate::analysis::SlopeOutcome::Exact;
                 let cells = vec![
                     Cell::text(&format!("{} / {}", f.testbed, f.variant)),
                     Cell::text(&label(report, &f.estimator)),
-                    Cell::num(&format!("{:.3}", f.slope)),
-                    Cell::num(&format!("[{:.3}, {:.3}]", f.slope_ci_low, f.slope_ci_high)),
-                    Cell::num(&format!("{:.4}", f.r2)),
-                    Cell::num(&right),
+                    Cell::num(&if exact { "exact at every budget".into() } else { format!("{:.3}", f.slope) }),
+                    Cell::num(&if exact {
+                        "-".into()
+                    } else {
+                        format!("[{:.3}, {:.3}]", f.slope_ci_low, f.slope_ci_high)
+                    }),
+                    Cell::num(&if exact { "-".into() } else { format!("{:.4}", f.r2) }),
+                    Cell::num(&if exact { "-".into() } else { right }),
                     Cell::text(&f.budgets.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")),
                 ];
                 (String::new(), cells)
@@ -201,20 +202,26 @@ fn fits(b: &mut String, report: &RunReport) {
             .speedups
             .iter()
             .map(|s| {
+                let unbounded = s.outcome == crate::analysis::SpeedUpOutcome::Unbounded;
+                let measured = crate::cost_model::Regime::Measured;
                 let cells = vec![
                     Cell::text(&format!("{} / {}", s.testbed, s.variant)),
                     Cell::text(&label(report, &s.estimator)),
                     Cell::text(&s.baseline),
                     Cell::num(&s.budget.to_string()),
-                    Cell::num(&sig(s.sample_ratio, 4)),
+                    Cell::num(&if unbounded { "unbounded".into() } else { sig(s.sample_ratio, 4) }),
                     Cell::num(&sig(s.overhead, 4)),
-                    Cell::num(&format!(
-                        "{} [{}, {}]",
-                        sig(s.speedup, 4),
-                        sig(s.speedup_ci_low, 3),
-                        sig(s.speedup_ci_high, 3)
-                    )),
-                    Cell::num(&sig(s.speedup_renderer, 4)),
+                    Cell::num(&if unbounded {
+                        s.describe(measured)
+                    } else {
+                        format!(
+                            "{} [{}, {}]",
+                            s.describe(measured),
+                            sig(s.speedup_ci_low, 3),
+                            sig(s.speedup_ci_high, 3)
+                        )
+                    }),
+                    Cell::num(&s.describe(crate::cost_model::Regime::Renderer)),
                 ];
                 (String::new(), cells)
             })

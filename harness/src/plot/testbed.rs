@@ -34,6 +34,9 @@ pub fn budget_unit(kind: &str) -> &str {
 pub fn legend(report: &RunReport, names: &DisplayNames, testbed: &str, variant: &str, name: &str) -> String {
     let mut label = names.estimator(name, Some(label_of(report, name)));
     let fit = report.fits.iter().find(|f| f.testbed == testbed && f.variant == variant && f.estimator == name);
+    if fit.is_some_and(|f| f.outcome == crate::analysis::SlopeOutcome::Exact) {
+        label.push_str(": exact at every budget");
+    }
     if let Some(f) = fit.filter(|f| f.slope.is_finite()) {
         label.push_str(&format!(": slope {:.2} [{:.2}, {:.2}]", f.slope, f.slope_ci_low, f.slope_ci_high));
         if f.slope_right.is_finite() && f.budgets_right.len() < f.budgets.len() {

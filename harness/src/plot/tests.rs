@@ -47,6 +47,7 @@ pub(crate) fn row(estimator: &str, budget: u64, rmse: f64, seconds: f64) -> Summ
         rmse_display: None,
         rmse_lo: None,
         rmse_hi: None,
+        rmse_roundoff: f64::NAN,
         fom_display: None,
         rep_blocks: Default::default(),
     }
@@ -128,6 +129,7 @@ pub fn synthetic_report() -> RunReport {
             speedup_renderer_ci_low: 16.0 / 0.2f64.exp(),
             speedup_renderer_ci_high: 16.0 * 0.2f64.exp(),
             interval_method: "delta method".into(),
+            outcome: Default::default(),
         }],
         skipped: vec![Skipped {
             testbed: "gradient-plane".into(),

@@ -84,6 +84,7 @@ const TEST_HEADER: &[&str] = &[
     "rel_bias",
     "rel_bias_se",
     "reason",
+    "spread",
 ];
 
 const CLAIM_HEADER: &[&str] = &[
