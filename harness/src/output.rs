@@ -286,6 +286,7 @@ pub const SUMMARY_HEADER: &[&str] = &[
     "fom_display",
     "rmse_lo",
     "rmse_hi",
+    "rmse_roundoff",
 ];
 
 /// Writes `summary.json`: one value per line without indentation (a quarter smaller than
