@@ -132,8 +132,8 @@ fn error_at(bed: &MediumBed, id: &str, rays: u64) -> f64 {
         .into_par_iter()
         .map(|i| {
             let truth = bed.reference().value[i][0];
-            let mut rng = StreamKey { seed: 8, testbed: "sig", estimator: id, budget: rays, rep: 0, integral: i as u64 }
-                .rng();
+            let mut rng =
+                StreamKey { seed: 8, testbed: "sig", estimator: id, budget: rays, rep: 0, integral: i as u64 }.rng();
             let mut s = 0.0;
             for _ in 0..REPS {
                 let task = Task::new(bed, i, Budget::samples(rays).unwrap());

@@ -281,7 +281,9 @@ pub fn compute_stored(
         return Err(ConfigError::invalid("reference", variant, "a pixel's estimate was not finite"));
     }
     let bound = match field {
-        Field::Eq21 => format!("optical-depth error <= {:.1e} per chord", eq21_tau_bound(bed.scale(), bed.exponent(), h)),
+        Field::Eq21 => {
+            format!("optical-depth error <= {:.1e} per chord", eq21_tau_bound(bed.scale(), bed.exponent(), h))
+        }
         Field::Perlin => "optical-depth error measured <= 1.7e-4 per chord on random chords (test)".to_string(),
     };
     let command = format!(
@@ -360,8 +362,8 @@ mod tests {
     }
 
     fn eq21_optical_depth_within_bound_and_inverse_at(k: i32) {
-        let b = MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("exponent", k as f64))
-            .unwrap();
+        let b =
+            MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("exponent", k as f64)).unwrap();
         let sigma = |p: Vec3| b.extinction(p);
         let h = panel(Field::Eq21, k);
         let bound = eq21_tau_bound(1.0, k, h);
