@@ -355,7 +355,9 @@ class Checker:
             pkgs = [package] if package else list(ws)
             if not any(name in ws[p].get(kind, set()) for p in pkgs):
                 self.problem(path, n, f"`cargo {sub}`: no {kind} target {name} in {package or 'the workspace'}")
-        if sub == "run" and rest is not None and package in (None, "experiments", "my-estimator"):
+        # after `--` the arguments are mcbench's, unless an example or another binary runs
+        runs_other = any(kind == "example" or (kind == "bin" and name != "mcbench") for kind, name in targets)
+        if sub == "run" and rest is not None and package in (None, "experiments", "my-estimator") and not runs_other:
             self.check_mcbench(path, n, rest)
 
     # ---- all ---------------------------------------------------------------------------------

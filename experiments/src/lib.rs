@@ -25,6 +25,7 @@ pub mod pmc_hi;
 pub mod pmc_hi_post;
 pub mod pmc_ip;
 pub mod pmc_ip_post;
+pub mod readme_table;
 pub mod sensitivity;
 pub mod single_scatter;
 pub mod single_scatter_post;

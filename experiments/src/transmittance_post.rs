@@ -40,7 +40,7 @@ struct BandRow {
     measured_mean: f64,
     /// Standard deviation of the one-ray estimates.
     measured_sd: f64,
-    /// Standard error of the measured variance (from the sample fourth moment).
+    /// Standard error of the measured variance (from the sample second and fourth moments).
     measured_variance_se: f64,
 }
 
@@ -91,7 +91,7 @@ pub fn post(
             paper_value: Some(POINTS as f64),
             our_value: Some(within as f64),
             held: Some(within == POINTS),
-            note: format!("points s = 1..20 whose measured variance lies within 4 SE of Eq. 16 ({RAYS} one-ray estimates each; SE from the sample fourth moment, itself unreliable for heavy tails); worst |z| {worst:.2}; data in fig8_bands.csv"),
+            note: format!("points s = 1..20 whose measured variance lies within 4 SE of Eq. 16 ({RAYS} one-ray estimates each; SE from the sample second and fourth moments, exact in n; itself unreliable for heavy tails); worst |z| {worst:.2}; data in fig8_bands.csv"),
             ..Default::default()
         });
     }

@@ -51,7 +51,18 @@ pub fn measure(est: &dyn Estimator, bed: &dyn TestBed, k: usize, n: usize, seed:
     }
     let v = m.variance();
     let m4 = xs.iter().map(|x| (x - m.mean()).powi(4)).sum::<f64>() / n as f64;
-    Measured { mean: m.mean(), variance: v, variance_se: ((m4 - v * v) / n as f64).max(0.0).sqrt() }
+    Measured { mean: m.mean(), variance: v, variance_se: sample_variance_se(m4, v * (n as f64 - 1.0) / n as f64, n) }
+}
+
+/// Standard error of the sample variance of `n` values with central moments `m2`, `m4` (both
+/// averaged over `n`): `Var(s^2) = m4 / n - m2^2 (n - 3) / (n (n - 1))`, the exact finite-`n`
+/// form with the moments plugged in. The first-order `(m4 - m2^2) / n` vanishes for a two-point
+/// distribution with equal weights (a binary estimate with T = 1/2: `m4 = m2^2`), where the
+/// sample variance still fluctuates at order `m2 / n`; a zero standard error would turn any
+/// difference into an infinite z.
+fn sample_variance_se(m4: f64, m2: f64, n: usize) -> f64 {
+    let n = n as f64;
+    (m4 / n - m2 * m2 * (n - 3.0) / (n * (n - 1.0))).max(0.0).sqrt()
 }
 
 /// The central-ray bed with `points` integrals, its extinction along the ray and the grid of s.
@@ -98,4 +109,22 @@ pub fn eq16_claims() -> Vec<Claim> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::sample_variance_se;
+
+    #[test]
+    fn variance_se_of_a_balanced_binary_sample_is_not_zero() {
+        // n values, half 0 and half 1: mean 1/2, m2 = 1/4, m4 = 1/16.
+        let n = 4000;
+        let se = sample_variance_se(1.0 / 16.0, 0.25, n);
+        // Exact for a Bernoulli(1/2) population: Var(s^2) = 1 / (8 n (n - 1)).
+        let exact = (1.0 / (8.0 * n as f64 * (n as f64 - 1.0))).sqrt();
+        assert!(se > 0.5 * exact && se < 2.0 * exact, "se {se:e}, exact {exact:e}");
+        // A normal sample: m4 = 3 v^2, so Var(s^2) is about 2 v^2 / n.
+        let se = sample_variance_se(3.0, 1.0, n);
+        assert!((se / (2.0 / n as f64).sqrt() - 1.0).abs() < 1e-3, "{se}");
+    }
 }

@@ -3,10 +3,14 @@
 
 use crate::math::Vec3;
 
-/// Paper 002 Eq. 21, the one place this formula lives (the exponent k is a parameter; maximum 1):
-/// `sigma_t = ((cos(1.5 (x + y + z)) + 1) / 2) * ((sin(z / 2) + 2) / 3)` inside the sphere.
-pub fn eq21(p: Vec3) -> f64 {
-    ((1.5 * (p.x + p.y + p.z)).cos() + 1.0) / 2.0 * (((p.z / 2.0).sin() + 2.0) / 3.0)
+/// Paper 002 Eq. 21, the one place this formula lives, with the exponent `k` of its first factor
+/// (the test bed's parameter `exponent`; maximum 1 for every `k`):
+/// `sigma_t = ((cos(1.5 (x + y + z)) + 1) / 2)^k * ((sin(z / 2) + 2) / 3)` inside the sphere.
+/// At `k = 1` the value is the product of the two factors bit for bit.
+pub fn eq21(p: Vec3, k: i32) -> f64 {
+    let wave = ((1.5 * (p.x + p.y + p.z)).cos() + 1.0) / 2.0;
+    let wave = if k == 1 { wave } else { wave.powi(k) };
+    wave * (((p.z / 2.0).sin() + 2.0) / 3.0)
 }
 
 /// Ken Perlin's reference permutation ("Improving noise", SIGGRAPH 2002).
@@ -195,10 +199,18 @@ mod tests {
     }
 
     #[test]
-    fn eq21_maximum_is_one() {
+    fn eq21_maximum_is_one_for_every_exponent() {
         // Both factors reach 1 at z = pi with x + y + z = 4 pi / 3 * k.
         let z = std::f64::consts::PI;
         let p = Vec3::new(4.0 * std::f64::consts::PI / 3.0 - z, 0.0, z);
-        assert!((eq21(p) - 1.0).abs() < 1e-12);
+        for k in [1, 2, 5, 16] {
+            assert!((eq21(p, k) - 1.0).abs() < 1e-12, "k = {k}");
+        }
+        // Elsewhere the exponent thins the medium: the wave factor below 1 shrinks with k.
+        let q = Vec3::new(0.3, -1.2, 7.0);
+        let wave = ((1.5 * (q.x + q.y + q.z)).cos() + 1.0) / 2.0;
+        assert!(wave < 0.99);
+        assert!((eq21(q, 5) / eq21(q, 1) - wave.powi(4)).abs() < 1e-12);
+        assert!(eq21(q, 5) < eq21(q, 1));
     }
 }

@@ -14,10 +14,10 @@
 //! - directions are uniform on the sphere with weight `4 pi p(w . w')` (Rayleigh, evaluated here);
 //! - Russian roulette below weight [`ROULETTE_BELOW`].
 //!
-//! Discretisation: only the optical depths are approximate. Eq. 21 is a sum of sinusoids along
-//! any ray whose angular frequencies are at most `1.5 sqrt 3 + 0.5`; the Gauss-Legendre remainder
-//! `h^9 (4!)^4 / (9 (8!)^3) max |f^(8)|` then bounds the optical-depth error of a whole chord by
-//! [`eq21_tau_bound`] (< 1e-7 at `h = 0.5`). Perlin's 12-octave field is only C0 (its clamp) with
+//! Discretisation: only the optical depths are approximate. Eq. 21 with exponent k is a sum of
+//! sinusoids along any ray whose angular frequencies are at most `1.5 k sqrt 3 + 0.5`; the
+//! Gauss-Legendre remainder `h^9 (4!)^4 / (9 (8!)^3) max |f^(8)|` then bounds the optical-depth
+//! error of a whole chord by [`eq21_tau_bound`] (< 1e-7 at `h = 0.5 / k` for k = 1 and 5). Perlin's 12-octave field is only C0 (its clamp) with
 //! lattice cells down to 1/512, so there the error is measured, not bounded a priori: at panels of
 //! 1/16 the worst optical-depth error on random chords measured 1.7e-4 (mean 3.5e-5) against the
 //! adaptive reference quadrature of [`super::reference`] (test `perlin_optical_depth_error`). Either error changes the radiance by a relative amount of order
@@ -47,10 +47,11 @@ pub const ROULETTE_BELOW: f64 = 0.05;
 /// What the stored files' `command` says made them.
 pub const METHOD: &str = "independent expected-value walk: optical depth by composite 4-point Gauss-Legendre, forced collisions by inverting it, uniform-sphere directions weighted by the phase function";
 
-/// Panel length of the optical-depth quadrature per field.
-pub fn panel(field: Field) -> f64 {
+/// Panel length of the optical-depth quadrature per field (Eq. 21: 0.5 / k for exponent k, whose
+/// highest frequency grows with k).
+pub fn panel(field: Field, exponent: i32) -> f64 {
     match field {
-        Field::Eq21 => 0.5,
+        Field::Eq21 => 0.5 / exponent.max(1) as f64,
         Field::Perlin => 1.0 / 16.0,
     }
 }
@@ -73,13 +74,25 @@ const GL4: [(f64, f64); 4] = [
     (0.861_136_311_594_052_6, 0.347_854_845_137_453_86),
 ];
 
-/// A priori bound on the optical-depth error of one chord (length <= 2 R = 20) of Eq. 21 at scale
-/// `scale` with panels of length `h`: Gauss-Legendre remainder times a bound on `|f^(8)|` from the
-/// sinusoids `(cos(1.5 (x + y + z)) + 1) (sin(z / 2) + 2) / 6` (frequencies `b <= 1.5 sqrt 3`,
-/// `d <= 0.5`: `f^(8) <= ((b + d)^8 + 2 b^8 + d^8) / 6`).
-pub fn eq21_tau_bound(scale: f64, h: f64) -> f64 {
+/// A priori bound on the optical-depth error of one chord (length <= 2 R = 20) of Eq. 21 with
+/// exponent `k` at scale `scale` with panels of length `h`: Gauss-Legendre remainder times a bound
+/// on `|f^(8)|`. The first factor is `((1 + cos u) / 2)^k = sum_j c_j cos(j u)` with
+/// `c_0 = C(2k, k) / 4^k`, `c_j = 2 C(2k, k - j) / 4^k` (a sum of sinusoids of frequencies `j b`,
+/// `b <= 1.5 sqrt 3`), the second `(2 + sin v) / 3` (`d <= 0.5`), and `cos(j u) sin v` splits into
+/// sines of frequencies `j b + d` and `|j b - d|`: `f^(8) <= sum_j c_j (2 (j b)^8 + ((j b + d)^8 +
+/// |j b - d|^8) / 2) / 3`.
+pub fn eq21_tau_bound(scale: f64, k: i32, h: f64) -> f64 {
     let (b, d) = (1.5 * 3f64.sqrt(), 0.5);
-    let f8 = ((b + d).powi(8) + 2.0 * b.powi(8) + d.powi(8)) / 6.0;
+    let k = k.max(1) as u32;
+    let binom = |n: u32, r: u32| (0..r).fold(1.0f64, |acc, i| acc * (n - i) as f64 / (i + 1) as f64);
+    let quarter_k = 0.25f64.powi(k as i32);
+    let f8: f64 = (0..=k)
+        .map(|j| {
+            let c = if j == 0 { binom(2 * k, k) } else { 2.0 * binom(2 * k, k - j) } * quarter_k;
+            let f = j as f64 * b;
+            c * (2.0 * f.powi(8) + ((f + d).powi(8) + (f - d).abs().powi(8)) / 2.0) / 3.0
+        })
+        .sum();
     let fact4: f64 = 24.0;
     let fact8: f64 = 40_320.0;
     let per_panel = h.powi(9) * fact4.powi(4) / (9.0 * fact8.powi(3)) * f8;
@@ -261,14 +274,16 @@ pub fn compute_stored(
     let per_batch = samples.div_ceil(BATCHES).max(1);
     let bed = MediumBed::without_reference(field, variant, params)?;
     let key = bed.reference_key();
-    let h = panel(field);
+    let h = panel(field, bed.exponent());
     let res = bed.resolution().0;
     let out = crate::parallel::map_indices(bed.integrals(), threads, |i| pixel(&bed, h, i, per_batch));
     if out.iter().any(|(m, e)| !m.is_finite() || !e.is_finite()) {
         return Err(ConfigError::invalid("reference", variant, "a pixel's estimate was not finite"));
     }
     let bound = match field {
-        Field::Eq21 => format!("optical-depth error <= {:.1e} per chord", eq21_tau_bound(bed.scale(), h)),
+        Field::Eq21 => {
+            format!("optical-depth error <= {:.1e} per chord", eq21_tau_bound(bed.scale(), bed.exponent(), h))
+        }
         Field::Perlin => "optical-depth error measured <= 1.7e-4 per chord on random chords (test)".to_string(),
     };
     let command = format!(
@@ -341,13 +356,23 @@ mod tests {
     /// a priori bound, and inverting it reaches the wanted optical depth within the same bound.
     #[test]
     fn eq21_optical_depth_within_bound_and_inverse() {
-        let b = bed(Field::Eq21, "multiple");
+        for k in [1, 5] {
+            eq21_optical_depth_within_bound_and_inverse_at(k);
+        }
+    }
+
+    fn eq21_optical_depth_within_bound_and_inverse_at(k: i32) {
+        let b =
+            MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("exponent", k as f64)).unwrap();
         let sigma = |p: Vec3| b.extinction(p);
-        let bound = eq21_tau_bound(1.0, panel(Field::Eq21));
+        let h = panel(Field::Eq21, k);
+        let bound = eq21_tau_bound(1.0, k, h);
         assert!(bound < 1e-7, "{bound:e}");
+        // The bound has teeth: panels four times longer break it at k = 5.
+        assert!(k == 1 || eq21_tau_bound(1.0, k, 4.0 * h) > 1e-6);
         for (p, w) in chords(200) {
             let (a, c) = sphere_interval(p, w).unwrap();
-            let ours = OpticalDepth::new(&sigma, p, w, (a, c), panel(Field::Eq21));
+            let ours = OpticalDepth::new(&sigma, p, w, (a, c), h);
             let exact = super::super::reference::optical_depth(&b, p, w, a, c).value;
             assert!((ours.total() - exact).abs() <= bound, "{} vs {exact}", ours.total());
             let s = a + 0.37 * (c - a);
@@ -370,7 +395,7 @@ mod tests {
         let mut worst = 0.0f64;
         for (p, w) in chords(3) {
             let (a, c) = sphere_interval(p, w).unwrap();
-            let ours = OpticalDepth::new(&sigma, p, w, (a, c), panel(Field::Perlin)).total();
+            let ours = OpticalDepth::new(&sigma, p, w, (a, c), panel(Field::Perlin, 1)).total();
             let exact = super::super::reference::optical_depth_with(&b, p, w, (a, c), 512.0, 1e-8).value;
             worst = worst.max((ours - exact).abs());
         }
@@ -384,7 +409,7 @@ mod tests {
         let t = bed(Field::Eq21, "transmittance");
         let ray = b.ray(100);
         let mut rng = StreamKey { seed: 1, testbed: "t", estimator: "e", budget: 0, rep: 0, integral: 0 }.rng();
-        let v = radiance(&b, panel(Field::Eq21), ray.origin, ray.dir, &mut rng);
+        let v = radiance(&b, panel(Field::Eq21, b.exponent()), ray.origin, ray.dir, &mut rng);
         let (a, c) = sphere_interval(ray.origin, ray.dir).unwrap();
         let exact = (-super::super::reference::optical_depth(&t, ray.origin, ray.dir, a, c).value).exp();
         let env = b.environment(ray.dir);

@@ -45,6 +45,9 @@ pub const RADIUS: f64 = 10.0;
 pub const VARIANTS: &[&str] = &["central-ray", "transmittance", "multiple", "single-scatter"];
 /// The point light of the media test beds: intensity 100 (power 400 pi) at the sphere's centre.
 pub const LIGHT: PointLight = PointLight { position: CENTRE, intensity: 100.0 };
+/// The default exponent `k` of Eq. 21's first factor (parameter `exponent` of `eq21-medium`; the
+/// book's paper-002 chapter gives the evidence for the reading).
+pub const DEFAULT_EXPONENT: i32 = 5;
 /// Closest a pixel ray may pass the light: the single-scattered radiance grows like `1 / D`.
 pub const MIN_LIGHT_DISTANCE: f64 = 1e-9;
 
@@ -126,6 +129,7 @@ pub struct MediumBed {
     variant: String,
     scale: f64,
     albedo: f64,
+    exponent: i32,
     resolution: (usize, usize),
     rays: Vec<MediumRay>,
     light: PointLight,
@@ -161,7 +165,7 @@ impl MediumBed {
     }
 
     /// What a stored reference of this scene is looked up by: variant, resolution, extinction
-    /// scale and albedo, and for `single-scatter` the light.
+    /// scale and albedo, Eq. 21's exponent, and for `single-scatter` the light.
     pub fn reference_key(&self) -> ReferenceKey {
         let mut params = vec![
             ("resolution", serde_json::Value::from(self.resolution.0)),
@@ -170,6 +174,10 @@ impl MediumBed {
         ];
         let default_res = if self.variant == "single-scatter" { self.default_resolution() } else { 16 };
         let mut default = self.resolution.0 == default_res && self.scale == 1.0 && self.albedo == self.field.albedo();
+        if self.field == Field::Eq21 {
+            params.push(("exponent", self.exponent.into()));
+            default &= self.exponent == DEFAULT_EXPONENT;
+        }
         if self.variant == "single-scatter" {
             let l = self.light;
             params.extend([
@@ -206,6 +214,7 @@ impl MediumBed {
         }
         p.check_for(field, variant)?;
         let scale = p.scale;
+        let exponent = if field == Field::Eq21 { p.exponent() } else { 1 };
         let default_res = match (variant, field) {
             ("single-scatter", Field::Perlin) => scatter_reference::PERLIN_RESOLUTION,
             ("single-scatter", Field::Eq21) => scatter_reference::EQ21_RESOLUTION,
@@ -251,6 +260,7 @@ impl MediumBed {
             variant: variant.to_string(),
             scale,
             albedo,
+            exponent,
             resolution,
             rays,
             light,
@@ -288,6 +298,11 @@ impl MediumBed {
         self.scale
     }
 
+    /// Eq. 21's exponent (1 for Perlin, which has none).
+    pub fn exponent(&self) -> i32 {
+        self.exponent
+    }
+
     /// The field.
     pub fn field(&self) -> Field {
         self.field
@@ -301,7 +316,7 @@ impl MediumBed {
         }
         self.scale
             * match self.field {
-                Field::Eq21 => density::eq21(p),
+                Field::Eq21 => density::eq21(p, self.exponent),
                 Field::Perlin => density::perlin(p, density::perlin_constants::OCTAVES),
             }
     }

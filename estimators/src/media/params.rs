@@ -29,6 +29,9 @@ pub struct MediumParams {
     pub light_z: Option<f64>,
     /// Point light intensity (`single-scatter` only; 0 to 1e12, exclusive of 0; unset: 100).
     pub intensity: Option<f64>,
+    /// The exponent k of Eq. 21's first factor, `((cos(1.5 (x + y + z)) + 1) / 2)^k`
+    /// (`eq21-medium` only; 1 to 16; unset: [`super::DEFAULT_EXPONENT`]).
+    pub exponent: Option<usize>,
 }
 
 impl Default for MediumParams {
@@ -42,6 +45,7 @@ impl Default for MediumParams {
             light_y: None,
             light_z: None,
             intensity: None,
+            exponent: None,
         }
     }
 }
@@ -54,6 +58,9 @@ impl ParamSet for MediumParams {
         check_count("points", self.points, 10_000)?;
         if let Some(a) = self.albedo {
             check_range("albedo", a, 0.0, 1.0)?;
+        }
+        if let Some(k) = self.exponent {
+            check_count("exponent", k, 16)?;
         }
         Ok(())
     }
@@ -73,23 +80,35 @@ impl MediumParams {
         .map(|(name, _)| name)
     }
 
-    /// Checks what depends on the field and the variant: the scale's range, and light parameters
-    /// only for `single-scatter` (elsewhere there is no light).
+    /// Checks what depends on the field and the variant: the scale's range, the exponent only for
+    /// `eq21-medium`, and light parameters only for `single-scatter` (elsewhere there is no light).
     pub fn check_for(&self, field: Field, variant: &str) -> Result<(), ConfigError> {
         if !(self.scale > 0.0 && self.scale <= 1e6) {
             return Err(ConfigError::invalid(format!("{}.scale", field.id()), self.scale, "must lie in (0, 1e6]"));
+        }
+        if field == Field::Perlin && self.exponent.is_some() {
+            return Err(ConfigError::UnknownName {
+                kind: "parameter",
+                name: format!("{}.exponent", field.id()),
+                valid: "resolution, points, scale, albedo, light_x, light_y, light_z, intensity (exponent is Eq. 21's, eq21-medium only)".into(),
+            });
         }
         if variant != "single-scatter" {
             if let Some(name) = self.light_given() {
                 return Err(ConfigError::UnknownName {
                     kind: "parameter",
                     name: format!("{}.{name}", field.id()),
-                    valid: "resolution, points, scale, albedo (the light parameters apply to single-scatter only)"
+                    valid: "resolution, points, scale, albedo, exponent (the light parameters apply to single-scatter only)"
                         .into(),
                 });
             }
         }
         Ok(())
+    }
+
+    /// The exponent of Eq. 21 (unset: [`super::DEFAULT_EXPONENT`]).
+    pub fn exponent(&self) -> i32 {
+        self.exponent.map_or(super::DEFAULT_EXPONENT, |k| k as i32)
     }
 
     /// The point light (defaults: intensity 100 at the sphere's centre).

@@ -148,11 +148,18 @@ impl Estimator for Spm {
         }
         Ok(mean.mean())
     }
+    /// A terminating model whose `r` can exceed `2/(a+1)` on this bed is a skipped pair with the
+    /// reason (as delta tracking below a majorant), so a sweep over sigma_samp and media runs it
+    /// only where it is valid; [`Estimator::validate`] refuses it with the same reason.
     fn supports(&self, bed: &dyn TestBed) -> Result<(), String> {
         match bed.medium().map(|m| m.ray(0).quantity) {
-            Some(MediumQuantity::Radiance) => Ok(()),
-            _ => Err("particle tracing estimates scattered radiance; this variant is a transmittance".into()),
+            Some(MediumQuantity::Radiance) => {}
+            _ => return Err("particle tracing estimates scattered radiance; this variant is a transmittance".into()),
         }
+        if self.mode == SpmMode::Terminating {
+            check_terminating("spm_terminating", self.sigma_samp, bed).map_err(|e| e.to_string())?;
+        }
+        Ok(())
     }
     fn validate(&self, bed: &dyn TestBed) -> Result<(), ConfigError> {
         if self.mode == SpmMode::Terminating {

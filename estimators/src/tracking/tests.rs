@@ -124,6 +124,11 @@ fn invalid_terminating_configurations_are_refused() {
         build("spm_terminating", Params::new().with("sigma_samp", 0.8)).validate(&multiple).unwrap_err().to_string();
     assert!(err.contains("2/(a+1)"), "{err}");
     assert!(build("spm_terminating", Params::new().with("sigma_samp", 1.0)).validate(&multiple).is_ok());
+    // In a sweep the same configuration is a skipped pair with the reason (valid at 0.9 on Eq. 21,
+    // albedo 0.7: r <= 1/0.9 < 2/1.7; not at 0.8).
+    let skip = build("spm_terminating", Params::new().with("sigma_samp", 0.8)).supports(&multiple).unwrap_err();
+    assert!(skip.contains("spm_terminating.sigma_samp") && skip.contains("2/(a+1)"), "{skip}");
+    assert!(build("spm_terminating", Params::new().with("sigma_samp", 0.9)).supports(&multiple).is_ok());
     assert!(matches!(super::interact(super::Rule::Terminating { a: 0.7 }, -0.1, 0.5), Err(EstimateError::Refused(_))));
     assert!(registry::estimator("double_particle")
         .map(|e| (e.build)(&Params::new().with("sigma_samp", 0.0)).is_err())

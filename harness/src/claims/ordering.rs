@@ -76,6 +76,24 @@ fn repetitions_to_decide((value, reps): (f64, usize), (lo, hi): (f64, f64), thre
     (need.is_finite() && gap > 0.0).then_some(need)
 }
 
+/// The smallest ratio `d` (and so `1 / d`) that an interval `(lo, hi)` of a ratio at `level` tells
+/// apart from 1 with 80% power: the log standard error read off the interval's width,
+/// `se = ln(hi / lo) / (2 z)` with `z` the level's normal quantile, and `d = exp(se (z + z_0.8))`.
+/// `None` for an empty or non-positive interval.
+pub fn detectable_ratio((lo, hi): (f64, f64), level: f64) -> Option<f64> {
+    let normal = |p: f64| estimators::stats::hypothesis::t_quantile(p, f64::INFINITY);
+    let z = normal(1.0 - (1.0 - level) / 2.0);
+    let se = (hi / lo).ln() / (2.0 * z);
+    let d = (se * (z + normal(0.8))).exp();
+    (lo > 0.0 && d.is_finite() && d > 1.0).then_some(d)
+}
+
+/// The repetitions at which [`detectable_ratio`] would fall to `target` (the log standard error
+/// falls as `1/sqrt(repetitions)`).
+pub fn repetitions_to_detect(detectable: f64, reps: usize, target: f64) -> f64 {
+    (reps as f64 * (detectable.ln() / target.ln()).powi(2)).ceil()
+}
+
 fn missing(base: Claim, why: String) -> Claim {
     Claim { verdict: "inconclusive".into(), held: None, reason: why.clone(), note: why, ..base }
 }
@@ -285,11 +303,15 @@ pub fn optimum_claim(
         .map(|(w, r)| format!("{} {:.4e} ({w})", r.estimator, value(r).unwrap_or(f64::NAN)))
         .collect();
     let (lo, hi) = r.interval_at(level);
+    let power = detectable_ratio((lo, hi), level).map_or(String::new(), |d| {
+        let tenth = repetitions_to_detect(d, r.reps, 1.1);
+        format!("; detectable ratio {d:.3} (80% power at this level; a 10% difference needs about {tenth} repetitions)")
+    });
     Claim {
         our_value: Some(r.value),
         held,
         note: format!(
-            "{} at {budget} ({} repetitions), {} is best; best inside / best outside {:.4} [{lo:.4}, {hi:.4}]: {}",
+            "{} at {budget} ({} repetitions), {} is best; best inside / best outside {:.4} [{lo:.4}, {hi:.4}]{power}: {}",
             family.metric.name(),
             r.reps,
             if lowest { "lowest" } else { "highest" },

@@ -140,3 +140,19 @@ fn a_claim_without_a_budget_uses_the_largest() {
     assert_eq!((c.verdict.as_str(), c.our_value), ("held", Some(0.5)), "{c:?}");
     assert!(c.note.contains("at 64"), "{}", c.note);
 }
+
+#[test]
+fn detectable_ratio_reads_the_log_standard_error_off_the_interval() {
+    use super::{detectable_ratio, repetitions_to_detect};
+    // [0.9, 1.1] at 95%: se = ln(1.1 / 0.9) / (2 x 1.95996) = 0.05119, d = exp(0.05119 x 2.80158).
+    let d = detectable_ratio((0.9, 1.1), 0.95).unwrap();
+    assert!((d - (0.051_19_f64 * 2.801_58).exp()).abs() < 1e-4, "{d}");
+    // A wider interval or a stricter level detects only larger ratios.
+    assert!(detectable_ratio((0.8, 1.25), 0.95).unwrap() > d);
+    assert!(detectable_ratio((0.9, 1.1), 0.99).unwrap() < d, "same width at a stricter level: smaller se");
+    assert_eq!(detectable_ratio((0.0, 1.1), 0.95), None);
+    assert_eq!(detectable_ratio((1.0, 1.0), 0.95), None);
+    // Repetitions scale with the square of the log ratio: half the log needs four times as many.
+    let n = repetitions_to_detect(1.21, 16, 1.1);
+    assert!((64.0..=65.0).contains(&n), "{n}");
+}

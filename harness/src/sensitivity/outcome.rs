@@ -1,7 +1,8 @@
 //! How a part ends: one outcome from its verdicts at every setting, decided in a fixed order
 //! (held at the paper-like setting; else holds where it held; else cannot hold, when a ceiling
 //! lies below the claim at every setting; else unsupportable as written, when the file states
-//! why; else not held anywhere tried).
+//! why; else not held anywhere tried, when at least one setting is not held; else inconclusive at
+//! every setting tried: an outcome is never stronger than its verdicts).
 
 use super::table::SettingRow;
 use super::{setting_text, Part};
@@ -32,9 +33,16 @@ pub enum Outcome {
     },
     /// The file's reason the claim cannot be supported as written.
     Unsupportable(String),
-    /// Held at no setting tried, with no ceiling or reason that explains it.
+    /// Held at no setting tried and not held at one at least, with no ceiling or reason that
+    /// explains it.
     NotHeldAnywhere {
         /// The best value and where.
+        best: String,
+    },
+    /// Neither held nor not held at any setting tried: every verdict is inconclusive (or not
+    /// measured), so the part decides nothing either way.
+    InconclusiveEverywhere {
+        /// The value closest to the paper's and where.
         best: String,
     },
 }
@@ -52,7 +60,8 @@ fn at(r: &SettingRow, vary: &str) -> String {
 }
 
 impl Outcome {
-    /// The outcome's class, one of the four the report names (or `not held at any setting tried`).
+    /// The outcome's class, one of the four the report names (or `not held at any setting tried`,
+    /// or `inconclusive at every setting tried`).
     pub fn kind(&self) -> &'static str {
         match self {
             Outcome::HeldAtPaperLike { .. } => "held at the paper-like setting",
@@ -60,6 +69,7 @@ impl Outcome {
             Outcome::CannotHold { .. } => "cannot hold on this scene",
             Outcome::Unsupportable(_) => "unsupportable as written",
             Outcome::NotHeldAnywhere { .. } => "not held at any setting tried",
+            Outcome::InconclusiveEverywhere { .. } => "inconclusive at every setting tried",
         }
     }
 
@@ -77,6 +87,9 @@ impl Outcome {
             }
             Outcome::Unsupportable(why) => format!("unsupportable as written: {why}"),
             Outcome::NotHeldAnywhere { best } => format!("not held at any setting tried; the closest: {best}"),
+            Outcome::InconclusiveEverywhere { best } => {
+                format!("inconclusive at every setting tried; the closest: {best}")
+            }
         }
     }
 }
@@ -126,5 +139,9 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
             d(a).total_cmp(&d(b))
         })
         .map_or_else(|| "no setting measured".to_string(), |r| at(r, &part.vary));
-    Outcome::NotHeldAnywhere { best }
+    if rows.iter().any(|r| r.verdict == "not held") {
+        Outcome::NotHeldAnywhere { best }
+    } else {
+        Outcome::InconclusiveEverywhere { best }
+    }
 }

@@ -120,6 +120,27 @@ fn the_outcome_is_decided_in_order() {
 }
 
 #[test]
+fn not_held_anywhere_needs_a_not_held_setting_and_inconclusive_everywhere_says_so() {
+    let f = file_with(("", "")).unwrap();
+    let p = &f.parts[0];
+    // Every setting inconclusive (no ceiling, no reason): nothing is decided either way.
+    let (a, b) = (row("1", "paper-like", 4.0, "inconclusive", None), row("5", "default", 2.0, "inconclusive", None));
+    let o = classify(p, &[&a, &b]);
+    assert!(matches!(o, Outcome::InconclusiveEverywhere { .. }), "{o:?}");
+    assert_eq!(o.kind(), "inconclusive at every setting tried");
+    assert!(o.sentence().starts_with("inconclusive at every setting tried; the closest: "), "{}", o.sentence());
+    assert!(!o.sentence().contains("not held at any"), "{}", o.sentence());
+    // One setting not held, the other inconclusive, none held: not held at any setting tried.
+    let (a, b) = (row("1", "paper-like", 4.0, "not held", None), row("5", "default", 2.0, "inconclusive", None));
+    let o = classify(p, &[&a, &b]);
+    assert!(matches!(o, Outcome::NotHeldAnywhere { .. }), "{o:?}");
+    assert_eq!(o.kind(), "not held at any setting tried");
+    // A held setting still wins over both.
+    let (a, b) = (row("1", "paper-like", 4.0, "inconclusive", None), row("5", "default", 2.0, "held", None));
+    assert!(matches!(classify(p, &[&a, &b]), Outcome::HoldsWhere { .. }));
+}
+
+#[test]
 fn the_work_ratio_ceiling_divides_error_times_rays_by_the_claims_own_error() {
     use super::run::ceiling;
     let mut report = crate::plot::tests::synthetic_report();
