@@ -5,10 +5,10 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
 use estimators::budget::Budget;
+use estimators::builtins;
 use estimators::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, St};
 use estimators::math::Rgb;
 use estimators::params::Params;
-use estimators::registry;
 use estimators::rng::stream;
 use estimators::task::Task;
 
@@ -61,7 +61,7 @@ fn cache_ops(c: &mut Criterion) {
 }
 
 fn is1_cv2_estimate(c: &mut Criterion) {
-    let bed = (registry::testbed("gradient-plane").unwrap().build)(
+    let bed = (builtins::testbed("gradient-plane").unwrap().build)(
         "default",
         &Params::new().with("resolution", 8.0),
         &estimators::references::NoReferences,
@@ -71,7 +71,7 @@ fn is1_cv2_estimate(c: &mut Criterion) {
     for spp in [64u64, 1024, 4096] {
         group.throughput(Throughput::Elements(spp));
         for id in ["is0_cv0", "is1_cv2"] {
-            let est = (registry::estimator(id).unwrap().build)(&Params::new()).expect("estimator");
+            let est = (builtins::estimator(id).unwrap().build)(&Params::new()).expect("estimator");
             let mut rng = stream(3, id);
             let mut i = 0;
             group.bench_function(BenchmarkId::new(id, spp), |b| {

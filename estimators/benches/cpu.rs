@@ -16,8 +16,8 @@
 //! (with `samples` = target evaluations).
 
 use estimators::budget::Budget;
+use estimators::builtins;
 use estimators::params::{ParamValue, Params};
-use estimators::registry;
 use estimators::rng::stream;
 use estimators::task::Task;
 use estimators::testbed::TestBed;
@@ -37,7 +37,7 @@ type Measured = (f64, u64, Vec<(&'static str, f64)>, u64);
 
 /// One whole-image sequence of `id` at `spp` samples per integral.
 fn run(bed: &dyn TestBed, id: &str, spp: u64, params: &Params, seed: u64) -> Measured {
-    let est = (registry::estimator(id).expect("registered").build)(params).expect("builds");
+    let est = (builtins::estimator(id).expect("registered").build)(params).expect("builds");
     let n = bed.integrals();
     let frames = bed.sequence_length().max(1);
     let tasks: Vec<Task<'_>> = (0..n).map(|i| Task::new(bed, i, Budget::samples(spp).expect("spp"))).collect();
@@ -66,7 +66,7 @@ fn run(bed: &dyn TestBed, id: &str, spp: u64, params: &Params, seed: u64) -> Mea
 /// estimates (equal hashes: bit-identical results).
 fn tracking(estimates: u64, ids: &[String]) {
     use rand::Rng;
-    let bed = (registry::testbed("eq21-medium").unwrap().build)(
+    let bed = (builtins::testbed("eq21-medium").unwrap().build)(
         "central-ray",
         &Params::new(),
         &estimators::references::NoReferences,
@@ -94,7 +94,7 @@ fn tracking(estimates: u64, ids: &[String]) {
             }
             (t0, estimates * 16 * points.len() as u64)
         } else {
-            let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+            let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
             let mut rng = stream(11, id);
             let (mut fetches, mut h) = (0, 0xcbf2_9ce4_8422_2325u64);
             let t0 = thread_cpu_seconds();
@@ -146,7 +146,7 @@ fn main() {
     let (bed, spp, per): (Box<dyn TestBed>, u64, &str) = match mode.as_str() {
         "media" => (Box::new(GradientBox::without_reference("albedo-0.8", &Params::new()).expect("bed")), size, "path"),
         "surface" => (
-            (registry::testbed("gradient-plane").unwrap().build)(
+            (builtins::testbed("gradient-plane").unwrap().build)(
                 "default",
                 &Params::new().with("resolution", res),
                 &estimators::references::NoReferences,
@@ -156,7 +156,7 @@ fn main() {
             "sample",
         ),
         "envmap" => (
-            (registry::testbed("envmap-sequence").unwrap().build)(
+            (builtins::testbed("envmap-sequence").unwrap().build)(
                 &variant,
                 &Params::new().with("resolution", res).with("frames", size as f64),
                 &estimators::references::NoReferences,

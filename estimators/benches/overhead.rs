@@ -20,13 +20,13 @@
 use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
 use estimators::budget::Budget;
+use estimators::builtins;
 use estimators::cache::{CacheConfig, ControlVariate, Domain, St};
 use estimators::math::{Rgb, Vec3};
 use estimators::media_smc::octree::{self, Octree};
 use estimators::media_smc::walk::{self, Flight, Vertex};
 use estimators::media_smc::{Sampling, Transport};
 use estimators::params::Params;
-use estimators::registry;
 use estimators::rng::stream;
 use estimators::task::{MediumProbe, Task};
 use estimators::testbeds::gradient_box::GradientBox;
@@ -195,13 +195,13 @@ fn media_vertex(c: &mut Criterion<ThreadCpu>) {
 
 fn surface_sample(c: &mut Criterion<ThreadCpu>) {
     const SPP: u64 = 1024;
-    let entry = registry::testbed("gradient-plane").expect("registered");
+    let entry = builtins::testbed("gradient-plane").expect("registered");
     let bed = (entry.build)("default", &Params::new(), &estimators::references::NoReferences).expect("bed");
     let mut group = c.benchmark_group("overhead_surface_sample");
     short(&mut group);
     group.throughput(Throughput::Elements(SPP));
     for id in ["brdf_is0_cv0", "is1_cv2"] {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let (mut rng, mut i) = (stream(3, id), 0);
         group.bench_function(id, |b| {
             b.iter(|| {
@@ -216,7 +216,7 @@ fn surface_sample(c: &mut Criterion<ThreadCpu>) {
 
 fn smc_frame(c: &mut Criterion<ThreadCpu>) {
     const FRAMES: usize = 10;
-    let entry = registry::testbed("envmap-sequence").expect("registered");
+    let entry = builtins::testbed("envmap-sequence").expect("registered");
     let params = Params::new().with("resolution", 4.0).with("frames", FRAMES as f64);
     let bed = (entry.build)("mixed", &params, &estimators::references::NoReferences).expect("bed");
     let budget = Budget::samples(16).expect("budget");
@@ -226,7 +226,7 @@ fn smc_frame(c: &mut Criterion<ThreadCpu>) {
     short(&mut group);
     group.throughput(Throughput::Elements(FRAMES as u64));
     for id in ["bidirectional_is", "smc"] {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let mut rng = stream(5, id);
         group.bench_function(id, |b| {
             b.iter(|| {

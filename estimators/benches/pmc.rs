@@ -6,9 +6,9 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use estimators::budget::Budget;
+use estimators::builtins;
 use estimators::params::Params;
 use estimators::pmc::ip::PmcIp;
-use estimators::registry;
 use estimators::rng::stream;
 use estimators::stats::Moments;
 use estimators::task::Task;
@@ -21,7 +21,7 @@ fn image(c: &mut Criterion) {
     let mut group = c.benchmark_group("checker_image_8x8_10spp");
     group.throughput(Throughput::Elements(10 * bed.integrals() as u64));
     for id in ["uniform_image", "pmc_ip"] {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let mut rng = stream(1, id);
         group.bench_function(BenchmarkId::from_parameter(id), |b| {
             b.iter(|| {

@@ -5,10 +5,10 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use estimators::budget::Budget;
+use estimators::builtins;
 use estimators::media::scatter_reference::{single_scatter, Settings};
 use estimators::media::{Field, MediumBed};
 use estimators::params::Params;
-use estimators::registry;
 use estimators::rng::stream;
 use estimators::task::Task;
 use estimators::testbed::{MediumQuantity, MediumScene};
@@ -29,7 +29,7 @@ fn bench(c: &mut Criterion) {
     let pixel = 3 * 8 + 3;
     let mut group = c.benchmark_group("single_scatter_4spp");
     for id in IDS {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let mut rng = stream(1, id);
         group.bench_function(id, |b| {
             b.iter(|| {

@@ -13,9 +13,9 @@
 
 use criterion::{black_box, Criterion, Throughput};
 use estimators::budget::Budget;
+use estimators::builtins;
 use estimators::math::Vec3;
 use estimators::params::Params;
-use estimators::registry;
 use estimators::rng::stream;
 use estimators::task::Task;
 use estimators::testbed::TestBed;
@@ -56,7 +56,7 @@ impl Tally {
 }
 
 fn bed(id: &str, variant: &str) -> Box<dyn TestBed> {
-    let entry = registry::testbed(id).expect("registered medium");
+    let entry = builtins::testbed(id).expect("registered medium");
     (entry.build)(variant, &Params::new(), &estimators::references::NoReferences).expect("builds")
 }
 
@@ -110,7 +110,7 @@ fn bare_fetch(c: &mut Criterion, medium: &str, bed: &dyn TestBed, tally: &mut Ta
 /// One estimate of `RAYS` rays on the last central-ray integral (s = 20).
 fn tracker(c: &mut Criterion, medium: &str, bed: &dyn TestBed, label: &str, id: &str, params: &[(&str, f64)]) -> Tally {
     let params = params.iter().fold(Params::new(), |p, (k, v)| p.with(k, *v));
-    let estimator = (registry::estimator(id).expect("registered").build)(&params).expect("builds");
+    let estimator = (builtins::estimator(id).expect("registered").build)(&params).expect("builds");
     let integral = bed.integrals() - 1;
     let budget = Budget::samples(RAYS).expect("budget");
     let mut rng = stream(11, label);

@@ -7,7 +7,7 @@
 
 use crate::canonical_sweep::{family_of, spec, terminating_min_ratio, FAMILIES, RATIOS};
 use estimators::estimator::Bias;
-use estimators::media::moments::EstimateMoments;
+use estimators::estimator::EstimateMoments;
 use estimators::registry;
 use estimators::stats::detectable_shift;
 use estimators::task::Task;

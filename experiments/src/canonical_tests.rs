@@ -8,7 +8,7 @@ use crate::canonical_sweep_post::Analysis;
 use crate::canonical_winners::cell_win;
 use estimators::budget::Budget;
 use estimators::estimator::Bias;
-use estimators::media::moments::EstimateMoments;
+use estimators::estimator::EstimateMoments;
 use estimators::params::Params;
 use estimators::testbeds::canonical_profiles::Profile;
 use mcbench::config::{Mode, Sweep, TestBedSpec};

@@ -1,7 +1,7 @@
 //! The extinction fields of paper 002 §4: the analytic medium of Eq. 21 and a 12-octave fractional
 //! Brownian motion of Perlin's improved gradient noise (book: testbeds.md).
 
-use crate::math::Vec3;
+use mcbench_core::math::Vec3;
 
 /// Paper 002 Eq. 21, the one place this formula lives (the exponent k is a parameter; maximum 1):
 /// `sigma_t = ((cos(1.5 (x + y + z)) + 1) / 2) * ((sin(z / 2) + 2) / 3)` inside the sphere.

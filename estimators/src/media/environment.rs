@@ -3,8 +3,8 @@
 //! directions below the horizon) plus a white HDR sun lobe `200 exp(100 (w . s - 1))`,
 //! `s = normalize(1, 1, 2)`.
 
-use crate::lighting::Gradient;
-use crate::math::{Rgb, Vec3};
+use mcbench_core::lighting::Gradient;
+use mcbench_core::math::{Rgb, Vec3};
 
 /// Sun lobe peak radiance.
 pub const SUN_PEAK: f64 = 200.0;

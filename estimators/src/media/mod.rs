@@ -29,13 +29,13 @@ pub mod reference;
 pub mod scatter_reference;
 pub mod variance;
 
-use crate::error::ConfigError;
-use crate::lighting::PointLight;
-use crate::math::{Rgb, Vec3};
-use crate::params::{parse, ParamSpec, Params};
-use crate::references::{ReferenceKey, ReferenceSource};
-use crate::registry::{BedCase, CaseRole, TestBedEntry};
-use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, TestBed};
+use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::lighting::PointLight;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{parse, ParamSpec, Params};
+use mcbench_core::references::{ReferenceKey, ReferenceSource};
+use mcbench_core::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, TestBed};
 
 /// Sphere centre.
 pub const CENTRE: Vec3 = Vec3::new(0.0, 0.0, 10.0);
@@ -153,7 +153,9 @@ impl MediumBed {
     pub fn new(field: Field, variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let mut bed = Self::without_reference(field, variant, params)?;
         bed.reference = match variant {
-            "multiple" => crate::references::load(refs, &bed.reference_key(), bed.integrals(), bed.resolution())?,
+            "multiple" => {
+                mcbench_core::references::load(refs, &bed.reference_key(), bed.integrals(), bed.resolution())?
+            }
             "single-scatter" => scatter_reference::reference(&bed, refs)?,
             _ => reference::transmittance_reference_of(&bed, refs)?,
         };
@@ -371,8 +373,8 @@ impl MediumScene for MediumBed {
         self.albedo
     }
     /// Both media scatter with the Rayleigh phase function (book: testbeds.md).
-    fn phase(&self) -> crate::phase::Phase {
-        crate::phase::Phase::Rayleigh
+    fn phase(&self) -> mcbench_core::phase::Phase {
+        mcbench_core::phase::Phase::Rayleigh
     }
     fn clip(&self, origin: Vec3, dir: Vec3) -> Option<(f64, f64)> {
         clip_sphere(origin, dir)

@@ -1,10 +1,10 @@
 //! The parameters of `eq21-medium` and `perlin-medium` (book: testbeds.md).
 
 use super::{Field, LIGHT};
-use crate::error::ConfigError;
-use crate::lighting::PointLight;
-use crate::math::Vec3;
-use crate::params::{check_count, check_range, ParamSet};
+use mcbench_core::error::ConfigError;
+use mcbench_core::lighting::PointLight;
+use mcbench_core::math::Vec3;
+use mcbench_core::params::{check_count, check_range, ParamSet};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 

@@ -9,11 +9,11 @@
 //!   ([`super::independent_reference`], which shares no code with the tracking estimators).
 
 use super::{clip_sphere, density, Field, MediumBed};
-use crate::error::ConfigError;
-use crate::math::{Rgb, Vec3};
-use crate::quadrature::{gauss_kronrod_multi, Quadrature};
-use crate::references::ReferenceSource;
-use crate::testbed::{MediumQuantity, Reference, ReferenceKind, TestBed};
+use mcbench_core::error::ConfigError;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::quadrature::{gauss_kronrod_multi, Quadrature};
+use mcbench_core::references::ReferenceSource;
+use mcbench_core::testbed::{MediumQuantity, Reference, ReferenceKind, TestBed};
 
 /// Absolute tolerance on the optical depth (relative error of T <= 1e-12 with margin).
 pub const TAU_TOL: f64 = 1e-13;
@@ -151,11 +151,11 @@ pub fn transmittance_method() -> String {
 pub fn transmittance_reference_of(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Reference, ConfigError> {
     let key = bed.reference_key();
     if let Some(r) =
-        crate::references::stored_exact(refs, &key, &transmittance_method(), bed.integrals(), bed.resolution())?
+        mcbench_core::references::stored_exact(refs, &key, &transmittance_method(), bed.integrals(), bed.resolution())?
     {
         return Ok(r);
     }
-    static COMPUTED: crate::memo::Memo<Reference> = crate::memo::Memo::new();
+    static COMPUTED: mcbench_core::memo::Memo<Reference> = mcbench_core::memo::Memo::new();
     Ok(COMPUTED.get_or_compute(key.describe(), || transmittance_reference(bed)))
 }
 
@@ -163,8 +163,8 @@ pub fn transmittance_reference_of(bed: &MediumBed, refs: &dyn ReferenceSource) -
 /// parallel over integrals; the bound is `weight T |d tau|` (first order) per integral.
 pub fn transmittance_reference(bed: &MediumBed) -> Reference {
     let n = bed.integrals();
-    let results = crate::parallel::map_indices(n, 0, |i| {
-        let r = crate::testbed::MediumScene::ray(bed, i);
+    let results = mcbench_core::parallel::map_indices(n, 0, |i| {
+        let r = mcbench_core::testbed::MediumScene::ray(bed, i);
         let MediumQuantity::Transmittance { weight } = r.quantity else { return (Rgb::ZERO, 0.0) };
         let (tau, err) = match clip_sphere(r.origin, r.dir) {
             None => (0.0, 0.0),
@@ -187,8 +187,8 @@ pub fn transmittance_reference(bed: &MediumBed) -> Reference {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::Params;
-    use crate::quadrature::gauss_legendre;
+    use mcbench_core::params::Params;
+    use mcbench_core::quadrature::gauss_legendre;
 
     /// Independent composite Gauss-Legendre (many panels, 20 nodes) agrees with the adaptive
     /// optical depth to 1e-12 relative in T, and the reported bound is within 1e-12 T; on Perlin
@@ -200,7 +200,7 @@ mod tests {
                 field,
                 "central-ray",
                 &Params::new().with("points", 4.0),
-                &crate::references::repository::Repository,
+                &crate::repository::Repository,
             )
             .unwrap();
             let (x, w) = gauss_legendre(20);
@@ -259,7 +259,8 @@ mod tests {
     /// bit for bit, and a build reads them; a stored one of another method is not used.
     #[test]
     fn stored_transmittance_references_are_the_computed_ones() {
-        use crate::references::{repository::Repository, InMemory, NoReferences, ReferenceSource, StoredReference};
+        use crate::repository::Repository;
+        use mcbench_core::references::{InMemory, NoReferences, ReferenceSource, StoredReference};
         for (variant, params) in [("central-ray", ("points", 8.0)), ("transmittance", ("resolution", 4.0))] {
             let p = Params::new().with(params.0, params.1);
             let bare = MediumBed::without_reference(Field::Perlin, variant, &p).unwrap();

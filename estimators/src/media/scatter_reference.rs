@@ -24,12 +24,12 @@
 
 use super::reference::optical_depth_with;
 use super::{clip_sphere, Field, MediumBed};
-use crate::error::ConfigError;
-use crate::lighting::PointLight;
-use crate::math::{Rgb, Vec3};
-use crate::quadrature::gauss_kronrod_multi;
-use crate::references::ReferenceSource;
-use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Reference, ReferenceKind, TestBed};
+use mcbench_core::error::ConfigError;
+use mcbench_core::lighting::PointLight;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::quadrature::gauss_kronrod_multi;
+use mcbench_core::references::ReferenceSource;
+use mcbench_core::testbed::{MediumQuantity, MediumRay, MediumScene, Reference, ReferenceKind, TestBed};
 
 /// Default image side of `eq21-medium/single-scatter` (camera b, full resolution).
 pub const EQ21_RESOLUTION: usize = 32;
@@ -160,7 +160,7 @@ pub fn reference(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Referenc
     }
     // The nested quadrature takes seconds per bed; a process that builds the same bed again (the
     // pilot and the main plan of an experiment, a sweep re-planned per estimator) reuses it.
-    static COMPUTED: crate::memo::Memo<Reference> = crate::memo::Memo::new();
+    static COMPUTED: mcbench_core::memo::Memo<Reference> = mcbench_core::memo::Memo::new();
     let settings = Settings::of(bed.field());
     let key = format!("{:?}|{}", bed.reference_key(), settings.method());
     Ok(COMPUTED.get_or_compute(key, || compute(bed, &settings)))
@@ -169,7 +169,7 @@ pub fn reference(bed: &MediumBed, refs: &dyn ReferenceSource) -> Result<Referenc
 /// Computes the reference of every pixel with `s` (threads over pixels).
 pub fn compute(bed: &MediumBed, s: &Settings) -> Reference {
     let n = bed.integrals();
-    let out = crate::parallel::map_indices(n, 0, |i| {
+    let out = mcbench_core::parallel::map_indices(n, 0, |i| {
         let ray = MediumScene::ray(bed, i);
         match ray.quantity {
             MediumQuantity::SingleScatter { light } => single_scatter(bed, &ray, &light, s),

@@ -2,8 +2,8 @@
 //! is shown, not assumed).
 
 use super::*;
-use crate::params::Params;
-use crate::quadrature::gauss_legendre;
+use mcbench_core::params::Params;
+use mcbench_core::quadrature::gauss_legendre;
 
 /// Composite 20-point Gauss-Legendre of `f` over the panels of `breaks`.
 fn composite(f: impl Fn(f64) -> f64, breaks: &[f64]) -> f64 {
@@ -50,7 +50,7 @@ fn brute(bed: &MediumBed, ray: &MediumRay, light: &PointLight) -> f64 {
             (-tau_c - tau_l).exp()
                 * bed.albedo()
                 * bed.extinction(p)
-                * crate::phase::Phase::Rayleigh.eval(cos)
+                * mcbench_core::phase::Phase::Rayleigh.eval(cos)
                 * light.intensity
                 / (r * r)
         },
@@ -116,7 +116,7 @@ fn perlin_settings_are_within_their_bound_on_a_short_segment() {
 #[test]
 fn perlin_default_reference_is_stored_with_the_current_settings() {
     let bed = MediumBed::without_reference(Field::Perlin, "single-scatter", &Params::new()).unwrap();
-    let r = load_stored(&bed, &crate::references::repository::Repository)
+    let r = load_stored(&bed, &crate::repository::Repository)
         .unwrap()
         .expect("results/references/perlin-medium_single-scatter.json");
     let ReferenceKind::Exact { bound, .. } = r.kind else { panic!("not exact") };

@@ -5,7 +5,7 @@
 //! constant `sigma_samp` and no control variate (`sigma_diff = sigma_t`). Integrals by adaptive
 //! quadrature between consecutive grid points.
 
-use crate::quadrature::gauss_kronrod;
+use mcbench_core::quadrature::gauss_kronrod;
 
 /// Which model's `w`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,18 +49,18 @@ pub fn predicted(sigma: impl Fn(f64) -> f64, model: Model, samp: f64, s: &[f64])
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::budget::Budget;
-    use crate::estimator::Estimator;
-    use crate::math::Vec3;
     use crate::media::{Field, MediumBed};
-    use crate::params::Params;
-    use crate::rng::stream;
-    use crate::stats::Moments;
-    use crate::task::Task;
-    use crate::testbed::TestBed;
     use crate::tracking::double_particle::DoubleParticle;
     use crate::tracking::single_particle::SingleParticle;
     use crate::tracking::SigmaSamp::Absolute;
+    use mcbench_core::budget::Budget;
+    use mcbench_core::estimator::Estimator;
+    use mcbench_core::math::Vec3;
+    use mcbench_core::params::Params;
+    use mcbench_core::rng::stream;
+    use mcbench_core::stats::Moments;
+    use mcbench_core::task::Task;
+    use mcbench_core::testbed::TestBed;
 
     /// Measured variance of one-ray estimates of T(s) on the eq21 central ray agrees with Eq. 16
     /// within 4 standard errors of the sample variance (from the sample fourth moment), for the
@@ -72,7 +72,7 @@ mod tests {
             Field::Eq21,
             "central-ray",
             &Params::new().with("points", 4.0),
-            &crate::references::repository::Repository,
+            &crate::repository::Repository,
         )
         .unwrap();
         let grid: Vec<f64> = (0..4).map(|k| bed.medium().unwrap().ray(k).length).collect();

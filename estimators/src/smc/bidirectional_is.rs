@@ -4,10 +4,10 @@
 //! the Rao-Blackwellised `mean(p~_c / q)`. Both unbiased (the resampled set is properly weighted).
 
 use super::params::BidirectionalParams;
-use crate::estimator::Bias;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::estimator::Bias;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::testbed::Needs;
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

@@ -7,14 +7,14 @@
 
 use super::params::BidirectionalSnParams;
 use super::resampling::{normalise_log_weights, resample, Scheme};
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry, Exemption};
-use crate::rng::StreamRng;
-use crate::task::Task;
-use crate::testbed::{EnvQuantity, Needs};
+use mcbench_core::entry::{Checks, EstimatorEntry, Exemption};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{EnvQuantity, Needs};
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

@@ -10,11 +10,11 @@
 
 use super::mh::{MhKernel, State};
 use super::resampling::{effective_sample_size, log_sum_exp, normalise_log_weights, resample, Scheme};
-use crate::error::EstimateError;
-use crate::math::{Rgb, Vec3};
-use crate::rng::StreamRng;
-use crate::task::{EnvProbe, Task};
-use crate::testbed::EnvQuantity;
+use mcbench_core::error::EstimateError;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::{EnvProbe, Task};
+use mcbench_core::testbed::EnvQuantity;
 
 /// How `L_ns` is carried from frame to frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -93,7 +93,7 @@ fn bridge_log(g: f64, la: f64, lb: f64) -> f64 {
 /// The number of particles N: the sample budget.
 pub fn particles(task: &Task<'_>) -> Result<usize, EstimateError> {
     let b = task.budget();
-    if b.kind != crate::budget::BudgetKind::Samples {
+    if b.kind != mcbench_core::budget::BudgetKind::Samples {
         return Err(EstimateError::Refused(
             "paper 004 estimators take a sample budget: N particles per pixel and frame".into(),
         ));

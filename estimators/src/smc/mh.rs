@@ -6,10 +6,10 @@
 //! state-independent mixture. Targets are given in log space; a proposal with zero target is
 //! rejected, and a reverse move of zero density makes the acceptance zero.
 
-use crate::brdf::DirectionSample;
-use crate::envmap::EnvFrame;
-use crate::math::{Frame, Vec3};
-use crate::samplers::spherical_direction;
+use mcbench_core::brdf::DirectionSample;
+use mcbench_core::envmap::EnvFrame;
+use mcbench_core::math::{Frame, Vec3};
+use mcbench_core::samplers::spherical_direction;
 use rand::Rng;
 use std::f64::consts::TAU;
 
@@ -121,11 +121,12 @@ impl MhKernel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::Phong;
-    use crate::envmap::{sky::Sky, EnvMap};
-    use crate::math::Rgb;
-    use crate::quadrature::gauss_legendre;
-    use crate::stats::chi_square_gof;
+    use crate::testbeds::sky::Sky;
+    use mcbench_core::brdf::Phong;
+    use mcbench_core::envmap::EnvMap;
+    use mcbench_core::math::Rgb;
+    use mcbench_core::quadrature::gauss_legendre;
+    use mcbench_core::stats::chi_square_gof;
     use std::f64::consts::PI;
 
     /// A coarse map (cells = texels), normal +z so the shading horizon is a texel edge, a glossy
@@ -173,7 +174,7 @@ mod tests {
             let v = map.radiance(d).mean() * fcos(d);
             ((if v > 0.0 { v.ln() } else { f64::NEG_INFINITY }), ())
         };
-        let mut rng = crate::rng::stream(seed, "mh invariance");
+        let mut rng = mcbench_core::rng::stream(seed, "mh invariance");
         let mut counts = vec![0u64; probs.len()];
         for _ in 0..60_000 {
             let w = loop {
@@ -203,13 +204,13 @@ mod tests {
     #[test]
     fn mh_local_cone_moves_leave_the_product_invariant() {
         let p = invariance_p(MhKernel::new(20.0, 0.0), 6, 51, false);
-        assert!(p > crate::samplers::testing::sampler_alpha(), "p = {p}");
+        assert!(p > mcbench_core::samplers::testing::sampler_alpha(), "p = {p}");
     }
 
     #[test]
     fn mh_mixture_leaves_the_product_invariant() {
         let p = invariance_p(MhKernel::new(5.0, 0.5), 4, 52, false);
-        assert!(p > crate::samplers::testing::sampler_alpha(), "p = {p}");
+        assert!(p > mcbench_core::samplers::testing::sampler_alpha(), "p = {p}");
     }
 
     /// Teeth: ignoring the proposal density in Eq. 8 breaks invariance, and the test sees it.

@@ -8,7 +8,7 @@
 //!   [`smc_bridge`], [`smc_path`], [`smc_adaptive`], and their parameters ([`params`]).
 //!
 //! Every estimator takes a sample budget N (particles per pixel and frame) and runs whole pixel
-//! sequences through [`crate::estimator::Estimator::estimate_sequence`].
+//! sequences through [`mcbench_core::estimator::Estimator::estimate_sequence`].
 
 pub mod bidirectional_is;
 pub mod bidirectional_is_sn;
@@ -24,12 +24,12 @@ pub mod smc_path;
 #[cfg(test)]
 mod tests;
 
-use crate::error::EstimateError;
-use crate::estimator::Estimator;
-use crate::math::Rgb;
-use crate::rng::StreamRng;
-use crate::task::Task;
 use engine::Config;
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::Rgb;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::Task;
 
 /// A configured paper 004 estimator.
 pub struct SmcEstimator(pub Config);

@@ -4,8 +4,8 @@
 use super::engine::{Config, Transition};
 use super::mh::MhKernel;
 use super::resampling::Scheme;
-use crate::error::ConfigError;
-use crate::params::{check_count, check_range, ParamSet};
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::{check_count, check_range, ParamSet};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 

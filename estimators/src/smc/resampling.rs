@@ -158,7 +158,7 @@ fn sweep(w: &[f64], u: &[f64], out: &mut Vec<usize>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::stats::{holm_bonferroni, one_sample_t};
+    use mcbench_core::stats::{holm_bonferroni, one_sample_t};
 
     /// The binary-search draw returns exactly the index a linear scan of the cumulative weights
     /// returns (zero weights skipped, rounding past the end to the last positive weight).
@@ -177,7 +177,7 @@ mod tests {
             }
             last
         };
-        let mut rng = crate::rng::stream(5, "cumulative pick");
+        let mut rng = mcbench_core::rng::stream(5, "cumulative pick");
         for n in [1usize, 2, 7, 64] {
             let w: Vec<f64> = (0..n).map(|i| if i % 3 == 1 { 0.0 } else { rng.gen::<f64>() }).collect();
             let cdf = Cumulative::new(&w);
@@ -198,9 +198,9 @@ mod tests {
         n: usize,
         reps: usize,
         seed: u64,
-        mut draw: impl FnMut(&mut crate::rng::StreamRng) -> Vec<usize>,
+        mut draw: impl FnMut(&mut mcbench_core::rng::StreamRng) -> Vec<usize>,
     ) -> f64 {
-        let mut rng = crate::rng::stream(seed, "resampling");
+        let mut rng = mcbench_core::rng::stream(seed, "resampling");
         let (mut sum, mut sum2) = (vec![0.0; w.len()], vec![0.0; w.len()]);
         for _ in 0..reps {
             let idx = draw(&mut rng);
@@ -240,7 +240,7 @@ mod tests {
     #[test]
     fn offspring_counts_are_unbiased_for_every_scheme() {
         let w = weights();
-        let alpha = crate::stats::sidak_alpha(1e-3, SCHEMES.len());
+        let alpha = mcbench_core::stats::sidak_alpha(1e-3, SCHEMES.len());
         for (s, scheme) in SCHEMES.iter().enumerate() {
             let p = offspring_p(&w, 7, 40_000, 100 + s as u64, |r| resample(*scheme, &w, 7, r));
             assert!(p > alpha, "{scheme:?}: smallest Holm-adjusted p = {p}");

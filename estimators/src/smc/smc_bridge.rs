@@ -8,10 +8,10 @@
 
 use super::engine::Transition;
 use super::params::SmcBridgeParams;
-use crate::estimator::Bias;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::estimator::Bias;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::testbed::Needs;
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

@@ -2,16 +2,16 @@
 //! (per-integral one-sample t-tests, Holm-Bonferroni at family-wise alpha 1e-3), with the
 //! biased control flagged; and the all-weights-zero fallback.
 
-use crate::brdf::Phong;
-use crate::budget::Budget;
-use crate::envmap::{EnvFrame, EnvMap};
-use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::registry;
-use crate::rng::StreamKey;
-use crate::stats::{holm_bonferroni, one_sample_t, Moments};
-use crate::task::Task;
-use crate::testbed::{EnvQuantity, EnvSequenceScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
+use crate::builtins;
+use mcbench_core::brdf::Phong;
+use mcbench_core::budget::Budget;
+use mcbench_core::envmap::{EnvFrame, EnvMap};
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::Params;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{EnvQuantity, EnvSequenceScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
 
 fn bed(variant: &str) -> Box<dyn TestBed> {
     let p = Params::new()
@@ -20,13 +20,12 @@ fn bed(variant: &str) -> Box<dyn TestBed> {
         .with("env_width", 64.0)
         .with("env_height", 32.0)
         .with("sun", 200.0);
-    (registry::testbed("envmap-sequence").unwrap().build)(variant, &p, &crate::references::repository::Repository)
-        .unwrap()
+    (builtins::testbed("envmap-sequence").unwrap().build)(variant, &p, &crate::repository::Repository).unwrap()
 }
 
 /// Smallest Holm-adjusted p-value of an estimator's per-integral t-tests over `reps` runs.
 fn holm_p(bed: &dyn TestBed, id: &str, params: Params, n: u64, reps: u64) -> f64 {
-    let est = (registry::estimator(id).unwrap().build)(&params).unwrap();
+    let est = (builtins::estimator(id).unwrap().build)(&params).unwrap();
     let f = bed.sequence_length();
     let mut m = vec![[Moments::default(), Moments::default(), Moments::default()]; bed.integrals()];
     for rep in 0..reps {
@@ -158,9 +157,9 @@ fn every_incremental_weight_zero_falls_back_without_nan() {
         },
     };
     for id in ["smc", "smc_bridge", "smc_path", "smc_adaptive"] {
-        let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+        let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
         let tasks: Vec<Task<'_>> = (0..3).map(|i| Task::new(&scene, i, Budget::samples(8).unwrap())).collect();
-        let v = est.estimate_sequence(&tasks, &mut crate::rng::stream(1, "fallback")).unwrap();
+        let v = est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(1, "fallback")).unwrap();
         assert!(v.iter().all(|x| x.is_finite() && x[0] > 0.0), "{id}: {v:?}");
         for t in &tasks[1..] {
             assert_eq!(t.diagnostics().iter().find(|(n, _)| *n == "fallback").map(|d| d.1), Some(1.0), "{id}");
@@ -179,23 +178,18 @@ fn stable_under_a_1e6_sun_and_30_degree_rotations() {
         .with("env_height", 64.0)
         .with("sun", 1e5)
         .with("rotation", 30.0);
-    let b = (registry::testbed("envmap-sequence").unwrap().build)(
-        "specular",
-        &p,
-        &crate::references::repository::Repository,
-    )
-    .unwrap();
+    let b =
+        (builtins::testbed("envmap-sequence").unwrap().build)("specular", &p, &crate::repository::Repository).unwrap();
     for id in ["bidirectional_is", "smc", "smc_bridge", "smc_path", "smc_adaptive"] {
-        let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+        let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
         for rep in 0..20 {
             let tasks: Vec<Task<'_>> = (0..4).map(|i| Task::new(b.as_ref(), i, Budget::samples(8).unwrap())).collect();
-            let v = est.estimate_sequence(&tasks, &mut crate::rng::stream(rep, id)).unwrap();
+            let v = est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(rep, id)).unwrap();
             assert!(v.iter().all(|x| x.is_finite() && x.0.iter().all(|c| *c >= 0.0)), "{id}: {v:?}");
         }
     }
     let mixed =
-        (registry::testbed("envmap-sequence").unwrap().build)("mixed", &p, &crate::references::repository::Repository)
-            .unwrap();
+        (builtins::testbed("envmap-sequence").unwrap().build)("mixed", &p, &crate::repository::Repository).unwrap();
     for (id, params) in [("bidirectional_is", Params::new()), ("smc", Params::new().with("moves", 2.0))] {
         let p = holm_p(mixed.as_ref(), id, params.with("candidates", 16.0), 4, 1500);
         eprintln!("stability (sun 1e5, 30 degrees a frame) {id}: Holm p = {p:e}");
@@ -208,10 +202,10 @@ fn stable_under_a_1e6_sun_and_30_degree_rotations() {
 /// The target evaluations of one pixel's frames under `id`, with its estimates' `fallback` notes.
 fn frame_counts(id: &str, params: Params, n: u64) -> Vec<(u64, u64, bool)> {
     let b = bed("mixed");
-    let est = (registry::estimator(id).unwrap().build)(&params).unwrap();
+    let est = (builtins::estimator(id).unwrap().build)(&params).unwrap();
     let f = b.sequence_length();
     let tasks: Vec<Task<'_>> = (0..f).map(|i| Task::new(b.as_ref(), i, Budget::samples(n).unwrap())).collect();
-    est.estimate_sequence(&tasks, &mut crate::rng::stream(5, id)).unwrap();
+    est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(5, id)).unwrap();
     tasks
         .iter()
         .map(|t| {
@@ -267,10 +261,10 @@ fn bridged_smc_evaluates_both_frames_at_each_proposal() {
 #[test]
 fn counted_runs_repeat_bit_for_bit_and_count_no_cache() {
     let b = bed("mixed");
-    let est = (registry::estimator("smc").unwrap().build)(&Params::new()).unwrap();
+    let est = (builtins::estimator("smc").unwrap().build)(&Params::new()).unwrap();
     let run = || {
         let tasks: Vec<Task<'_>> = (0..4).map(|i| Task::new(b.as_ref(), i, Budget::samples(8).unwrap())).collect();
-        let v = est.estimate_sequence(&tasks, &mut crate::rng::stream(11, "repeat")).unwrap();
+        let v = est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(11, "repeat")).unwrap();
         (v, tasks.iter().map(Task::costs).collect::<Vec<_>>())
     };
     let (a, b2) = (run(), run());
@@ -291,9 +285,9 @@ fn recompute_adds_m_target_evaluations_on_its_frames() {
         ("smc_path", base.with("bridges", k as f64), n * (1 + 2 * k)),
     ] {
         let b = bed("mixed");
-        let est = (registry::estimator(id).unwrap().build)(&params).unwrap();
+        let est = (builtins::estimator(id).unwrap().build)(&params).unwrap();
         let tasks: Vec<Task<'_>> = (0..4).map(|i| Task::new(b.as_ref(), i, Budget::samples(n).unwrap())).collect();
-        est.estimate_sequence(&tasks, &mut crate::rng::stream(5, id)).unwrap();
+        est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(5, id)).unwrap();
         for (frame, t) in tasks.iter().enumerate().skip(1) {
             let again = frame == 2;
             let noted = t.diagnostics().iter().any(|(name, v)| *name == "recomputed" && *v > 0.0);
@@ -310,9 +304,9 @@ fn recompute_that_never_fires_changes_nothing() {
     let b = bed("mixed-lns");
     for id in ["smc", "smc_bridge", "smc_path"] {
         let run = |p: Params| {
-            let est = (registry::estimator(id).unwrap().build)(&p).unwrap();
+            let est = (builtins::estimator(id).unwrap().build)(&p).unwrap();
             let tasks: Vec<Task<'_>> = (0..4).map(|i| Task::new(b.as_ref(), i, Budget::samples(8).unwrap())).collect();
-            est.estimate_sequence(&tasks, &mut crate::rng::stream(4, id)).unwrap()
+            est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(4, id)).unwrap()
         };
         let default = run(Params::new());
         assert_eq!(default, run(Params::new().with("recompute", 0.0)), "{id}");
@@ -331,11 +325,11 @@ fn recompute_every_frame_tracks_the_reference() {
     let reference = &b.reference().value;
     for id in ["smc", "smc_path"] {
         let p = Params::new().with("recompute", 1.0).with("candidates", 65536.0);
-        let est = (registry::estimator(id).unwrap().build)(&p).unwrap();
+        let est = (builtins::estimator(id).unwrap().build)(&p).unwrap();
         for pixel in 0..4 {
             let tasks: Vec<Task<'_>> =
                 (0..4).map(|f| Task::new(b.as_ref(), pixel * 4 + f, Budget::samples(4).unwrap())).collect();
-            let v = est.estimate_sequence(&tasks, &mut crate::rng::stream(pixel as u64, id)).unwrap();
+            let v = est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(pixel as u64, id)).unwrap();
             for (f, e) in v.iter().enumerate().skip(1) {
                 let exact = reference[pixel * 4 + f].mean();
                 assert!((e.mean() / exact - 1.0).abs() < 0.06, "{id} pixel {pixel} frame {f}: {} vs {exact}", e.mean());
@@ -347,7 +341,7 @@ fn recompute_every_frame_tracks_the_reference() {
 #[test]
 fn recompute_is_refused_past_the_longest_sequence() {
     for id in ["smc", "smc_bridge", "smc_path"] {
-        let e = (registry::estimator(id).unwrap().build)(&Params::new().with("recompute", 1001.0)).err().unwrap();
+        let e = (builtins::estimator(id).unwrap().build)(&Params::new().with("recompute", 1001.0)).err().unwrap();
         assert!(e.to_string().contains("recompute"), "{id}: {e}");
     }
 }

@@ -4,11 +4,11 @@
 use super::params::CacheSmcParams;
 use super::{build_surface_or_medium, Sampling};
 use crate::cache::ControlVariate;
-use crate::estimator::Bias;
 use crate::media_smc::Sampling as MediaSampling;
-use crate::params::ParamSpec;
-use crate::registry::{Checks, EstimatorEntry};
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::estimator::Bias;
+use mcbench_core::params::ParamSpec;
+use mcbench_core::testbed::Needs;
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

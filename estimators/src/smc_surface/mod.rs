@@ -24,15 +24,15 @@ pub mod is1_cv2;
 pub mod params;
 pub mod variance_tracker;
 
-use crate::accumulate::RgbMean;
 use crate::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, Storage};
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::Estimator;
-use crate::math::{Frame, Rgb};
 use crate::media_smc::{MediaSmc, SurfaceOrMedium};
-use crate::params::{parse, Params};
-use crate::rng::StreamRng;
-use crate::task::{HemisphereProbe, Task};
+use mcbench_core::accumulate::RgbMean;
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::{Frame, Rgb};
+use mcbench_core::params::{parse, Params};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::{HemisphereProbe, Task};
 use params::{CacheSmcParams, SurfaceSmcParams};
 use variance_tracker::VarianceTracker;
 

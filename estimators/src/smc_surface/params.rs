@@ -4,9 +4,9 @@
 //! [`crate::media_smc::SurfaceOrMedium`]).
 
 use crate::cache::{Storage, MAX_DEPTH_LIMIT};
-use crate::error::ConfigError;
 use crate::media_smc::params::MediaSmcParams;
-use crate::params::{check_count, check_range, ParamSet};
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::{check_count, check_range, ParamSet};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 

@@ -1,12 +1,12 @@
 //! Unbiasedness tests of the surface SMC ids (book: statistics.md) with teeth, and parameter handling.
 
 use super::*;
-use crate::budget::Budget;
-use crate::registry;
-use crate::rng::StreamKey;
-use crate::stats::{holm_bonferroni, one_sample_t, Moments};
-use crate::testbed::TestBed;
+use crate::builtins;
 use crate::testbeds::gradient_plane::GradientPlane;
+use mcbench_core::budget::Budget;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
+use mcbench_core::testbed::TestBed;
 
 /// Family-wise level of the unbiasedness tests (book: statistics.md).
 const ALPHA: f64 = 1e-3;
@@ -43,8 +43,8 @@ fn unbiasedness(est: &dyn Estimator, id: &str, variant: &str, pixels: &[usize], 
         let reference = bed.reference().value[px];
         for ch in 0..3 {
             p_values.push(one_sample_t(m[ch].mean(), m[ch].std_err(), reps, reference[ch]).p_value);
-            detectable =
-                detectable.max(crate::stats::detectable_shift(m[ch].std_err(), ALPHA, 0.5) / reference[ch].abs());
+            detectable = detectable
+                .max(mcbench_core::stats::detectable_shift(m[ch].std_err(), ALPHA, 0.5) / reference[ch].abs());
         }
     }
     let min_adjusted_p = holm_bonferroni(&p_values).into_iter().fold(1.0, f64::min);
@@ -55,7 +55,7 @@ fn unbiasedness(est: &dyn Estimator, id: &str, variant: &str, pixels: &[usize], 
 }
 
 fn build(id: &str, params: &Params) -> Box<dyn Estimator> {
-    (registry::estimator(id).unwrap().build)(params).unwrap()
+    (builtins::estimator(id).unwrap().build)(params).unwrap()
 }
 
 const NEW_IDS: [&str; 6] = ["is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1", "is1_cv2", "brdf_is1_cv2"];
@@ -116,13 +116,13 @@ fn unbiased_on_the_stiff_variant_and_the_control_is_flagged() {
 #[test]
 fn f32_storage_is_unbiased_and_smaller() {
     let mut params = Params::new();
-    params.0.insert("storage".into(), crate::params::ParamValue::Text("f32".into()));
+    params.0.insert("storage".into(), mcbench_core::params::ParamValue::Text("f32".into()));
     let v = unbiasedness(build("is1_cv2", &params).as_ref(), "is1_cv2_f32", "default", &ALL_PIXELS, 600, 64);
     assert!(!v.rejects(), "f32: Holm-adjusted p = {:e}", v.min_adjusted_p);
     let bed = GradientPlane::new("default", &Params::new().with("resolution", 4.0)).unwrap();
     let cell_bytes = |p: &Params| {
         let task = Task::new(&bed, 3, Budget::samples(1024).unwrap());
-        build("is1_cv2", p).estimate(&task, &mut crate::rng::stream(1, "bytes")).unwrap();
+        build("is1_cv2", p).estimate(&task, &mut mcbench_core::rng::stream(1, "bytes")).unwrap();
         let d = task.diagnostics();
         let get = |n: &str| d.iter().find(|(k, _)| *k == n).map(|(_, v)| *v).unwrap();
         (get("cell_bytes"), get("cells"), get("refinements"))
@@ -136,7 +136,7 @@ fn f32_storage_is_unbiased_and_smaller() {
 #[test]
 fn parameters_are_validated_and_named() {
     for id in NEW_IDS {
-        let entry = registry::estimator(id).unwrap();
+        let entry = builtins::estimator(id).unwrap();
         assert!((entry.build)(&Params::new()).is_ok());
         let err = |p: Params| (entry.build)(&p).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(err(Params::new().with("criterion", 0.5)).contains("criterion"));
@@ -158,11 +158,11 @@ fn cache_operations_are_a_read_and_a_record_per_sample_plus_refinements() {
     for id in ["is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1", "is1_cv2"] {
         let est = build(id, &Params::new());
         let task = Task::new(&bed, 5, Budget::samples(4).unwrap());
-        est.estimate(&task, &mut crate::rng::stream(1, id)).unwrap();
+        est.estimate(&task, &mut mcbench_core::rng::stream(1, id)).unwrap();
         assert_eq!(task.costs().cache_ops, 8, "{id}");
         for spp in [64u64, 1024] {
             let task = Task::new(&bed, 5, Budget::samples(spp).unwrap());
-            est.estimate(&task, &mut crate::rng::stream(2, id)).unwrap();
+            est.estimate(&task, &mut mcbench_core::rng::stream(2, id)).unwrap();
             let refinements = task.diagnostics().iter().find(|(n, _)| *n == "refinements").unwrap().1 as u64;
             assert!(refinements > 0, "{id} at {spp} spp refined");
             assert_eq!(task.costs().cache_ops, 2 * spp + refinements, "{id} at {spp} spp");
@@ -172,14 +172,14 @@ fn cache_operations_are_a_read_and_a_record_per_sample_plus_refinements() {
     // The tracked estimator records every sample whose direction lies in the cache's hemisphere
     // (a BRDF draw below the horizon has none): between one and two operations per sample.
     let task = Task::new(&bed, 5, Budget::samples(256).unwrap());
-    build("brdf_is1_cv2", &Params::new()).estimate(&task, &mut crate::rng::stream(3, "tracked")).unwrap();
+    build("brdf_is1_cv2", &Params::new()).estimate(&task, &mut mcbench_core::rng::stream(3, "tracked")).unwrap();
     let refinements = task.diagnostics().iter().find(|(n, _)| *n == "refinements").unwrap().1 as u64;
     let ops = task.costs().cache_ops - refinements;
     assert!((256..=512).contains(&ops), "{ops}");
     // The independent estimators keep no cache.
     for id in ["is0_cv0", "brdf_is0_cv0"] {
         let task = Task::new(&bed, 5, Budget::samples(64).unwrap());
-        build(id, &Params::new()).estimate(&task, &mut crate::rng::stream(4, id)).unwrap();
+        build(id, &Params::new()).estimate(&task, &mut mcbench_core::rng::stream(4, id)).unwrap();
         assert_eq!((task.costs().cache_ops, task.costs().target_evals), (0, 0), "{id}");
     }
 }

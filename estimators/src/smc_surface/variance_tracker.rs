@@ -10,8 +10,8 @@
 //! Squared deviations are averaged over the colour channels. Start-up uses the BRDF estimator
 //! ("preferable upon start-up") until two samples have been seen.
 
-use crate::accumulate::RgbMean;
-use crate::math::Rgb;
+use mcbench_core::accumulate::RgbMean;
+use mcbench_core::math::Rgb;
 
 /// Running variance estimates of the two estimators of one pixel.
 #[derive(Clone, Debug)]

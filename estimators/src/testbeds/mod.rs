@@ -12,5 +12,7 @@ pub mod envmap_sequence;
 pub mod gradient_box;
 pub mod gradient_box_independent;
 pub mod gradient_plane;
+pub mod moving_sky;
 pub mod phong_lobe;
 pub mod pinhole;
+pub mod sky;

@@ -15,14 +15,15 @@ pub mod residual_ratio_tracking;
 pub mod single_particle;
 pub mod spm;
 
-use crate::error::{ConfigError, EstimateError};
-use crate::math::{Rgb, Vec3};
-use crate::media::moments::{tracker_moments, EstimateMoments};
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::stats::NeumaierSum;
-use crate::task::{MediumProbe, Task};
-use crate::testbed::{MediumQuantity, TestBed};
+use crate::media::moments::tracker_moments;
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::EstimateMoments;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::stats::NeumaierSum;
+use mcbench_core::task::{MediumProbe, Task};
+use mcbench_core::testbed::{MediumQuantity, TestBed};
 use rand::Rng;
 use residual_ratio_tracking::{main_part, MainPart};
 
@@ -268,17 +269,17 @@ pub fn ray_moments(
 /// (the stability case `sigma_samp = 1e-6 x sigma_t`: the double and non-terminating particle models are
 /// unbiased for any `sigma_samp`, but their second moment `exp(int sigma_samp ((1 - r)^2 - 1))`
 /// is `exp(7e5)` there, so no run of any length estimates anything). Checks the exact moments
-/// ([`crate::estimator::Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.
+/// ([`mcbench_core::estimator::Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.
 pub fn check_finite_variance(
     id: &str,
-    est: &dyn crate::estimator::Estimator,
+    est: &dyn mcbench_core::estimator::Estimator,
     sigma_samp: SigmaSamp,
     bed: &dyn TestBed,
 ) -> Result<(), ConfigError> {
     if bed.medium().is_none() {
         return Ok(());
     }
-    let budget = crate::budget::Budget::samples(1)?;
+    let budget = mcbench_core::budget::Budget::samples(1)?;
     let n = bed.integrals();
     let step = n.div_ceil(16).max(1);
     for i in (0..n).step_by(step) {

@@ -104,9 +104,9 @@ impl StoredReference {
 /// Where test beds find stored references.
 ///
 /// ```
-/// use estimators::math::Rgb;
-/// use estimators::references::{load, InMemory, ReferenceKey, ReferenceSource, StoredReference};
-/// use estimators::testbed::{Reference, ReferenceKind};
+/// use mcbench_core::math::Rgb;
+/// use mcbench_core::references::{load, InMemory, ReferenceKey, ReferenceSource, StoredReference};
+/// use mcbench_core::testbed::{Reference, ReferenceKind};
 ///
 /// let key = ReferenceKey::new("my-bed", "default", &[("resolution", 1.into())], true);
 /// let reference = Reference {
@@ -207,29 +207,6 @@ pub fn stored_exact(
         ConfigError::invalid(format!("{} reference", key.describe()), key.file_name(), format!("malformed ({e})"))
     })?;
     Ok(Some(stored.reference))
-}
-
-/// The repository's stored references (`results/references`), for the library's own tests.
-#[cfg(test)]
-pub(crate) mod repository {
-    use super::*;
-
-    /// Reads `<repository>/results/references/<key's file name>`.
-    pub struct Repository;
-
-    impl ReferenceSource for Repository {
-        fn stored(&self, key: &ReferenceKey) -> Result<Option<StoredReference>, ConfigError> {
-            let path =
-                std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/references").join(key.file_name());
-            let Ok(text) = std::fs::read_to_string(&path) else { return Ok(None) };
-            let s: StoredReference = serde_json::from_str(&text)
-                .map_err(|e| ConfigError::invalid("reference", path.display(), e.to_string()))?;
-            Ok(s.matches(key).then_some(s))
-        }
-        fn location(&self) -> String {
-            "results/references".into()
-        }
-    }
 }
 
 #[cfg(test)]

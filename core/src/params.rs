@@ -4,7 +4,7 @@
 //! construction ([`parse`]), and that documents them ([`describe`], `mcbench list --params`).
 //!
 //! ```
-//! use estimators::params::{parse, ParamSet, Params};
+//! use mcbench_core::params::{parse, ParamSet, Params};
 //! use serde::{Deserialize, Serialize};
 //!
 //! /// Parameters of a clamping estimator.
@@ -241,7 +241,19 @@ mod tests {
     #[serde(deny_unknown_fields, default)]
     struct Named {
         /// The precision.
-        storage: crate::cache::Storage,
+        storage: Precision,
+    }
+
+    /// A parameter value that is one of two names.
+    #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, schemars::JsonSchema)]
+    #[serde(rename_all = "lowercase")]
+    #[schemars(inline)]
+    enum Precision {
+        /// Single precision.
+        F32,
+        /// Double precision.
+        #[default]
+        F64,
     }
     impl ParamSet for Named {}
 

@@ -1,15 +1,13 @@
 //! Lat-long environment maps (paper 004; book: testbeds.md): a piecewise-constant table of texels
-//! tabulated from an analytic HDR [`sky::Sky`] (or [`moving_sky::MovingSky`]), its importance
-//! sampler ([`sampling::PiecewiseConstant2D`]), and one frame of a dynamic sequence ([`EnvFrame`]:
-//! a map rotated about +z and scaled).
+//! (tabulated from any radiance function, e.g. an analytic HDR sky, with [`EnvMap::tabulate`]), its
+//! importance sampler ([`sampling::PiecewiseConstant2D`]), and one frame of a dynamic sequence
+//! ([`EnvFrame`]: a map rotated about +z and scaled).
 //!
 //! Convention: row `i` of `H` covers `theta` in `[i pi / H, (i + 1) pi / H]` (row 0 at the zenith
 //! +z), column `j` of `W` covers `phi` in `[2 pi j / W, 2 pi (j + 1) / W]`, with
 //! `w = (sin theta cos phi, sin theta sin phi, cos theta)`.
 
-pub mod moving_sky;
 pub mod sampling;
-pub mod sky;
 
 use crate::brdf::DirectionSample;
 use crate::error::ConfigError;

@@ -23,7 +23,7 @@
 //!   key lobe, so the lobes hold about 80% of the map's energy, as the windows and lamps do.
 
 use super::sky::{direction, Lobe, SkyModel};
-use crate::math::{Rgb, Vec3};
+use mcbench_core::math::{Rgb, Vec3};
 
 /// The map of the `moving` variants.
 #[derive(Clone, Debug, PartialEq)]

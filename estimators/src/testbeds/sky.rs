@@ -2,7 +2,7 @@
 //! sun lobe and two dim lobes, `peak * colour * exp(k (w . d - 1))` each. With the default sun
 //! peak of 1e3 the tabulated 256x128 map spans a dynamic range above 1e4; `sun = 1e5` gives 1e6.
 
-use crate::math::{Rgb, Vec3};
+use mcbench_core::math::{Rgb, Vec3};
 
 /// One exponential lobe.
 #[derive(Clone, Copy, Debug, PartialEq)]
