@@ -1,16 +1,19 @@
 #!/usr/bin/env python3
 """Import cycles between the modules of a Rust crate.
 
-Reads every .rs file under a crate's src folder, takes each file as one module (`lib.rs` is the
-crate root, `a/mod.rs` is `a`, `a/b.rs` is `a::b`; inline `mod name { .. }` blocks belong to their
-file), and draws an edge from a module to every module a path in it names: `crate::a::b::Item`,
-`super::Item`, `self::child::Item` and a child module named directly (`child::Item`), in `use`
-declarations and in code alike (`mod child;` declarations are not edges). A path names the longest
-module prefix it has (`crate::a::b::Item` names `a::b` when `a/b.rs` exists, else `a`). Then the
-strongly connected components of that graph (Tarjan): a component of more than one module is an
-import cycle.
+Follows a crate's `mod name;` declarations from its src/lib.rs (with `#[path = ..]`), takes each
+file as one module (inline `mod name { .. }` blocks belong to their file), and draws an edge from a
+module to every module a path in it names: `crate::a::b::Item`, `super::Item`,
+`self::child::Item`, a child module named directly (`child::Item`) and a module imported by `use`,
+in `use` declarations and in code alike (`mod child;` declarations are not edges). A path names the
+longest module prefix it has (`crate::a::b::Item` names `a::b` when that module exists, else `a`).
+Then the strongly connected components of that graph (Tarjan): a component of more than one module
+is an import cycle.
 
-Usage: module_cycles.py [--max N] [--list] CRATE_SRC [CRATE_SRC ...]
+Test code (`#[cfg(test)]` modules, inline or in files of their own) is left out unless --tests is
+given: a test may import any module of its crate without making the library's layers circular.
+
+Usage: module_cycles.py [--max N] [--list] [--tests] CRATE_SRC [CRATE_SRC ...]
 Prints each crate's largest component (and with --list every component of more than one module) and
 exits 1 when a component has more than N modules (default 4).
 """
@@ -110,12 +113,53 @@ def use_paths(tree, prefix=()):
     return [(prefix + parts, alias)]
 
 
+MOD_DECL = re.compile(r"((?:#\[[^\]]*\]\s*)*)(?:pub(?:\([^)]*\))?\s+)?mod\s+(" + IDENT + r")\s*;")
+
+
+def blank_test_blocks(text):
+    """`text` with every `#[cfg(test)]` inline module's block blanked (newlines kept)."""
+    out = text
+    for m in reversed(list(re.finditer(r"#\[cfg\(test\)\]\s*(?:pub(?:\([^)]*\))?\s+)?mod\s+" + IDENT + r"\s*\{", text))):
+        depth, i = 0, m.end() - 1
+        while i < len(out):
+            depth += out[i] == "{"
+            depth -= out[i] == "}"
+            i += 1
+            if depth == 0:
+                break
+        out = out[:m.start()] + re.sub(r"[^\n]", " ", out[m.start():i]) + out[i:]
+    return out
+
+
 class Crate:
-    def __init__(self, src):
+    def __init__(self, src, tests=False):
         self.src = Path(src)
-        self.files = sorted(self.src.rglob("*.rs"))
-        self.modules = {module_of(self.src, f): f for f in self.files}
+        self.tests = tests
+        self.modules = {}
+        self.texts = {}
+        self.walk((), self.src / "lib.rs", mod_rs=True)
         self.edges = {m: set() for m in self.modules}
+
+    def walk(self, module, path, mod_rs):
+        """Registers `module` (file `path`) and the file modules it declares."""
+        text = strip_comments_and_strings(path.read_text())
+        if not self.tests:
+            text = blank_test_blocks(text)
+        self.modules[module] = path
+        self.texts[module] = text
+        here = path.parent if mod_rs else path.parent / path.stem
+        for m in MOD_DECL.finditer(text):
+            attrs, name = m.group(1), m.group(2)
+            if "cfg(test)" in attrs and not self.tests:
+                continue
+            at = re.search(r'path\s*=\s*"([^"]*)"', path.read_text()[m.start():m.end()]) if "path" in attrs else None
+            if at:
+                child = path.parent / at.group(1)
+                self.walk(module + (name,), child, mod_rs=child.name == "mod.rs")
+            elif (here / (name + ".rs")).exists():
+                self.walk(module + (name,), here / (name + ".rs"), mod_rs=False)
+            elif (here / name / "mod.rs").exists():
+                self.walk(module + (name,), here / name / "mod.rs", mod_rs=True)
 
     def longest_module(self, path):
         """The longest prefix of `path` that is a module of the crate (None: none, or the root)."""
@@ -146,8 +190,8 @@ class Crate:
             return module + (head,) + tuple(rest)
         return None
 
-    def scan(self, module, path):
-        text = strip_comments_and_strings(path.read_text())
+    def scan(self, module):
+        text = self.texts[module]
         # Inline `mod name {` blocks: the brace depth at which each opens, to know the nesting of
         # any position.
         opens = [(m.end() - 1) for m in re.finditer(r"\bmod\s+" + IDENT + r"\s*\{", text)]
@@ -214,8 +258,8 @@ class Crate:
         self.edges[module] |= targets
 
     def build(self):
-        for module, path in self.modules.items():
-            self.scan(module, path)
+        for module in self.modules:
+            self.scan(module)
         return self
 
     def components(self):
@@ -266,14 +310,15 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--max", type=int, default=4, help="the largest component allowed (default 4)")
     ap.add_argument("--list", action="store_true", help="list every component of more than one module")
+    ap.add_argument("--tests", action="store_true", help="count the imports of test code too")
     ap.add_argument("src", nargs="+", help="a crate's src folder")
     args = ap.parse_args()
     failed = False
     for src in args.src:
-        if not Path(src).is_dir():
-            print(f"{src}: not a folder", file=sys.stderr)
+        if not (Path(src) / "lib.rs").is_file():
+            print(f"{src}: no lib.rs there", file=sys.stderr)
             return 2
-        crate = Crate(src).build()
+        crate = Crate(src, args.tests).build()
         comps = crate.components()
         largest = comps[0] if comps else []
         bad = [c for c in comps if len(c) > args.max]

@@ -5,8 +5,8 @@
 
 mod common;
 use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::estimators::budget::{Budget, BudgetKind};
-use mcbench::estimators::params::{ParamSpec, Params};
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::params::{ParamSpec, Params};
 use mcbench::runner::{self, RunOptions, Silent};
 use mcbench::{Bias, Checks, EstimateError, Estimator, EstimatorEntry, Needs, Registry, Rgb, StreamRng, Task};
 

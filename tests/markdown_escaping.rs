@@ -17,7 +17,7 @@ const IMG_ESCAPED: &str = "&lt;img src=x onerror=alert(1)&gt;";
 static HOSTILE: EstimatorEntry = EstimatorEntry {
     id: "hostile_label",
     label: "tracer <script>alert(1)</script> <img src=x onerror=alert(1)>",
-    ..mcbench::estimators::independent::is0_cv0::ENTRY
+    ..mcbench_papers::independent::is0_cv0::ENTRY
 };
 
 /// The repository's stored reference of `gradient-box/albedo-0.8` with both tags in its command.

@@ -4,12 +4,12 @@
 //! the random streams fails here; an intended one is re-pinned with
 //! `MCBENCH_REPIN=1 cargo test -p experiments --test pinned` (and the diff reviewed).
 
-use estimators::budget::Budget;
-use estimators::params::Params;
-use estimators::registry::{self, ESTIMATORS};
-use estimators::rng::StreamKey;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_papers::builtins::{self, ESTIMATORS};
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -32,7 +32,7 @@ fn first_estimates() -> BTreeMap<String, String> {
     let built: Vec<(String, Box<dyn TestBed>)> = beds()
         .into_iter()
         .map(|(id, v, p)| {
-            let entry = registry::testbed(id).expect("registered test bed");
+            let entry = builtins::testbed(id).expect("registered test bed");
             let refs = mcbench::references::ReferenceDir::new(REFERENCES);
             (format!("{id}/{v}"), (entry.build)(v, &p, &refs).expect("builds"))
         })

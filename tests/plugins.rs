@@ -4,8 +4,8 @@
 //! no id list anywhere has to name it.
 
 use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::estimators::math::{Frame, Vec3};
-use mcbench::estimators::params::{check_range, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::math::{Frame, Vec3};
+use mcbench_core::params::{check_range, parse, ParamSet, ParamSpec, Params};
 use mcbench::{
     Bias, Checks, ConfigError, EstimateError, Estimator, EstimatorEntry, Needs, Registry, Rgb, StreamRng, Task,
 };

@@ -7,12 +7,12 @@
 
 use mcbench::analysis::{SlopeOutcome, SpeedUpOutcome, Spread};
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::estimators::brdf::Phong;
-use mcbench::estimators::math::{Frame, Vec3};
-use mcbench::estimators::params::{ParamSpec, Params};
-use mcbench::estimators::references::ReferenceSource;
-use mcbench::estimators::samplers::{cosine_hemisphere, uniform_hemisphere};
-use mcbench::estimators::testbed::{HemisphereScene, ReferenceKind, ShadingPoint};
+use mcbench_core::brdf::Phong;
+use mcbench_core::math::{Frame, Vec3};
+use mcbench_core::params::{ParamSpec, Params};
+use mcbench_core::references::ReferenceSource;
+use mcbench_core::samplers::{cosine_hemisphere, uniform_hemisphere};
+use mcbench_core::testbed::{HemisphereScene, ReferenceKind, ShadingPoint};
 use mcbench::execute::{execute, ExecOptions};
 use mcbench::runner::Silent;
 use mcbench::{
@@ -139,7 +139,7 @@ impl Estimator for FurnaceEstimator {
     }
 }
 
-const fn entry(id: &'static str, bias: Bias, build: mcbench::estimators::registry::BuildEstimator) -> EstimatorEntry {
+const fn entry(id: &'static str, bias: Bias, build: mcbench_core::entry::BuildEstimator) -> EstimatorEntry {
     EstimatorEntry {
         id,
         paper: "tests",

@@ -1,16 +1,16 @@
 //! Criterion benches of the surface radiance cache hot paths (book: benches.md): one cache sample
 //! (partial-sum tree + uniform in the cell), one record (running means, maintained sums, tree
 //! update), one refinement, one reconstruction of g, and one whole `is1_cv2` estimate.
-//! Run with `cargo bench -p estimators --bench cache`.
+//! Run with `cargo bench -p mcbench-papers --bench cache`.
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
-use estimators::budget::Budget;
-use estimators::builtins;
-use estimators::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, St};
-use estimators::math::Rgb;
-use estimators::params::Params;
-use estimators::rng::stream;
-use estimators::task::Task;
+use mcbench_core::budget::Budget;
+use mcbench_papers::builtins;
+use mcbench_papers::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, St};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
 
 /// A cache refined exactly `depth` times by uniform records of a smooth integrand.
 fn cache_at_depth<S: Scalar>(depth: u32) -> RadianceCache<S> {
@@ -64,7 +64,7 @@ fn is1_cv2_estimate(c: &mut Criterion) {
     let bed = (builtins::testbed("gradient-plane").unwrap().build)(
         "default",
         &Params::new().with("resolution", 8.0),
-        &estimators::references::NoReferences,
+        &mcbench_core::references::NoReferences,
     )
     .expect("test bed");
     let mut group = c.benchmark_group("is1_cv2_estimate");

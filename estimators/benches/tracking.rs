@@ -9,16 +9,16 @@
 //! loop timed for 0.3 s just before and just after that tracker's bench (their mean), so a change
 //! of machine load during the run does not leak into the ratios. Cheap (approximate-extinction)
 //! fetches are shown apart and are not counted as steps.
-//! Run with `cargo bench -p estimators --bench tracking`.
+//! Run with `cargo bench -p mcbench-papers --bench tracking`.
 
 use criterion::{black_box, Criterion, Throughput};
-use estimators::budget::Budget;
-use estimators::builtins;
-use estimators::math::Vec3;
-use estimators::params::Params;
-use estimators::rng::stream;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
+use mcbench_core::budget::Budget;
+use mcbench_papers::builtins;
+use mcbench_core::math::Vec3;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 use rand::Rng;
 use std::cell::RefCell;
 use std::time::{Duration, Instant};
@@ -57,7 +57,7 @@ impl Tally {
 
 fn bed(id: &str, variant: &str) -> Box<dyn TestBed> {
     let entry = builtins::testbed(id).expect("registered medium");
-    (entry.build)(variant, &Params::new(), &estimators::references::NoReferences).expect("builds")
+    (entry.build)(variant, &Params::new(), &mcbench_core::references::NoReferences).expect("builds")
 }
 
 /// 1024 random points along the central ray (where the trackers step, so the bare loop and the

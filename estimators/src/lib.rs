@@ -1,34 +1,28 @@
-//! # estimators
+//! # mcbench-papers
 //!
-//! The papers' half of `mcbench`: the estimator families of the five papers with their biased
-//! controls, and the test beds they run on, built on the plug-in API of `mcbench-core`.
-//! [`builtins`] lists them all.
+//! The estimators of five adaptive Monte Carlo rendering papers with their biased controls, and
+//! the test beds they run on, as plug-ins of `mcbench-core`; [`builtins`] lists them all and hands
+//! them to a harness registry as one [`mcbench_core::Catalog`] ([`builtins::catalog`]).
+//!
+//! One module per family, named like the experiment that measures it: [`independent`] (the
+//! baseline and the clamped control), [`surface_smc`] (paper 001's adaptive surface estimators
+//! with [`cache`], their radiance cache), [`media_smc`] (paper 000 in a medium), [`tracking`] and
+//! [`single_scatter`] (paper 002's trackers with their moment theory, and its single-scattering
+//! estimators), [`pmc`] (paper 003), [`envmap_smc`] (paper 004); and [`testbeds`], the eight test
+//! beds with their references.
 //!
 //! No I/O, plotting or CLI lives here (that is the `mcbench` crate, in `harness/`).
 #![warn(missing_docs)]
 
 pub mod builtins;
 pub mod cache;
+pub mod envmap_smc;
 pub mod independent;
-pub mod media;
 pub mod media_smc;
 pub mod pmc;
 #[cfg(test)]
 mod repository;
 pub mod single_scatter;
-pub mod smc;
-pub mod smc_surface;
+pub mod surface_smc;
 pub mod testbeds;
 pub mod tracking;
-
-// The plug-in API's modules under their former paths, for the crates not yet moved to
-// `mcbench-core`.
-pub use mcbench_core::{
-    accumulate, brdf, budget, envmap, error, estimator, lighting, math, memo, parallel, params, perception, phase,
-    quadrature, references, rng, samplers, stats, task, testbed,
-};
-/// The registry entries and the built-in lists under their former path.
-pub mod registry {
-    pub use crate::builtins::*;
-    pub use mcbench_core::entry::*;
-}

@@ -18,7 +18,7 @@
 //! adaptive sigma_samp) and `ray-marching` (the biased control, step 0.5) once per test bed.
 
 use crate::ExperimentDef;
-use estimators::params::{ParamValue, Params};
+use mcbench_core::params::{ParamValue, Params};
 use mcbench::config::{EstimatorSpec, Mode};
 
 /// Sampling density ratios `sigma_samp / max sigma_t`.

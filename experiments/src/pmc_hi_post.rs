@@ -5,9 +5,9 @@
 //! (the paper's "16 total samples per estimate", two populations of 8), as maps (bright = high
 //! weight) and in `alpha_maps.csv`.
 
-use estimators::budget::Budget;
-use estimators::rng::StreamKey;
-use estimators::task::Task;
+use mcbench_core::budget::Budget;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
 use mcbench::error::{HarnessError, Result};
 use mcbench::folder::OutputDir;
 use mcbench::output::RunReport;

@@ -11,7 +11,7 @@
 use crate::stability_cases::{self as sc, CaseFile, Expect, Outcome};
 use crate::stability_numeric::{self as num, Sequence};
 use crate::ExperimentDef;
-use estimators::params::Params;
+use mcbench_core::params::Params;
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::guarded::one_line;
@@ -57,8 +57,8 @@ fn numeric_cases() -> Vec<(&'static str, &'static str, Expect, Outcome)> {
 fn params_text(p: &Params) -> String {
     p.0.iter()
         .map(|(k, v)| match v {
-            estimators::params::ParamValue::Number(x) => format!("{k}={x}"),
-            estimators::params::ParamValue::Text(t) => format!("{k}={t}"),
+            mcbench_core::params::ParamValue::Number(x) => format!("{k}={x}"),
+            mcbench_core::params::ParamValue::Text(t) => format!("{k}={t}"),
         })
         .collect::<Vec<_>>()
         .join(";")

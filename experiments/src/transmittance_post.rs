@@ -7,8 +7,8 @@
 //! markers, Eq. 16's prediction dashed.
 
 use crate::variance_claims::{build, central_ray, measure, Measured, CASES};
-use estimators::math::Vec3;
-use estimators::media::variance::predicted;
+use mcbench_core::math::Vec3;
+use mcbench_papers::tracking::variance::predicted;
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};

@@ -4,7 +4,7 @@
 
 use crate::registry::Registry;
 use crate::report::markdown_table;
-use estimators::params::ParamDoc;
+use mcbench_core::params::ParamDoc;
 use std::fmt::Write;
 
 /// What to list.

@@ -6,7 +6,7 @@
 //! use mcbench::{EstimatorEntry, Registry};
 //!
 //! // An estimator of your own: here the built-in independent estimator under another id.
-//! static MINE: EstimatorEntry = EstimatorEntry { id: "my_estimator", ..estimators::independent::is0_cv0::ENTRY };
+//! static MINE: EstimatorEntry = EstimatorEntry { id: "my_estimator", ..mcbench_papers::independent::is0_cv0::ENTRY };
 //!
 //! let registry = Registry::builtin().with_estimator(&MINE);
 //! assert!(registry.estimator("my_estimator").is_ok());
@@ -23,9 +23,9 @@ use crate::plan::Plan;
 use crate::plot::DisplayNames;
 use crate::references::ReferenceDir;
 use crate::runner::RunResults;
-use estimators::error::ConfigError;
-use estimators::references::ReferenceSource;
-use estimators::registry::{EstimatorEntry, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::references::ReferenceSource;
+use mcbench_core::entry::{EstimatorEntry, TestBedEntry};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -148,8 +148,8 @@ impl Registry {
     /// registered.
     pub fn builtin() -> Self {
         Registry {
-            estimators: estimators::registry::ESTIMATORS.to_vec(),
-            test_beds: estimators::registry::TESTBEDS.to_vec(),
+            estimators: mcbench_papers::builtins::ESTIMATORS.to_vec(),
+            test_beds: mcbench_papers::builtins::TESTBEDS.to_vec(),
             ..Registry::default()
         }
         .with_experiment(crate::unbiasedness::experiment())
@@ -288,7 +288,7 @@ mod tests {
         let e = r.estimator("nope").err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains("is0_cv0"), "{e}");
         assert!(r.check().is_ok());
-        let twice = r.clone().with_estimator(estimators::registry::ESTIMATORS[0]);
+        let twice = r.clone().with_estimator(mcbench_papers::builtins::ESTIMATORS[0]);
         assert!(twice.check().expect_err("duplicate").to_string().contains("registered twice"));
         assert!(Registry::empty().estimators().is_empty());
     }

@@ -12,11 +12,11 @@ pub use crate::interleave::{run_group_with, GroupCell};
 use crate::plan::Plan;
 pub use crate::resume::{preload, preload_from};
 use crate::store::StoreWriter;
-use estimators::budget::{Budget, BudgetKind};
-use estimators::error::EstimateError;
-use estimators::math::Rgb;
-use estimators::rng::StreamKey;
-use estimators::task::{Costs, Task};
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::error::EstimateError;
+use mcbench_core::math::Rgb;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::{Costs, Task};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -174,7 +174,7 @@ pub fn sequence_estimates(
 }
 
 /// Repetitions per block. A cell's repetitions are reduced block by block (Welford pushes in
-/// repetition order inside a block, [`Moments::merge`](estimators::stats::Moments::merge) of the
+/// repetition order inside a block, [`Moments::merge`](mcbench_core::stats::Moments::merge) of the
 /// blocks in block order), so the block is the unit a shard (`--shard i/n`) can own: the split is
 /// fixed by the sweep's `reps` alone, never by the thread or shard count, and a merge of shards
 /// reproduces a single run bit for bit.

@@ -2,7 +2,7 @@
 //! estimators, on `eq21-medium/single-scatter` (exact references by nested quadrature).
 
 use crate::builtins::{self, ESTIMATORS};
-use crate::media::{Field, MediumBed};
+use crate::testbeds::medium::{Field, MediumBed};
 use mcbench_core::budget::{Budget, BudgetKind};
 use mcbench_core::estimator::{Bias, Estimator};
 use mcbench_core::params::Params;

@@ -102,7 +102,7 @@ impl Track<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::media::{Field, MediumBed};
+    use crate::testbeds::medium::{Field, MediumBed};
     use mcbench_core::budget::Budget;
     use mcbench_core::params::Params;
     use mcbench_core::rng::stream;
@@ -127,7 +127,7 @@ mod tests {
         let z = mcbench_core::math::Vec3::Z;
         let exact: Vec<f64> = points
             .iter()
-            .map(|&s| (-crate::media::reference::optical_depth(&bed, Default::default(), z, 0.0, s).value).exp())
+            .map(|&s| (-crate::testbeds::medium::reference::optical_depth(&bed, Default::default(), z, 0.0, s).value).exp())
             .collect();
         let task = Task::new(&bed, 9, Budget::samples(1).unwrap());
         let probe = task.medium().unwrap();
@@ -136,7 +136,7 @@ mod tests {
             origin: ray.origin,
             dir: ray.dir,
             seg: (0.0, 20.0),
-            light: crate::media::LIGHT,
+            light: crate::testbeds::medium::LIGHT,
             t_l: 10.0,
             d: 1.0,
             albedo: 0.7,

@@ -203,7 +203,7 @@ mod tests {
 
     /// The table of expected shares against rotation at the `envmap-smc` quick size (10x10
     /// pixels, 6 frames); seconds in a release build:
-    /// `cargo test --release -p estimators expected_share_table -- --ignored --nocapture`.
+    /// `cargo test --release -p mcbench-papers expected_share_table -- --ignored --nocapture`.
     #[test]
     #[ignore = "prints a table for the docs; about 2 min in a release build"]
     fn expected_share_table() {

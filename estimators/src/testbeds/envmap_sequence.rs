@@ -49,7 +49,7 @@ const ENVMAP_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1500, 
 /// Registry entry.
 ///
 /// ```
-/// use estimators::builtins::testbed;
+/// use mcbench_papers::builtins::testbed;
 /// use mcbench_core::params::Params;
 ///
 /// let params = Params::new().with("resolution", 2.0).with("frames", 3.0).with("env_width", 16.0).with("env_height", 8.0);

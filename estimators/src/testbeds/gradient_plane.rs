@@ -25,7 +25,7 @@ pub const SURFACE_PART: CaseRole = CaseRole::Unbiasedness { samples: 64, reps: (
 /// Registry entry.
 ///
 /// ```
-/// use estimators::builtins::testbed;
+/// use mcbench_papers::builtins::testbed;
 /// use mcbench_core::params::Params;
 /// let bed = testbed("gradient-plane").unwrap().build_exact("diffuse", &Params::new().with("resolution", 4.0)).unwrap();
 /// assert_eq!(bed.integrals(), 16);

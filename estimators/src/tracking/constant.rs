@@ -142,7 +142,7 @@ fn flight(rng: &mut StreamRng, v: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::media::{Field, MediumBed};
+    use crate::testbeds::medium::{Field, MediumBed};
     use mcbench_core::budget::Budget;
     use mcbench_core::params::Params;
     use mcbench_core::rng::stream;

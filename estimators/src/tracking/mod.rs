@@ -8,14 +8,16 @@
 pub mod constant;
 pub mod delta_tracking;
 pub mod double_particle;
+pub mod moments;
 pub mod params;
 pub mod ratio_tracking;
 pub mod ray_marching;
 pub mod residual_ratio_tracking;
 pub mod single_particle;
 pub mod spm;
+pub mod variance;
 
-use crate::media::moments::tracker_moments;
+use crate::tracking::moments::tracker_moments;
 use mcbench_core::error::{ConfigError, EstimateError};
 use mcbench_core::estimator::EstimateMoments;
 use mcbench_core::math::{Rgb, Vec3};
@@ -242,7 +244,7 @@ pub fn transmittance(
 }
 
 /// The exact moments of one tracker ray on `task`'s transmittance integral
-/// ([`crate::media::moments`]): constant density `sigma_samp`, the rule `rule(albedo)`, and the
+/// ([`crate::tracking::moments`]): constant density `sigma_samp`, the rule `rule(albedo)`, and the
 /// main part `control` (shape, explorer spacing) computed exactly as the estimator computes it;
 /// `None` for radiance integrals or where the rule is invalid on the ray.
 pub fn ray_moments(

@@ -10,7 +10,7 @@
 
 use super::params::RayMarchingParams;
 use super::{segment, supports_transmittance, transmittance};
-use crate::media::moments::ray_marching_moments;
+use crate::tracking::moments::ray_marching_moments;
 use mcbench_core::budget::{Budget, BudgetKind};
 use mcbench_core::entry::{Checks, EstimatorEntry, Exemption};
 use mcbench_core::error::EstimateError;

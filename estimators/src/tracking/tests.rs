@@ -1,7 +1,7 @@
 //! Unbiasedness (book: statistics.md), refusal and stability (book: stability.md) tests of the trackers.
 
 use crate::builtins;
-use crate::media::{Field, MediumBed};
+use crate::testbeds::medium::{Field, MediumBed};
 use mcbench_core::budget::{Budget, BudgetKind};
 use mcbench_core::error::EstimateError;
 use mcbench_core::estimator::Estimator;

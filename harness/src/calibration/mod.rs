@@ -26,7 +26,7 @@ use crate::folder::OutputDir;
 use crate::output::RunReport;
 use crate::plan::Plan;
 use crate::registry::{Experiment, Registry, Sweeps};
-use estimators::estimator::Bias;
+use mcbench_core::estimator::Bias;
 use measure::Family;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -110,7 +110,7 @@ pub fn families_of_run(plan: &Plan, registry: &Registry) -> Vec<Family> {
         return families(registry, plan.sweep.mode);
     }
     let mut out = Vec::new();
-    for budget in s.budgets.iter().filter(|b| b.kind == estimators::budget::BudgetKind::Samples) {
+    for budget in s.budgets.iter().filter(|b| b.kind == mcbench_core::budget::BudgetKind::Samples) {
         for &(bi, ei) in &plan.pairs {
             out.push(Family {
                 bed: s.testbeds[bi].clone(),

@@ -98,8 +98,8 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
     use crate::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
     use crate::plan::Plan;
     use crate::runner::{run, RunOptions, Silent};
-    use estimators::budget::Budget;
-    use estimators::params::Params;
+    use mcbench_core::budget::Budget;
+    use mcbench_core::params::Params;
     let sweep = Sweep {
         experiment: "unbiasedness-test".into(),
         testbeds: vec![TestBedSpec {

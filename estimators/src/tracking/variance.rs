@@ -49,7 +49,7 @@ pub fn predicted(sigma: impl Fn(f64) -> f64, model: Model, samp: f64, s: &[f64])
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::media::{Field, MediumBed};
+    use crate::testbeds::medium::{Field, MediumBed};
     use crate::tracking::double_particle::DoubleParticle;
     use crate::tracking::single_particle::SingleParticle;
     use crate::tracking::SigmaSamp::Absolute;

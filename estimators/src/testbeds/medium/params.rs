@@ -1,6 +1,6 @@
 //! The parameters of `eq21-medium` and `perlin-medium` (book: testbeds.md).
 
-use super::{Field, LIGHT};
+use super::sphere::{Field, LIGHT};
 use mcbench_core::error::ConfigError;
 use mcbench_core::lighting::PointLight;
 use mcbench_core::math::Vec3;

@@ -16,9 +16,9 @@ use std::f64::consts::TAU;
 /// An independent proposal over directions with its density.
 ///
 /// ```
-/// use estimators::brdf::DirectionSample;
-/// use estimators::math::Vec3;
-/// use estimators::smc::mh::Proposal;
+/// use mcbench_core::brdf::DirectionSample;
+/// use mcbench_core::math::Vec3;
+/// use mcbench_papers::envmap_smc::mh::Proposal;
 ///
 /// /// Directions uniform on the sphere.
 /// struct Sphere;
@@ -34,7 +34,7 @@ use std::f64::consts::TAU;
 ///     }
 /// }
 ///
-/// let mut rng = estimators::rng::stream(3, "sphere");
+/// let mut rng = mcbench_core::rng::stream(3, "sphere");
 /// let s = Sphere.draw(&mut rng);
 /// assert!((s.w.dot(s.w) - 1.0).abs() < 1e-12 && s.pdf > 0.0);
 /// ```

@@ -121,7 +121,7 @@ pub fn ray_marching_moments(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::media::variance::{predicted, Model};
+    use crate::tracking::variance::{predicted, Model};
     use mcbench_core::rng::stream;
     use rand::Rng;
 
