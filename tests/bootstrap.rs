@@ -3,13 +3,13 @@
 //! blocks apart and merging them (as shards do), give paired, reproducible intervals, and a cell
 //! stored without them falls back to the delta method.
 
-use mcbench_core::budget::Budget;
-use mcbench_core::params::Params;
 use mcbench::cell::{rep_block_count, CellResult};
 use mcbench::claims::{Ratio, RatioMetric};
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::plan::Plan;
 use mcbench::runner::{self, RunOptions, Silent};
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
 
 const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
 

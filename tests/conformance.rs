@@ -3,10 +3,10 @@
 //! stability cases, determinism for a seed, chi-square of its samplers, unbiasedness at a
 //! small budget), so a new plug-in is covered without new test code.
 
-use mcbench_core::entry::EstimatorEntry;
-use mcbench_papers::builtins;
 use mcbench::analysis::UNBIASEDNESS_ALPHA;
 use mcbench::conformance::{small_budget_unbiasedness, Conformance};
+use mcbench_core::entry::EstimatorEntry;
+use mcbench_papers::builtins;
 
 #[test]
 fn every_registered_estimator_conforms() {

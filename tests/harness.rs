@@ -2,11 +2,11 @@
 //! temp dir, the result files, determinism across thread counts, resume, and the unbiasedness
 //! test's teeth.
 
-use mcbench_core::params::Params;
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::execute::{execute, ExecOptions};
 use mcbench::integrals::IntegralsFormat;
 use mcbench::runner::Silent;
+use mcbench_core::params::Params;
 use std::path::Path;
 
 mod common;

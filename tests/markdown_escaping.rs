@@ -55,7 +55,8 @@ fn markdown_files(root: &Path) -> Vec<PathBuf> {
 #[test]
 fn text_from_configs_labels_and_stored_files_is_escaped_in_every_markdown_file() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let registry = Registry::builtin()
+    let registry = Registry::new()
+        .with_catalog(mcbench_papers::catalog())
         .with_estimator(&HOSTILE)
         .with_references(mcbench::references::ReferenceDir::new(planted_references(dir.path())));
     let config = format!(

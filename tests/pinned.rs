@@ -6,10 +6,10 @@
 
 use mcbench_core::budget::Budget;
 use mcbench_core::params::Params;
-use mcbench_papers::builtins::{self, ESTIMATORS};
 use mcbench_core::rng::StreamKey;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins::{self, ESTIMATORS};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -64,6 +64,12 @@ fn first_estimates() -> BTreeMap<String, String> {
     out
 }
 
+/// The command that rewrites the pins (book: extending.md).
+const REPIN_COMMAND: &str = "MCBENCH_REPIN=1 cargo test -p experiments --test pinned";
+
+/// What a failure says to do.
+const REPIN: &str = "if the change is intended, re-pin with `MCBENCH_REPIN=1 cargo test -p experiments --test pinned` and review the diff of tests/pinned_estimates.json";
+
 #[test]
 fn first_estimates_are_pinned() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/pinned_estimates.json");
@@ -73,24 +79,21 @@ fn first_estimates_are_pinned() {
         std::fs::write(&path, text + "\n").expect("write the pins");
         return;
     }
-    let text = std::fs::read_to_string(&path).expect("tests/pinned_estimates.json (make it with MCBENCH_REPIN=1)");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("tests/pinned_estimates.json: {e}; {REPIN}"));
     let pinned: BTreeMap<String, String> = serde_json::from_str(&text).expect("pins parse");
     let mut diffs = Vec::new();
     for (id, value) in &now {
         match pinned.get(id) {
             Some(p) if p == value => {}
             Some(p) => diffs.push(format!("{id}: pinned {p}, now {value}")),
-            None => diffs.push(format!("{id}: not pinned yet (now {value})")),
+            None => diffs
+                .push(format!("{id}: not pinned yet (now {value}); a new estimator is pinned with {REPIN_COMMAND}")),
         }
     }
     for id in pinned.keys().filter(|id| !now.contains_key(*id)) {
         diffs.push(format!("{id}: pinned but no longer registered"));
     }
-    assert!(
-        diffs.is_empty(),
-        "first estimates changed (re-pin with MCBENCH_REPIN=1 if intended):\n{}",
-        diffs.join("\n")
-    );
+    assert!(diffs.is_empty(), "first estimates changed ({REPIN}):\n{}", diffs.join("\n"));
 }
 
 /// The repository's stored references.

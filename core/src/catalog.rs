@@ -1,4 +1,4 @@
-//! A set of plug-ins a crate hands over: estimators, test beds and samplers, as registry entries.
+//! A set of plug-ins a crate hands over: estimators and test beds, as registry entries.
 //!
 //! A crate of estimators exposes one function returning its [`Catalog`]; the harness adds it to
 //! its registry (`Registry::empty().with_catalog(catalog)`), so the crate needs no dependency on
@@ -18,24 +18,20 @@
 
 use crate::entry::{EstimatorEntry, TestBedEntry};
 use crate::error::ConfigError;
-use crate::samplers::registry::SamplerEntry;
 
-/// Estimators, test beds and samplers, in the order they are listed.
+/// Estimators and test beds, in the order they are listed.
 #[derive(Clone, Default)]
 pub struct Catalog {
     /// The estimators.
     pub estimators: Vec<&'static EstimatorEntry>,
     /// The test beds.
     pub testbeds: Vec<&'static TestBedEntry>,
-    /// Samplers beyond the core's own ([`crate::samplers::registry::SAMPLERS`]), which every
-    /// registry has: an estimator entry names the samplers it draws from by id.
-    pub samplers: Vec<&'static SamplerEntry>,
 }
 
 impl Catalog {
-    /// The estimators and test beds of two lists, no sampler of its own.
+    /// The estimators and test beds of two lists.
     pub fn new(estimators: &[&'static EstimatorEntry], testbeds: &[&'static TestBedEntry]) -> Self {
-        Catalog { estimators: estimators.to_vec(), testbeds: testbeds.to_vec(), samplers: Vec::new() }
+        Catalog { estimators: estimators.to_vec(), testbeds: testbeds.to_vec() }
     }
 
     /// Looks an estimator up by id.
@@ -62,7 +58,6 @@ impl std::fmt::Debug for Catalog {
         f.debug_struct("Catalog")
             .field("estimators", &self.estimators.iter().map(|e| e.id).collect::<Vec<_>>())
             .field("testbeds", &self.testbeds.iter().map(|t| t.id).collect::<Vec<_>>())
-            .field("samplers", &self.samplers.iter().map(|s| s.id).collect::<Vec<_>>())
             .finish()
     }
 }

@@ -5,12 +5,12 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
 use mcbench_core::budget::Budget;
-use mcbench_papers::builtins;
-use mcbench_papers::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, St};
 use mcbench_core::math::Rgb;
 use mcbench_core::params::Params;
 use mcbench_core::rng::stream;
 use mcbench_core::task::Task;
+use mcbench_papers::builtins;
+use mcbench_papers::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, St};
 
 /// A cache refined exactly `depth` times by uniform records of a smooth integrand.
 fn cache_at_depth<S: Scalar>(depth: u32) -> RadianceCache<S> {

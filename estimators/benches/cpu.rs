@@ -16,11 +16,11 @@
 //! (with `samples` = target evaluations).
 
 use mcbench_core::budget::Budget;
-use mcbench_papers::builtins;
 use mcbench_core::params::{ParamValue, Params};
 use mcbench_core::rng::stream;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
 use mcbench_papers::testbeds::gradient_box::GradientBox;
 
 fn thread_cpu_seconds() -> f64 {

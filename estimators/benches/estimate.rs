@@ -4,9 +4,9 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mcbench_core::budget::Budget;
 use mcbench_core::params::Params;
-use mcbench_papers::builtins::{ESTIMATORS, TESTBEDS};
 use mcbench_core::rng::stream;
 use mcbench_core::task::Task;
+use mcbench_papers::builtins::{ESTIMATORS, TESTBEDS};
 
 fn one_estimate(c: &mut Criterion) {
     let budget = Budget::samples(64).expect("64 >= 1");

@@ -8,17 +8,17 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use mcbench_core::budget::Budget;
-use mcbench_papers::cache::{CacheConfig, ControlVariate, Domain};
 use mcbench_core::estimator::Estimator;
 use mcbench_core::math::{Rgb, Vec3};
-use mcbench_papers::media_smc::octree::Octree;
-use mcbench_papers::media_smc::params::MediaSmcParams;
-use mcbench_papers::media_smc::walk::Vertex;
-use mcbench_papers::media_smc::{walk, MediaSmc, Sampling};
 use mcbench_core::params::Params;
 use mcbench_core::phase::Phase;
 use mcbench_core::rng::stream;
 use mcbench_core::task::Task;
+use mcbench_papers::cache::{CacheConfig, ControlVariate, Domain};
+use mcbench_papers::media_smc::octree::Octree;
+use mcbench_papers::media_smc::params::MediaSmcParams;
+use mcbench_papers::media_smc::walk::Vertex;
+use mcbench_papers::media_smc::{walk, MediaSmc, Sampling};
 use mcbench_papers::testbeds::gradient_box::GradientBox;
 use rand::Rng;
 

@@ -6,13 +6,13 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mcbench_core::budget::Budget;
-use mcbench_papers::builtins;
 use mcbench_core::params::Params;
-use mcbench_papers::pmc::ip::PmcIp;
 use mcbench_core::rng::stream;
 use mcbench_core::stats::Moments;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
+use mcbench_papers::pmc::ip::PmcIp;
 use mcbench_papers::testbeds::checker_image::CheckerImage;
 
 fn image(c: &mut Criterion) {

@@ -5,13 +5,13 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use mcbench_core::budget::Budget;
-use mcbench_papers::builtins;
-use mcbench_papers::testbeds::medium::scatter_reference::{single_scatter, Settings};
-use mcbench_papers::testbeds::medium::{Field, MediumBed};
 use mcbench_core::params::Params;
 use mcbench_core::rng::stream;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::{MediumQuantity, MediumScene};
+use mcbench_papers::builtins;
+use mcbench_papers::testbeds::medium::scatter_reference::{single_scatter, Settings};
+use mcbench_papers::testbeds::medium::{Field, MediumBed};
 
 const IDS: [&str; 7] = [
     "ray_marching",

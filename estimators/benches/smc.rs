@@ -10,15 +10,15 @@
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mcbench_core::brdf::Phong;
 use mcbench_core::budget::Budget;
-use mcbench_papers::builtins;
-use mcbench_papers::cache::PartialSumTree;
 use mcbench_core::envmap::{EnvFrame, EnvMap};
 use mcbench_core::math::{Rgb, Vec3};
 use mcbench_core::params::Params;
 use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_papers::builtins;
+use mcbench_papers::cache::PartialSumTree;
 use mcbench_papers::envmap_smc::mh::{MhKernel, State};
 use mcbench_papers::envmap_smc::resampling::{normalise_log_weights, resample, Scheme};
-use mcbench_core::task::Task;
 use mcbench_papers::testbeds::sky::Sky;
 use rand::Rng;
 

@@ -13,12 +13,12 @@
 
 use criterion::{black_box, Criterion, Throughput};
 use mcbench_core::budget::Budget;
-use mcbench_papers::builtins;
 use mcbench_core::math::Vec3;
 use mcbench_core::params::Params;
 use mcbench_core::rng::stream;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
 use rand::Rng;
 use std::cell::RefCell;
 use std::time::{Duration, Instant};

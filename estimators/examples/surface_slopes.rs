@@ -11,11 +11,11 @@
 
 use mcbench_core::budget::Budget;
 use mcbench_core::params::Params;
-use mcbench_papers::builtins;
 use mcbench_core::rng::{stream, StreamKey};
 use mcbench_core::stats::log_log_fit;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
 use mcbench_papers::testbeds::gradient_plane::GradientPlane;
 use std::collections::BTreeMap;
 use std::time::Instant;

@@ -2,7 +2,8 @@
 //!
 //! The estimators of five adaptive Monte Carlo rendering papers with their biased controls, and
 //! the test beds they run on, as plug-ins of `mcbench-core`; [`builtins`] lists them all and hands
-//! them to a harness registry as one [`mcbench_core::Catalog`] ([`builtins::catalog`]).
+//! them to a harness registry as one [`mcbench_core::Catalog`] ([`catalog`]):
+//! `mcbench::Registry::new().with_catalog(mcbench_papers::catalog())`.
 //!
 //! One module per family, named like the experiment that measures it: [`independent`] (the
 //! baseline and the clamped control), [`surface_smc`] (paper 001's adaptive surface estimators
@@ -26,3 +27,5 @@ pub mod single_scatter;
 pub mod surface_smc;
 pub mod testbeds;
 pub mod tracking;
+
+pub use builtins::catalog;

@@ -6,17 +6,17 @@
 //! not run keep their reason.
 
 use crate::canonical_sweep::{family_of, spec, terminating_min_ratio, FAMILIES, RATIOS};
-use mcbench_core::estimator::Bias;
-use mcbench_core::estimator::EstimateMoments;
-use mcbench_papers::builtins;
-use mcbench_core::stats::detectable_shift;
-use mcbench_core::task::Task;
-use mcbench_papers::testbeds::canonical_1d::parse_variant;
-use mcbench_papers::testbeds::canonical_profiles::Profile;
 use mcbench::claims::decisive_test;
 use mcbench::output::RunReport;
 use mcbench::plan::{Plan, Skipped};
 use mcbench::runner::RunResults;
+use mcbench_core::estimator::Bias;
+use mcbench_core::estimator::EstimateMoments;
+use mcbench_core::stats::detectable_shift;
+use mcbench_core::task::Task;
+use mcbench_papers::builtins;
+use mcbench_papers::testbeds::canonical_1d::parse_variant;
+use mcbench_papers::testbeds::canonical_profiles::Profile;
 
 /// A measured variance is resolved when its predicted error bar (one standard deviation of the
 /// sample variance, from the predicted fourth moment) is at most this fraction of the prediction.

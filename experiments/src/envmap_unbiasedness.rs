@@ -7,14 +7,14 @@
 //! estimate); `smc_path` (exponentiated log) and `smc_adaptive` (particle-dependent schedule) only
 //! consistent; `bidirectional_is_sn` is the biased control and must be flagged.
 
-use mcbench_core::budget::Budget;
-use mcbench_core::params::Params;
-use mcbench_core::rng::StreamKey;
-use mcbench_core::task::Task;
 use mcbench::analysis::{unbiasedness, TestRow};
 use mcbench::config::Mode;
 use mcbench::error::Result;
 use mcbench::registry::Registry;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
 use rayon::prelude::*;
 
 /// (estimator id, its parameters) checked.

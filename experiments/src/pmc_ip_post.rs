@@ -7,17 +7,17 @@
 //! run's repetitions (`pixels.csv` holds the same per pixel).
 
 use crate::pmc_ip::{row, PMC_IP_4};
-use mcbench_core::budget::Budget;
-use mcbench_core::math::Rgb;
-use mcbench_papers::pmc::ip::{image_probes, PmcIp, Trace};
-use mcbench_core::rng::StreamKey;
-use mcbench_core::task::Task;
 use mcbench::error::{HarnessError, Result};
 use mcbench::folder::OutputDir;
 use mcbench::output::RunReport;
 use mcbench::plan::{Plan, PreparedBed};
 use mcbench::plot::maps::{write_maps, Map, Scale};
 use mcbench::runner::RunResults;
+use mcbench_core::budget::Budget;
+use mcbench_core::math::Rgb;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
+use mcbench_papers::pmc::ip::{image_probes, PmcIp, Trace};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

@@ -11,13 +11,13 @@
 use crate::stability_cases::{self as sc, CaseFile, Expect, Outcome};
 use crate::stability_numeric::{self as num, Sequence};
 use crate::ExperimentDef;
-use mcbench_core::params::Params;
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::guarded::one_line;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::runner::RunResults;
+use mcbench_core::params::Params;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

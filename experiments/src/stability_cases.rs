@@ -14,6 +14,12 @@
 //! The cases themselves, and the table of places where a pdf can be zero, are data:
 //! `stability_cases.toml` beside this file, embedded and read by [`CaseFile::load`].
 
+use mcbench::analysis::unbiasedness;
+use mcbench::claims::decisive_test;
+use mcbench::config::Mode;
+use mcbench::error::HarnessError;
+use mcbench::guarded::{self, one_line, Stopped};
+use mcbench::registry::Registry;
 use mcbench_core::budget::Budget;
 use mcbench_core::error::EstimateError;
 use mcbench_core::params::Params;
@@ -21,12 +27,6 @@ use mcbench_core::rng::StreamKey;
 use mcbench_core::stats::Moments;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::TestBed;
-use mcbench::analysis::unbiasedness;
-use mcbench::claims::decisive_test;
-use mcbench::config::Mode;
-use mcbench::error::HarnessError;
-use mcbench::guarded::{self, one_line, Stopped};
-use mcbench::registry::Registry;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -360,20 +360,33 @@ mod tests {
 
     #[test]
     fn outcomes_are_correct_refused_or_failed_never_a_panic() {
-        let ok = run(&case("delta_tracking", Params::new(), Expect::Correct), 1, &Registry::builtin());
+        let ok = run(
+            &case("delta_tracking", Params::new(), Expect::Correct),
+            1,
+            &Registry::new().with_catalog(mcbench_papers::catalog()),
+        );
         assert_eq!(ok.outcome, "correct", "{ok:?}");
         // Optical depth ln 2 (the default of constant-T0.5): r = 1e6 > 2/(a+1), the model refuses.
         let terminating = Case {
             bed: Params::new(),
             ..case("single_particle_terminating", Params::new().with("sigma_samp_ratio", 1e-6), Expect::Refused)
         };
-        let refused = run(&terminating, 1, &Registry::builtin());
+        let refused = run(&terminating, 1, &Registry::new().with_catalog(mcbench_papers::catalog()));
         assert!(refused.outcome == "refused" && refused.text.contains("sigma_samp"), "{refused:?}");
-        let unknown = run(&case("no_such_estimator", Params::new(), Expect::Refused), 1, &Registry::builtin());
+        let unknown = run(
+            &case("no_such_estimator", Params::new(), Expect::Refused),
+            1,
+            &Registry::new().with_catalog(mcbench_papers::catalog()),
+        );
         assert!(unknown.outcome == "refused" && unknown.text.contains("no_such_estimator"), "{unknown:?}");
         // A panicking estimator is caught and reported in one line.
         let c = case("delta_tracking", Params::new(), Expect::Correct);
-        let bed = Registry::builtin().test_bed("canonical-1d").unwrap().build_exact(&c.variant, &c.bed).unwrap();
+        let bed = Registry::new()
+            .with_catalog(mcbench_papers::catalog())
+            .test_bed("canonical-1d")
+            .unwrap()
+            .build_exact(&c.variant, &c.bed)
+            .unwrap();
         let err = one_rep(&Panics, bed.as_ref(), &c, 1, 0).unwrap_err();
         assert_eq!(err, "panic: boom");
     }

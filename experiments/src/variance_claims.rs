@@ -2,18 +2,18 @@
 //! estimates of T(s) at s = 5 and 10, 20000 rays per point; held when the measured variance is
 //! within 4 standard errors (from the sample fourth moment) of the prediction.
 
+use mcbench::output::Claim;
 use mcbench_core::budget::Budget;
 use mcbench_core::estimator::Estimator;
 use mcbench_core::math::Vec3;
-use mcbench_papers::tracking::variance::{predicted, Model};
-use mcbench_papers::testbeds::medium::{Field, MediumBed};
 use mcbench_core::params::Params;
-use mcbench_papers::builtins;
 use mcbench_core::rng::stream;
 use mcbench_core::stats::Moments;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::TestBed;
-use mcbench::output::Claim;
+use mcbench_papers::builtins;
+use mcbench_papers::testbeds::medium::{Field, MediumBed};
+use mcbench_papers::tracking::variance::{predicted, Model};
 
 /// Albedo of the eq21 medium (the non-terminating model's `w` depends on it).
 const ALBEDO: f64 = 0.7;

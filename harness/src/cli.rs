@@ -195,7 +195,7 @@ impl RunArgs {
 ///
 /// ```no_run
 /// // The whole body of `main`:
-/// std::process::exit(mcbench::cli::main_with(mcbench::Registry::builtin()));
+/// std::process::exit(mcbench::cli::main_with(mcbench::Registry::new().with_catalog(mcbench_papers::catalog())));
 /// ```
 pub fn main_with(registry: Registry) -> i32 {
     main_with_args(registry, std::env::args_os())

@@ -73,8 +73,10 @@ pub fn run_group_with(
     let keys: Vec<CellKey> = cells.iter().map(|c| cell_key(plan, bi, c.ei, budget)).collect();
     let reference = &b.bed.reference().value;
     // Paper 003's per-integral weight 1 / tvi(L_ref), for each repetition's `Err`.
-    let inv_tvi: Vec<f64> =
-        reference.iter().map(|v| 1.0 / mcbench_core::perception::tvi(mcbench_core::perception::luminance(*v))).collect();
+    let inv_tvi: Vec<f64> = reference
+        .iter()
+        .map(|v| 1.0 / mcbench_core::perception::tvi(mcbench_core::perception::luminance(*v)))
+        .collect();
     let block_size = rep_block_size(reps);
     let per_chunk = (MAX_ITEMS / (REP_BLOCK * batches * cells.len()).max(1)).max(1);
     for start in (0..longest).step_by(per_chunk) {

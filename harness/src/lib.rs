@@ -16,15 +16,14 @@
 //! ## Quick start: your own estimator, from your own crate
 //!
 //! ```no_run
-//! use mcbench::{Checks, EstimateError, Estimator, EstimatorEntry, ParamSpec, Registry, Rgb, StreamRng, Task};
-//! use mcbench_papers::{estimator::Bias, testbed::Needs};
+//! use mcbench::{Bias, Checks, EstimateError, Estimator, EstimatorEntry, Needs, ParamSpec, Registry, Rgb, StreamRng, Task};
 //!
 //! /// Independent uniform-hemisphere sampling of a surface integral.
 //! struct Uniform;
 //!
 //! impl Estimator for Uniform {
 //!     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
-//!         use mcbench_papers::{math::Frame, samplers::uniform_hemisphere};
+//!         use mcbench::mcbench_core::{math::Frame, samplers::uniform_hemisphere};
 //!         let probe = task.hemisphere().ok_or(EstimateError::Refused("needs a surface".into()))?;
 //!         let frame = Frame::around(probe.point().normal);
 //!         let (mut sum, mut n) = (Rgb::ZERO, 0.0);
@@ -54,9 +53,10 @@
 //! };
 //!
 //! fn main() {
-//!     // The whole CLI (run, list, plot, shards, merge, conformance) over the built-in plug-ins
-//!     // and this one: `cargo run -- run --config my-sweep.toml`.
-//!     std::process::exit(mcbench::cli::main_with(Registry::builtin().with_estimator(&UNIFORM)));
+//!     // The whole CLI (run, list, plot, shards, merge, conformance) over the papers' plug-ins
+//!     // (crate `mcbench-papers`, for their test beds) and this one:
+//!     // `cargo run -- run --config my-sweep.toml`.
+//!     std::process::exit(mcbench::cli::main_with(Registry::new().with_catalog(mcbench_papers::catalog()).with_estimator(&UNIFORM)));
 //! }
 //! ```
 #![warn(missing_docs)]

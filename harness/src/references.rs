@@ -6,10 +6,10 @@
 //! (`mcbench reference --param k=v`) is found by any run that uses them.
 
 use crate::error::{HarnessError, Result};
+use mcbench_core::entry::TestBedEntry;
 use mcbench_core::error::ConfigError;
 use mcbench_core::params::Params;
 use mcbench_core::references::{NoReferences, ReferenceKey, ReferenceSource, StoredReference};
-use mcbench_core::entry::TestBedEntry;
 use std::path::{Path, PathBuf};
 
 /// A folder of stored references, one JSON file per key ([`ReferenceKey::file_name`]).

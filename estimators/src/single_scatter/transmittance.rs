@@ -127,7 +127,9 @@ mod tests {
         let z = mcbench_core::math::Vec3::Z;
         let exact: Vec<f64> = points
             .iter()
-            .map(|&s| (-crate::testbeds::medium::reference::optical_depth(&bed, Default::default(), z, 0.0, s).value).exp())
+            .map(|&s| {
+                (-crate::testbeds::medium::reference::optical_depth(&bed, Default::default(), z, 0.0, s).value).exp()
+            })
             .collect();
         let task = Task::new(&bed, 9, Budget::samples(1).unwrap());
         let probe = task.medium().unwrap();

@@ -99,7 +99,10 @@ impl Gate {
 
     /// The group of `estimator` on `bed`: 1 if its integrals are independent, else the bed's
     /// sequence length.
-    pub fn group_of(estimator: &dyn mcbench_core::estimator::Estimator, bed: &dyn mcbench_core::testbed::TestBed) -> usize {
+    pub fn group_of(
+        estimator: &dyn mcbench_core::estimator::Estimator,
+        bed: &dyn mcbench_core::testbed::TestBed,
+    ) -> usize {
         if estimator.integrals_independent() {
             1
         } else {

@@ -181,10 +181,9 @@ mod tests {
     /// family somewhere, and each family carries its row's samples and repetitions.
     #[test]
     fn families_cover_the_controls_and_few_unbiased_estimators_per_case() {
-        let registry = Registry::builtin().with_references(crate::references::ReferenceDir::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../results/references"
-        )));
+        let registry = Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
+            crate::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+        );
         let all = families(&registry, Mode::Quick);
         let mut per_case = std::collections::HashMap::new();
         for f in all.iter().filter(|f| f.bias == Bias::Unbiased) {

@@ -227,7 +227,7 @@ fn mark(x: Option<bool>) -> &'static str {
     }
 }
 
-/// `calibration.md`: the table with the checks (names escaped, [`md_text`]).
+/// `calibration.md`: the table with the checks (names escaped, [`md_text`](crate::report::md_text)).
 pub fn markdown(rows: &[Row], header: &str) -> String {
     use crate::report::md_text;
     let mut s = format!("# calibration\n\n{}\n\n", md_text(header));

@@ -22,7 +22,7 @@ use mcbench_core::testbed::TestBed;
 /// An estimator whose estimates are `1 + b` times `inner`'s.
 ///
 /// ```
-/// use mcbench_papers::{estimator::Estimator, error::EstimateError, math::Rgb, rng::StreamRng, task::Task};
+/// use mcbench_core::{estimator::Estimator, error::EstimateError, math::Rgb, rng::StreamRng, task::Task};
 /// use mcbench::calibration::Scaled;
 ///
 /// struct Half;
@@ -140,7 +140,7 @@ mod tests {
     /// inner one: what lets the calibration apply the transform instead of re-running.
     #[test]
     fn the_wrappers_equal_their_transform_on_the_same_stream() {
-        let registry = Registry::builtin();
+        let registry = Registry::new().with_catalog(mcbench_papers::catalog());
         let bed = registry.test_bed("gradient-plane").unwrap();
         let bed = (bed.build)(
             "default",

@@ -17,9 +17,9 @@ pub mod columns;
 
 use crate::cell::CellResult;
 use crate::shard::BlockFile;
-use mcbench_core::stats::Moments;
 use flate2::read::DeflateDecoder;
 use flate2::write::DeflateEncoder;
+use mcbench_core::stats::Moments;
 use std::io::{Read, Write};
 
 /// At most this many bytes are inflated from one record (a damaged record cannot make the reader

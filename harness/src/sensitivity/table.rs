@@ -86,7 +86,7 @@ fn num(x: Option<f64>) -> String {
 }
 
 /// `sensitivity.md`: the outcome table, then per part its settings (every text of the file and of
-/// the verdicts escaped, [`md_text`]).
+/// the verdicts escaped, [`md_text`](crate::report::md_text)).
 pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
     use crate::report::md_text;
     let mut s = String::from(

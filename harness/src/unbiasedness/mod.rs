@@ -134,7 +134,7 @@ mod tests {
 
     #[test]
     fn parts_cover_every_case_and_every_estimator_that_can_run() {
-        let registry = Registry::builtin();
+        let registry = Registry::new().with_catalog(mcbench_papers::catalog());
         let parts = parts(&registry, Mode::Quick);
         let cases: usize = registry
             .test_beds()
