@@ -21,9 +21,6 @@ use mcbench_core::params::Params;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-/// Ids of the harness sweep (the post hook names its own).
-pub const IDS: &[&str] = &["is0_cv0", "is1_cv2"];
-
 /// Definition.
 pub static DEF: ExperimentDef = ExperimentDef { toml: include_str!("stability.toml"), claims: None, post: Some(post) };
 
