@@ -59,6 +59,28 @@ pub struct Costs {
     pub cache_ops: u64,
 }
 
+impl std::ops::AddAssign for Costs {
+    /// Field by field: the costs of two estimates (or two blocks of them) together.
+    fn add_assign(&mut self, b: Costs) {
+        self.samples += b.samples;
+        self.fetches += b.fetches;
+        self.cheap_fetches += b.cheap_fetches;
+        self.rays += b.rays;
+        self.shadow_rays += b.shadow_rays;
+        self.free_flights += b.free_flights;
+        self.target_evals += b.target_evals;
+        self.cache_ops += b.cache_ops;
+    }
+}
+
+impl std::ops::Add for Costs {
+    type Output = Costs;
+    fn add(mut self, b: Costs) -> Costs {
+        self += b;
+        self
+    }
+}
+
 /// Under a fetch budget, an estimate also stops after `budget x FETCH_BUDGET_SAMPLE_CAP` samples
 /// (rays that fetch nothing cannot spend a fetch budget).
 pub const FETCH_BUDGET_SAMPLE_CAP: u64 = 64;
@@ -440,5 +462,35 @@ mod tests {
         let c: Costs = serde_json::from_str(old).expect("reads");
         assert_eq!(c, Costs { samples: 5, fetches: 2, rays: 7, shadow_rays: 1, free_flights: 3, ..Costs::default() });
         assert_eq!((c.target_evals, c.cache_ops), (0, 0));
+    }
+
+    /// Adding costs adds every count, field by field.
+    #[test]
+    fn costs_add_field_by_field() {
+        let one = Costs {
+            samples: 1,
+            fetches: 2,
+            cheap_fetches: 3,
+            rays: 4,
+            shadow_rays: 5,
+            free_flights: 6,
+            target_evals: 7,
+            cache_ops: 8,
+        };
+        let two = Costs {
+            samples: 2,
+            fetches: 4,
+            cheap_fetches: 6,
+            rays: 8,
+            shadow_rays: 10,
+            free_flights: 12,
+            target_evals: 14,
+            cache_ops: 16,
+        };
+        assert_eq!(one + one, two);
+        let mut sum = Costs::default();
+        sum += one;
+        sum += one;
+        assert_eq!(sum, two);
     }
 }

@@ -165,7 +165,7 @@ impl RepBlock {
         self.p_err += o.p_err;
         self.cpu_seconds += o.cpu_seconds;
         self.wall_seconds += o.wall_seconds;
-        crate::runner::add_costs(&mut self.costs, &o.costs);
+        self.costs += o.costs;
     }
 }
 

@@ -12,7 +12,7 @@
 use crate::cell::{add_diagnostics, rep_block_count, rep_block_size, CellKey, CellResult, RepBlock, TimeStats};
 use crate::error::Result;
 use crate::plan::Plan;
-use crate::runner::{add_costs, calibrated_samples, cell_key, run_sequence, CellRun, Item, REP_BLOCK};
+use crate::runner::{calibrated_samples, cell_key, run_sequence, CellRun, Item, REP_BLOCK};
 use mcbench_core::budget::Budget;
 use mcbench_core::stats::{Moments, NeumaierSum};
 use mcbench_core::task::Costs;
@@ -140,7 +140,7 @@ pub fn run_group_with(
                 acc.integrals += 1;
             }
             part.estimates += r.values.len() as u64;
-            add_costs(&mut part.costs, &r.costs);
+            part.costs += r.costs;
             part.time.merge(&r.time);
             if let Some(t) = &mut part.cpu_time {
                 t.merge(&r.cpu_time);
@@ -149,7 +149,7 @@ pub fn run_group_with(
             if let Some(blk) = part.blocks.get_mut(rep / block_size) {
                 blk.cpu_seconds += r.cpu_time.total;
                 blk.wall_seconds += r.time.total;
-                add_costs(&mut blk.costs, &r.costs);
+                blk.costs += r.costs;
             }
         }
         for (k, acc) in rep_acc.into_iter().enumerate() {

@@ -80,17 +80,6 @@ pub(crate) struct Item {
     pub(crate) diagnostics: Vec<(String, f64)>,
 }
 
-pub(crate) fn add_costs(a: &mut Costs, b: &Costs) {
-    a.samples += b.samples;
-    a.fetches += b.fetches;
-    a.cheap_fetches += b.cheap_fetches;
-    a.rays += b.rays;
-    a.shadow_rays += b.shadow_rays;
-    a.free_flights += b.free_flights;
-    a.target_evals += b.target_evals;
-    a.cache_ops += b.cache_ops;
-}
-
 /// Repetition index of the pilot stream that calibrates fetch budgets (never a real repetition).
 pub(crate) const PILOT_REP: u64 = u64::MAX;
 
@@ -147,7 +136,7 @@ pub(crate) fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut
         }
         out.time.push(seconds);
         out.cpu_time.push(cpu_seconds);
-        add_costs(&mut out.costs, &task.costs());
+        out.costs += task.costs();
         add_diagnostics(&mut out.diagnostics, &task.diagnostics());
         out.values.push(v);
     }
@@ -247,7 +236,7 @@ fn merge_into(out: &mut CellResult, p: &CellResult) {
         }
     }
     out.estimates += p.estimates;
-    add_costs(&mut out.costs, &p.costs);
+    out.costs += p.costs;
     out.time.merge(&p.time);
     out.merge_cpu_time(p);
     add_diagnostics(&mut out.diagnostics, &p.diagnostics);
