@@ -3,13 +3,13 @@
 //! blocks apart and merging them (as shards do), give paired, reproducible intervals, and a cell
 //! stored without them falls back to the delta method.
 
-use estimators::budget::Budget;
-use estimators::params::Params;
 use mcbench::cell::{rep_block_count, CellResult};
 use mcbench::claims::{Ratio, RatioMetric};
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::plan::Plan;
 use mcbench::runner::{self, RunOptions, Silent};
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
 
 const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
 
@@ -47,7 +47,7 @@ fn run(plan: &Plan, threads: usize) -> Vec<CellResult> {
 }
 
 /// The blocks without their time sums (which vary run to run).
-fn untimed(c: &CellResult) -> Vec<(u64, u64, u64, estimators::task::Costs)> {
+fn untimed(c: &CellResult) -> Vec<(u64, u64, u64, mcbench_core::task::Costs)> {
     c.blocks.iter().map(|b| (b.reps, b.sq.to_bits(), b.p_err.to_bits(), b.costs)).collect()
 }
 

@@ -3,9 +3,10 @@
 //! stability cases, determinism for a seed, chi-square of its samplers, unbiasedness at a
 //! small budget), so a new plug-in is covered without new test code.
 
-use estimators::registry;
 use mcbench::analysis::UNBIASEDNESS_ALPHA;
 use mcbench::conformance::{small_budget_unbiasedness, Conformance};
+use mcbench_core::entry::EstimatorEntry;
+use mcbench_papers::builtins;
 
 #[test]
 fn every_registered_estimator_conforms() {
@@ -19,12 +20,12 @@ fn every_registered_estimator_conforms() {
 /// integrand of independent MC) on the same kind of bed and budget the suite uses.
 #[test]
 fn the_small_budget_check_flags_the_biased_control() {
-    let entry = registry::estimator("clamped_is0_cv0").expect("registered");
+    let entry = builtins::estimator("clamped_is0_cv0").expect("registered");
     let est = (entry.build)(&Default::default()).expect("builds");
-    let bed = (registry::testbed("gradient-plane").expect("registered").build)(
+    let bed = (builtins::testbed("gradient-plane").expect("registered").build)(
         "default",
-        &estimators::params::Params::new().with("resolution", 2.0),
-        &estimators::references::NoReferences,
+        &mcbench_core::params::Params::new().with("resolution", 2.0),
+        &mcbench_core::references::NoReferences,
     )
     .expect("builds");
     let row = small_budget_unbiasedness(entry, est.as_ref(), bed.as_ref()).expect("the control runs");
@@ -35,8 +36,8 @@ fn the_small_budget_check_flags_the_biased_control() {
 /// sampler check cannot pass vacuously.
 #[test]
 fn an_unregistered_sampler_name_fails_the_suite() {
-    let real = registry::estimator("is0_cv0").expect("registered");
-    let entry = registry::EstimatorEntry { samplers: &["no_such_sampler"], ..*real };
+    let real = builtins::estimator("is0_cv0").expect("registered");
+    let entry = EstimatorEntry { samplers: &["no_such_sampler"], ..*real };
     let failures = Conformance::new(registry()).expect("builds").check(&entry);
     assert!(
         failures.iter().any(|f| f.check == "samplers" && f.detail.contains("no_such_sampler")),
@@ -50,33 +51,33 @@ fn an_unregistered_sampler_name_fails_the_suite() {
 /// gives the unbiasedness tests more power, is checked.
 #[test]
 fn a_false_independence_declaration_fails_the_suite() {
-    use estimators::estimator::Estimator;
+    use mcbench_core::estimator::Estimator;
     struct Claims(Box<dyn Estimator>);
     impl Estimator for Claims {
         fn estimate(
             &self,
-            task: &estimators::task::Task<'_>,
-            rng: &mut estimators::rng::StreamRng,
-        ) -> Result<estimators::math::Rgb, estimators::error::EstimateError> {
+            task: &mcbench_core::task::Task<'_>,
+            rng: &mut mcbench_core::rng::StreamRng,
+        ) -> Result<mcbench_core::math::Rgb, mcbench_core::error::EstimateError> {
             self.0.estimate(task, rng)
         }
         fn estimate_sequence(
             &self,
-            tasks: &[estimators::task::Task<'_>],
-            rng: &mut estimators::rng::StreamRng,
-        ) -> Result<Vec<estimators::math::Rgb>, estimators::error::EstimateError> {
+            tasks: &[mcbench_core::task::Task<'_>],
+            rng: &mut mcbench_core::rng::StreamRng,
+        ) -> Result<Vec<mcbench_core::math::Rgb>, mcbench_core::error::EstimateError> {
             self.0.estimate_sequence(tasks, rng)
         }
         fn integrals_independent(&self) -> bool {
             true
         }
-        fn supports(&self, bed: &dyn estimators::testbed::TestBed) -> Result<(), String> {
+        fn supports(&self, bed: &dyn mcbench_core::testbed::TestBed) -> Result<(), String> {
             self.0.supports(bed)
         }
     }
-    let real = registry::estimator("pmc_ip").expect("registered");
-    let entry = registry::EstimatorEntry {
-        build: |p| Ok(Box::new(Claims((registry::estimator("pmc_ip").expect("registered").build)(p)?))),
+    let real = builtins::estimator("pmc_ip").expect("registered");
+    let entry = EstimatorEntry {
+        build: |p| Ok(Box::new(Claims((builtins::estimator("pmc_ip").expect("registered").build)(p)?))),
         samplers: &[],
         ..*real
     };

@@ -5,10 +5,10 @@
 
 mod common;
 use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::estimators::budget::{Budget, BudgetKind};
-use mcbench::estimators::params::{ParamSpec, Params};
 use mcbench::runner::{self, RunOptions, Silent};
 use mcbench::{Bias, Checks, EstimateError, Estimator, EstimatorEntry, Needs, Registry, Rgb, StreamRng, Task};
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::params::{ParamSpec, Params};
 
 /// Takes the task's samples (all along the surface normal), returning their mean.
 fn spend_budget(task: &Task<'_>) -> Result<Rgb, EstimateError> {

@@ -1,13 +1,13 @@
 //! A fetch budget is spent as asked wherever the image's rays are cheap or costly: the pilot that
 //! turns it into a fixed sample count samples the whole image, not one column.
 
-use estimators::budget::{Budget, BudgetKind};
-use estimators::media::{clip_sphere, Field, MediumBed};
-use estimators::params::Params;
-use estimators::testbed::MediumScene;
 use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::execute::{execute, ExecOptions};
 use mcbench::runner::Silent;
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::params::Params;
+use mcbench_core::testbed::MediumScene;
+use mcbench_papers::testbeds::medium::{clip_sphere, Field, MediumBed};
 
 const TRACKERS: [&str; 4] = ["delta_tracking", "ratio_tracking", "residual_ratio_tracking", "ray_marching"];
 const BUDGET: u64 = 1000;

@@ -317,7 +317,7 @@ fn edited_references_never_panic_and_pass_only_when_well_formed() {
         .run(&edits(), |edits| {
             let text = mutate(&original, &edits);
             let outcome = catch_unwind(AssertUnwindSafe(|| {
-                let s: estimators::references::StoredReference =
+                let s: mcbench_core::references::StoredReference =
                     serde_json::from_str(&text).map_err(|e| e.to_string())?;
                 s.check(256, (16, 16)).map(|()| s)
             }));

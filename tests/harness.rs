@@ -2,11 +2,11 @@
 //! temp dir, the result files, determinism across thread counts, resume, and the unbiasedness
 //! test's teeth.
 
-use estimators::params::Params;
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::execute::{execute, ExecOptions};
 use mcbench::integrals::IntegralsFormat;
 use mcbench::runner::Silent;
+use mcbench_core::params::Params;
 use std::path::Path;
 
 mod common;
@@ -113,7 +113,7 @@ fn same_seed_same_results_whatever_the_thread_count() {
                 params: Params::new().with("resolution", 4.0),
             }];
             media.budgets =
-                vec![estimators::budget::Budget { kind: estimators::budget::BudgetKind::Fetches, amount: 30 }];
+                vec![mcbench_core::budget::Budget { kind: mcbench_core::budget::BudgetKind::Fetches, amount: 30 }];
             media.baseline = None;
             run_into(d.path(), media, threads, false);
             let mut csv = deterministic_csv(&d.path().join("results/itest/summary.csv"));
@@ -208,7 +208,7 @@ fn incompatible_pairs_are_skipped_with_a_reason_and_bad_sweeps_refused() {
     assert!(plan.skipped[0].reason.contains("medium"), "{}", plan.skipped[0].reason);
     // A sweep in which no pair can run is refused (it would only overwrite results with nothing).
     let mut s = sweep(&["is0_cv0"], 3);
-    s.budgets = vec![estimators::budget::Budget { kind: estimators::budget::BudgetKind::Fetches, amount: 10 }];
+    s.budgets = vec![mcbench_core::budget::Budget { kind: mcbench_core::budget::BudgetKind::Fetches, amount: 10 }];
     let err = plan_of(s).err().expect("refused");
     assert!(err.to_string().contains("medium") && err.exit_code() == 2, "{err}");
     let mut s = sweep(&["no_such_estimator"], 3);
@@ -227,7 +227,7 @@ fn sequences_are_deterministic_whatever_the_thread_count() {
         let params =
             Params::new().with("resolution", 3.0).with("frames", 3.0).with("env_width", 32.0).with("env_height", 16.0);
         s.testbeds = vec![TestBedSpec { id: "envmap-sequence".into(), variant: Some("mixed".into()), params }];
-        s.budgets = vec![estimators::budget::Budget { kind: estimators::budget::BudgetKind::Samples, amount: 8 }];
+        s.budgets = vec![mcbench_core::budget::Budget { kind: mcbench_core::budget::BudgetKind::Samples, amount: 8 }];
         s.baseline = None;
         s
     };
@@ -259,7 +259,7 @@ fn a_fetch_budget_buys_a_fixed_calibrated_number_of_rays() {
         variant: Some("transmittance".into()),
         params: Params::new().with("resolution", 4.0),
     }];
-    s.budgets = vec![estimators::budget::Budget { kind: estimators::budget::BudgetKind::Fetches, amount: 40 }];
+    s.budgets = vec![mcbench_core::budget::Budget { kind: mcbench_core::budget::BudgetKind::Fetches, amount: 40 }];
     s.baseline = None;
     let out = run_into(dir.path(), s, 2, false);
     for row in &out.report.rows {

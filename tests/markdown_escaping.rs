@@ -17,7 +17,7 @@ const IMG_ESCAPED: &str = "&lt;img src=x onerror=alert(1)&gt;";
 static HOSTILE: EstimatorEntry = EstimatorEntry {
     id: "hostile_label",
     label: "tracer <script>alert(1)</script> <img src=x onerror=alert(1)>",
-    ..mcbench::estimators::independent::is0_cv0::ENTRY
+    ..mcbench_papers::independent::is0_cv0::ENTRY
 };
 
 /// The repository's stored reference of `gradient-box/albedo-0.8` with both tags in its command.
@@ -55,7 +55,8 @@ fn markdown_files(root: &Path) -> Vec<PathBuf> {
 #[test]
 fn text_from_configs_labels_and_stored_files_is_escaped_in_every_markdown_file() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let registry = Registry::builtin()
+    let registry = Registry::new()
+        .with_catalog(mcbench_papers::catalog())
         .with_estimator(&HOSTILE)
         .with_references(mcbench::references::ReferenceDir::new(planted_references(dir.path())));
     let config = format!(

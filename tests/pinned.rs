@@ -4,12 +4,12 @@
 //! the random streams fails here; an intended one is re-pinned with
 //! `MCBENCH_REPIN=1 cargo test -p experiments --test pinned` (and the diff reviewed).
 
-use estimators::budget::Budget;
-use estimators::params::Params;
-use estimators::registry::{self, ESTIMATORS};
-use estimators::rng::StreamKey;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins::{self, ESTIMATORS};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -33,7 +33,7 @@ fn first_estimates() -> BTreeMap<String, String> {
     let built: Vec<(String, Box<dyn TestBed>)> = beds()
         .into_iter()
         .map(|(id, v, p)| {
-            let entry = registry::testbed(id).expect("registered test bed");
+            let entry = builtins::testbed(id).expect("registered test bed");
             let refs = mcbench::references::ReferenceDir::new(REFERENCES);
             (format!("{id}/{v}"), (entry.build)(v, &p, &refs).expect("builds"))
         })
@@ -65,6 +65,12 @@ fn first_estimates() -> BTreeMap<String, String> {
     out
 }
 
+/// The command that rewrites the pins (book: extending.md).
+const REPIN_COMMAND: &str = "MCBENCH_REPIN=1 cargo test -p experiments --test pinned";
+
+/// What a failure says to do.
+const REPIN: &str = "if the change is intended, re-pin with `MCBENCH_REPIN=1 cargo test -p experiments --test pinned` and review the diff of tests/pinned_estimates.json";
+
 #[test]
 fn first_estimates_are_pinned() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/pinned_estimates.json");
@@ -74,24 +80,21 @@ fn first_estimates_are_pinned() {
         std::fs::write(&path, text + "\n").expect("write the pins");
         return;
     }
-    let text = std::fs::read_to_string(&path).expect("tests/pinned_estimates.json (make it with MCBENCH_REPIN=1)");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("tests/pinned_estimates.json: {e}; {REPIN}"));
     let pinned: BTreeMap<String, String> = serde_json::from_str(&text).expect("pins parse");
     let mut diffs = Vec::new();
     for (id, value) in &now {
         match pinned.get(id) {
             Some(p) if p == value => {}
             Some(p) => diffs.push(format!("{id}: pinned {p}, now {value}")),
-            None => diffs.push(format!("{id}: not pinned yet (now {value})")),
+            None => diffs
+                .push(format!("{id}: not pinned yet (now {value}); a new estimator is pinned with {REPIN_COMMAND}")),
         }
     }
     for id in pinned.keys().filter(|id| !now.contains_key(*id)) {
         diffs.push(format!("{id}: pinned but no longer registered"));
     }
-    assert!(
-        diffs.is_empty(),
-        "first estimates changed (re-pin with MCBENCH_REPIN=1 if intended):\n{}",
-        diffs.join("\n")
-    );
+    assert!(diffs.is_empty(), "first estimates changed ({REPIN}):\n{}", diffs.join("\n"));
 }
 
 /// The repository's stored references.

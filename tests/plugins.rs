@@ -4,11 +4,11 @@
 //! no id list anywhere has to name it.
 
 use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::estimators::math::{Frame, Vec3};
-use mcbench::estimators::params::{check_range, parse, ParamSet, ParamSpec, Params};
 use mcbench::{
     Bias, Checks, ConfigError, EstimateError, Estimator, EstimatorEntry, Needs, Registry, Rgb, StreamRng, Task,
 };
+use mcbench_core::math::{Frame, Vec3};
+use mcbench_core::params::{check_range, parse, ParamSet, ParamSpec, Params};
 use serde::{Deserialize, Serialize};
 
 /// Uniform hemisphere sampling whose samples are weighted by `1 + tilt * z`: unbiased for any tilt
@@ -65,10 +65,9 @@ static THROW_AWAY: EstimatorEntry = EstimatorEntry {
 };
 
 fn registry() -> Registry {
-    Registry::builtin().with_estimator(&THROW_AWAY).with_references(mcbench::references::ReferenceDir::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../results/references"
-    )))
+    Registry::new().with_catalog(mcbench_papers::catalog()).with_estimator(&THROW_AWAY).with_references(
+        mcbench::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+    )
 }
 
 #[test]

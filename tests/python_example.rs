@@ -3,10 +3,10 @@
 //! and one line. Where Python 3 with polars and matplotlib is missing the test prints why and
 //! passes, unless `MCBENCH_REQUIRE_PYTHON=1` (CI sets it) makes that a failure.
 
-use estimators::params::Params;
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::execute::{execute, ExecOptions};
 use mcbench::runner::Silent;
+use mcbench_core::params::Params;
 use std::path::Path;
 use std::process::Command;
 

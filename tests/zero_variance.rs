@@ -7,18 +7,18 @@
 
 use mcbench::analysis::{SlopeOutcome, SpeedUpOutcome, Spread};
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::estimators::brdf::Phong;
-use mcbench::estimators::math::{Frame, Vec3};
-use mcbench::estimators::params::{ParamSpec, Params};
-use mcbench::estimators::references::ReferenceSource;
-use mcbench::estimators::samplers::{cosine_hemisphere, uniform_hemisphere};
-use mcbench::estimators::testbed::{HemisphereScene, ReferenceKind, ShadingPoint};
 use mcbench::execute::{execute, ExecOptions};
 use mcbench::runner::Silent;
 use mcbench::{
     Bias, Checks, EstimateError, Estimator, EstimatorEntry, Needs, Reference, Registry, Rgb, StreamRng, Task, TestBed,
     TestBedEntry,
 };
+use mcbench_core::brdf::Phong;
+use mcbench_core::math::{Frame, Vec3};
+use mcbench_core::params::{ParamSpec, Params};
+use mcbench_core::references::ReferenceSource;
+use mcbench_core::samplers::{cosine_hemisphere, uniform_hemisphere};
+use mcbench_core::testbed::{HemisphereScene, ReferenceKind, ShadingPoint};
 
 /// Albedo of patch `i`.
 fn albedo(i: usize) -> f64 {
@@ -139,7 +139,7 @@ impl Estimator for FurnaceEstimator {
     }
 }
 
-const fn entry(id: &'static str, bias: Bias, build: mcbench::estimators::registry::BuildEstimator) -> EstimatorEntry {
+const fn entry(id: &'static str, bias: Bias, build: mcbench_core::entry::BuildEstimator) -> EstimatorEntry {
     EstimatorEntry {
         id,
         paper: "tests",
@@ -162,7 +162,8 @@ static UNIFORM: EstimatorEntry =
     entry("furnace_uniform", Bias::Unbiased, |_| Ok(Box::new(FurnaceEstimator(Kind::Uniform))));
 
 fn registry() -> Registry {
-    Registry::builtin()
+    Registry::new()
+        .with_catalog(mcbench_papers::catalog())
         .with_test_bed(&FURNACE)
         .with_estimator(&EXACT)
         .with_estimator(&COSINE)

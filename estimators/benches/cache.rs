@@ -1,16 +1,16 @@
 //! Criterion benches of the surface radiance cache hot paths (book: benches.md): one cache sample
 //! (partial-sum tree + uniform in the cell), one record (running means, maintained sums, tree
 //! update), one refinement, one reconstruction of g, and one whole `is1_cv2` estimate.
-//! Run with `cargo bench -p estimators --bench cache`.
+//! Run with `cargo bench -p mcbench-papers --bench cache`.
 
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
-use estimators::budget::Budget;
-use estimators::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, St};
-use estimators::math::Rgb;
-use estimators::params::Params;
-use estimators::registry;
-use estimators::rng::stream;
-use estimators::task::Task;
+use mcbench_core::budget::Budget;
+use mcbench_core::math::Rgb;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_papers::builtins;
+use mcbench_papers::cache::{CacheConfig, ControlVariate, RadianceCache, Scalar, St};
 
 /// A cache refined exactly `depth` times by uniform records of a smooth integrand.
 fn cache_at_depth<S: Scalar>(depth: u32) -> RadianceCache<S> {
@@ -61,17 +61,17 @@ fn cache_ops(c: &mut Criterion) {
 }
 
 fn is1_cv2_estimate(c: &mut Criterion) {
-    let bed = (registry::testbed("gradient-plane").unwrap().build)(
+    let bed = (builtins::testbed("gradient-plane").unwrap().build)(
         "default",
         &Params::new().with("resolution", 8.0),
-        &estimators::references::NoReferences,
+        &mcbench_core::references::NoReferences,
     )
     .expect("test bed");
     let mut group = c.benchmark_group("is1_cv2_estimate");
     for spp in [64u64, 1024, 4096] {
         group.throughput(Throughput::Elements(spp));
         for id in ["is0_cv0", "is1_cv2"] {
-            let est = (registry::estimator(id).unwrap().build)(&Params::new()).expect("estimator");
+            let est = (builtins::estimator(id).unwrap().build)(&Params::new()).expect("estimator");
             let mut rng = stream(3, id);
             let mut i = 0;
             group.bench_function(BenchmarkId::new(id, spp), |b| {

@@ -4,10 +4,10 @@
 //! line per measurement and ignores criterion's options.
 //!
 //! ```text
-//! cargo bench -p estimators --bench cpu -- media 1024 is0_cv0 is1_cv2      # gradient-box albedo 0.8, 16x16
-//! cargo bench -p estimators --bench cpu -- surface 1024 brdf_is0_cv0 is1_cv2 brdf_is1_cv2   # gradient-plane 16x16
-//! cargo bench -p estimators --bench cpu -- envmap 10 bidirectional_is smc smc_bridge   # envmap-sequence mixed 16x16, 10 frames, N = 16
-//! cargo bench -p estimators --bench cpu -- tracking 20000 bare bare_chained delta_tracking ratio_tracking   # eq21-medium, CPU per fetch
+//! cargo bench -p mcbench-papers --bench cpu -- media 1024 is0_cv0 is1_cv2      # gradient-box albedo 0.8, 16x16
+//! cargo bench -p mcbench-papers --bench cpu -- surface 1024 brdf_is0_cv0 is1_cv2 brdf_is1_cv2   # gradient-plane 16x16
+//! cargo bench -p mcbench-papers --bench cpu -- envmap 10 bidirectional_is smc smc_bridge   # envmap-sequence mixed 16x16, 10 frames, N = 16
+//! cargo bench -p mcbench-papers --bench cpu -- tracking 20000 bare bare_chained delta_tracking ratio_tracking   # eq21-medium, CPU per fetch
 //! ```
 //! Options after the ids: `storage=f32` (the caches' cell precision), `reps=K` (repeat K times,
 //! each line its own measurement), `res=R` (the image side of gradient-plane and envmap-sequence,
@@ -15,13 +15,13 @@
 //! `candidates=256`). Media report CPU per path, surfaces per sample, envmap per pixel and frame
 //! (with `samples` = target evaluations).
 
-use estimators::budget::Budget;
-use estimators::params::{ParamValue, Params};
-use estimators::registry;
-use estimators::rng::stream;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
-use estimators::testbeds::gradient_box::GradientBox;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::{ParamValue, Params};
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
+use mcbench_papers::testbeds::gradient_box::GradientBox;
 
 fn thread_cpu_seconds() -> f64 {
     let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };
@@ -37,7 +37,7 @@ type Measured = (f64, u64, Vec<(&'static str, f64)>, u64);
 
 /// One whole-image sequence of `id` at `spp` samples per integral.
 fn run(bed: &dyn TestBed, id: &str, spp: u64, params: &Params, seed: u64) -> Measured {
-    let est = (registry::estimator(id).expect("registered").build)(params).expect("builds");
+    let est = (builtins::estimator(id).expect("registered").build)(params).expect("builds");
     let n = bed.integrals();
     let frames = bed.sequence_length().max(1);
     let tasks: Vec<Task<'_>> = (0..n).map(|i| Task::new(bed, i, Budget::samples(spp).expect("spp"))).collect();
@@ -66,10 +66,10 @@ fn run(bed: &dyn TestBed, id: &str, spp: u64, params: &Params, seed: u64) -> Mea
 /// estimates (equal hashes: bit-identical results).
 fn tracking(estimates: u64, ids: &[String]) {
     use rand::Rng;
-    let bed = (registry::testbed("eq21-medium").unwrap().build)(
+    let bed = (builtins::testbed("eq21-medium").unwrap().build)(
         "central-ray",
         &Params::new(),
-        &estimators::references::NoReferences,
+        &mcbench_core::references::NoReferences,
     )
     .expect("bed");
     for id in ids {
@@ -78,7 +78,7 @@ fn tracking(estimates: u64, ids: &[String]) {
             let scene = bed.medium().expect("medium");
             let mut rng = stream(7, "bench fetch points");
             let points: Vec<_> =
-                (0..1024).map(|_| estimators::math::Vec3::new(0.0, 0.0, rng.gen_range(0.0..20.0))).collect();
+                (0..1024).map(|_| mcbench_core::math::Vec3::new(0.0, 0.0, rng.gen_range(0.0..20.0))).collect();
             // `bare_chained`: each point depends on the previous fetch's value (by a zero
             // offset the compiler cannot see through), as a tracker's next point depends on its
             // last step: the fetches run one after the other instead of overlapping.
@@ -87,14 +87,14 @@ fn tracking(estimates: u64, ids: &[String]) {
             for _ in 0..estimates * 16 {
                 let mut s = 0.0;
                 for p in &points {
-                    let p = if chained { *p + estimators::math::Vec3::new(0.0, 0.0, 0.0 * s) } else { *p };
+                    let p = if chained { *p + mcbench_core::math::Vec3::new(0.0, 0.0, 0.0 * s) } else { *p };
                     s += scene.sigma_t(std::hint::black_box(p));
                 }
                 std::hint::black_box(s);
             }
             (t0, estimates * 16 * points.len() as u64)
         } else {
-            let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+            let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
             let mut rng = stream(11, id);
             let (mut fetches, mut h) = (0, 0xcbf2_9ce4_8422_2325u64);
             let t0 = thread_cpu_seconds();
@@ -119,7 +119,7 @@ fn main() {
         let n = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1000);
         return tracking(n, &args[2..]);
     }
-    // Run by `cargo bench -p estimators -- <criterion options>` (no mode, or an option's value
+    // Run by `cargo bench -p mcbench-papers -- <criterion options>` (no mode, or an option's value
     // first): nothing to measure.
     let Some(mode) = args.first().filter(|m| ["media", "surface", "envmap"].contains(&m.as_str())) else {
         eprintln!("usage: cpu <media|surface|envmap|tracking> <spp|frames|estimates> <ids...> [storage=f32] [reps=K]");
@@ -146,20 +146,20 @@ fn main() {
     let (bed, spp, per): (Box<dyn TestBed>, u64, &str) = match mode.as_str() {
         "media" => (Box::new(GradientBox::without_reference("albedo-0.8", &Params::new()).expect("bed")), size, "path"),
         "surface" => (
-            (registry::testbed("gradient-plane").unwrap().build)(
+            (builtins::testbed("gradient-plane").unwrap().build)(
                 "default",
                 &Params::new().with("resolution", res),
-                &estimators::references::NoReferences,
+                &mcbench_core::references::NoReferences,
             )
             .expect("bed"),
             size,
             "sample",
         ),
         "envmap" => (
-            (registry::testbed("envmap-sequence").unwrap().build)(
+            (builtins::testbed("envmap-sequence").unwrap().build)(
                 &variant,
                 &Params::new().with("resolution", res).with("frames", size as f64),
-                &estimators::references::NoReferences,
+                &mcbench_core::references::NoReferences,
             )
             .expect("bed"),
             16,

@@ -1,12 +1,12 @@
 //! Criterion bench: one estimate of each registered estimator on each test bed it runs on, at a
-//! small sample budget (book: benches.md). Run with `cargo bench -p estimators`.
+//! small sample budget (book: benches.md). Run with `cargo bench -p mcbench-papers`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use estimators::budget::Budget;
-use estimators::params::Params;
-use estimators::registry::{ESTIMATORS, TESTBEDS};
-use estimators::rng::stream;
-use estimators::task::Task;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_papers::builtins::{ESTIMATORS, TESTBEDS};
 
 fn one_estimate(c: &mut Criterion) {
     let budget = Budget::samples(64).expect("64 >= 1");
@@ -14,7 +14,7 @@ fn one_estimate(c: &mut Criterion) {
         let variant = bed_entry.variants[0];
         // Test beds with stored references exist only at the stored resolution (benches/media.rs).
         let Ok(bed) =
-            (bed_entry.build)(variant, &Params::new().with("resolution", 8.0), &estimators::references::NoReferences)
+            (bed_entry.build)(variant, &Params::new().with("resolution", 8.0), &mcbench_core::references::NoReferences)
         else {
             continue;
         };

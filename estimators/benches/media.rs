@@ -4,22 +4,22 @@
 //! estimate and the record; paper 000 Fig. 2) on a full octree of depth 3 (512 leaves, 65 536
 //! cells: the structure of a 16x16 image at 1024 spp) and depth 4 (4096 leaves, 2.1 M cells: at
 //! 16 384 spp), and one `is1_cv2` estimate of a 16 x 16 gradient-box image at 4 spp (shared
-//! octree, 1024 paths). Run with `cargo bench -p estimators --bench media`.
+//! octree, 1024 paths). Run with `cargo bench -p mcbench-papers --bench media`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
-use estimators::budget::Budget;
-use estimators::cache::{CacheConfig, ControlVariate, Domain};
-use estimators::estimator::Estimator;
-use estimators::math::{Rgb, Vec3};
-use estimators::media_smc::octree::Octree;
-use estimators::media_smc::params::MediaSmcParams;
-use estimators::media_smc::walk::Vertex;
-use estimators::media_smc::{walk, MediaSmc, Sampling};
-use estimators::params::Params;
-use estimators::phase::Phase;
-use estimators::rng::stream;
-use estimators::task::Task;
-use estimators::testbeds::gradient_box::GradientBox;
+use mcbench_core::budget::Budget;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::Params;
+use mcbench_core::phase::Phase;
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_papers::cache::{CacheConfig, ControlVariate, Domain};
+use mcbench_papers::media_smc::octree::Octree;
+use mcbench_papers::media_smc::params::MediaSmcParams;
+use mcbench_papers::media_smc::walk::Vertex;
+use mcbench_papers::media_smc::{walk, MediaSmc, Sampling};
+use mcbench_papers::testbeds::gradient_box::GradientBox;
 use rand::Rng;
 
 fn media(c: &mut Criterion) {
@@ -36,7 +36,7 @@ fn media(c: &mut Criterion) {
     let mut r = stream(2, "bench octree");
     while tree.stats().depth < 3 || tree.stats().leaves < 512 {
         let p = Vec3::new(r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5);
-        let st = estimators::cache::St { s: r.gen(), t: r.gen() };
+        let st = mcbench_papers::cache::St { s: r.gen(), t: r.gen() };
         tree.add_record(p, st, Rgb::splat(1.0 + st.t), Rgb::ZERO);
     }
     group.bench_function("octree_lookup_depth3", |b| {
@@ -92,7 +92,7 @@ fn full_octree(depth: u32) -> Octree<f64> {
     while tree.stats().leaves < leaves {
         for _ in 0..4096 {
             let p = Vec3::new(r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5, r.gen::<f64>() - 0.5);
-            let st = estimators::cache::St { s: r.gen(), t: r.gen() };
+            let st = mcbench_papers::cache::St { s: r.gen(), t: r.gen() };
             tree.add_record(p, st, Rgb::splat(1.0 + st.t), Rgb::splat(0.5));
         }
     }

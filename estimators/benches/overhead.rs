@@ -14,22 +14,22 @@
 //!
 //! Times are the CPU time of the bench's thread ([`ThreadCpu`]), not wall time: on a shared machine
 //! the neighbours' load slows the run (and moves the memory-bound vertex more than the others)
-//! but is not counted. Run with `cargo bench -p estimators --bench overhead` (about 20 s of
+//! but is not counted. Run with `cargo bench -p mcbench-papers --bench overhead` (about 20 s of
 //! measurement).
 
 use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkGroup, Criterion, Throughput};
-use estimators::budget::Budget;
-use estimators::cache::{CacheConfig, ControlVariate, Domain, St};
-use estimators::math::{Rgb, Vec3};
-use estimators::media_smc::octree::{self, Octree};
-use estimators::media_smc::walk::{self, Flight, Vertex};
-use estimators::media_smc::{Sampling, Transport};
-use estimators::params::Params;
-use estimators::registry;
-use estimators::rng::stream;
-use estimators::task::{MediumProbe, Task};
-use estimators::testbeds::gradient_box::GradientBox;
+use mcbench_core::budget::Budget;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::task::{MediumProbe, Task};
+use mcbench_papers::builtins;
+use mcbench_papers::cache::{CacheConfig, ControlVariate, Domain, St};
+use mcbench_papers::media_smc::octree::{self, Octree};
+use mcbench_papers::media_smc::walk::{self, Flight, Vertex};
+use mcbench_papers::media_smc::{Sampling, Transport};
+use mcbench_papers::testbeds::gradient_box::GradientBox;
 use rand::Rng;
 use std::time::Duration;
 
@@ -195,13 +195,13 @@ fn media_vertex(c: &mut Criterion<ThreadCpu>) {
 
 fn surface_sample(c: &mut Criterion<ThreadCpu>) {
     const SPP: u64 = 1024;
-    let entry = registry::testbed("gradient-plane").expect("registered");
-    let bed = (entry.build)("default", &Params::new(), &estimators::references::NoReferences).expect("bed");
+    let entry = builtins::testbed("gradient-plane").expect("registered");
+    let bed = (entry.build)("default", &Params::new(), &mcbench_core::references::NoReferences).expect("bed");
     let mut group = c.benchmark_group("overhead_surface_sample");
     short(&mut group);
     group.throughput(Throughput::Elements(SPP));
     for id in ["brdf_is0_cv0", "is1_cv2"] {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let (mut rng, mut i) = (stream(3, id), 0);
         group.bench_function(id, |b| {
             b.iter(|| {
@@ -216,9 +216,9 @@ fn surface_sample(c: &mut Criterion<ThreadCpu>) {
 
 fn smc_frame(c: &mut Criterion<ThreadCpu>) {
     const FRAMES: usize = 10;
-    let entry = registry::testbed("envmap-sequence").expect("registered");
+    let entry = builtins::testbed("envmap-sequence").expect("registered");
     let params = Params::new().with("resolution", 4.0).with("frames", FRAMES as f64);
-    let bed = (entry.build)("mixed", &params, &estimators::references::NoReferences).expect("bed");
+    let bed = (entry.build)("mixed", &params, &mcbench_core::references::NoReferences).expect("bed");
     let budget = Budget::samples(16).expect("budget");
     // The sequence of the pixel at the image centre (integrals are pixel-major, frames inner).
     let first = (2 * 4 + 2) * FRAMES;
@@ -226,7 +226,7 @@ fn smc_frame(c: &mut Criterion<ThreadCpu>) {
     short(&mut group);
     group.throughput(Throughput::Elements(FRAMES as u64));
     for id in ["bidirectional_is", "smc"] {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let mut rng = stream(5, id);
         group.bench_function(id, |b| {
             b.iter(|| {

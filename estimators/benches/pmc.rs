@@ -2,18 +2,18 @@
 //! 8x8 `checker-image` at 10 spp with `pmc_ip` (2+4+4) and `uniform_image` (the pixel samples
 //! dominate both), and the adaptation overhead of one PMC-IP iteration alone (weights from the
 //! pixel statistics plus the DMS allocation) on 48x48 pixels. Run with
-//! `cargo bench -p estimators --bench pmc`.
+//! `cargo bench -p mcbench-papers --bench pmc`.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use estimators::budget::Budget;
-use estimators::params::Params;
-use estimators::pmc::ip::PmcIp;
-use estimators::registry;
-use estimators::rng::stream;
-use estimators::stats::Moments;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
-use estimators::testbeds::checker_image::CheckerImage;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::stats::Moments;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
+use mcbench_papers::pmc::ip::PmcIp;
+use mcbench_papers::testbeds::checker_image::CheckerImage;
 
 fn image(c: &mut Criterion) {
     let bed = CheckerImage::without_reference("occluded", &Params::new().with("resolution", 8.0)).expect("bed");
@@ -21,7 +21,7 @@ fn image(c: &mut Criterion) {
     let mut group = c.benchmark_group("checker_image_8x8_10spp");
     group.throughput(Throughput::Elements(10 * bed.integrals() as u64));
     for id in ["uniform_image", "pmc_ip"] {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let mut rng = stream(1, id);
         group.bench_function(BenchmarkId::from_parameter(id), |b| {
             b.iter(|| {

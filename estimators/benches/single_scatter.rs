@@ -1,17 +1,17 @@
 //! Criterion bench of the single-scatter estimators (paper 002 §4.3): one estimate of a
 //! pixel near the light (4 spp, i.e. 4 primary rays) of `eq21-medium/single-scatter` by each of
 //! the seven ids of Fig. 12, and the nested-quadrature reference of that pixel.
-//! Run with `cargo bench -p estimators --bench single_scatter`.
+//! Run with `cargo bench -p mcbench-papers --bench single_scatter`.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
-use estimators::budget::Budget;
-use estimators::media::scatter_reference::{single_scatter, Settings};
-use estimators::media::{Field, MediumBed};
-use estimators::params::Params;
-use estimators::registry;
-use estimators::rng::stream;
-use estimators::task::Task;
-use estimators::testbed::{MediumQuantity, MediumScene};
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{MediumQuantity, MediumScene};
+use mcbench_papers::builtins;
+use mcbench_papers::testbeds::medium::scatter_reference::{single_scatter, Settings};
+use mcbench_papers::testbeds::medium::{Field, MediumBed};
 
 const IDS: [&str; 7] = [
     "ray_marching",
@@ -29,7 +29,7 @@ fn bench(c: &mut Criterion) {
     let pixel = 3 * 8 + 3;
     let mut group = c.benchmark_group("single_scatter_4spp");
     for id in IDS {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let mut rng = stream(1, id);
         group.bench_function(id, |b| {
             b.iter(|| {

@@ -5,21 +5,21 @@
 //! a `pmc_hi` estimate whose budget is exactly one population of `2 m` samples on
 //! `checker-direct`), and one frame of one pixel of the paper 004 estimators (`bidirectional_is`,
 //! `smc`, `smc_bridge`, `smc_path` at their defaults, N = 16: a 10-frame sequence of one pixel of
-//! `envmap-sequence` `mixed`, reported per frame). Run with `cargo bench -p estimators --bench smc`.
+//! `envmap-sequence` `mixed`, reported per frame). Run with `cargo bench -p mcbench-papers --bench smc`.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use estimators::brdf::Phong;
-use estimators::budget::Budget;
-use estimators::cache::PartialSumTree;
-use estimators::envmap::sky::Sky;
-use estimators::envmap::{EnvFrame, EnvMap};
-use estimators::math::{Rgb, Vec3};
-use estimators::params::Params;
-use estimators::registry;
-use estimators::rng::stream;
-use estimators::smc::mh::{MhKernel, State};
-use estimators::smc::resampling::{normalise_log_weights, resample, Scheme};
-use estimators::task::Task;
+use mcbench_core::brdf::Phong;
+use mcbench_core::budget::Budget;
+use mcbench_core::envmap::{EnvFrame, EnvMap};
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_papers::builtins;
+use mcbench_papers::cache::PartialSumTree;
+use mcbench_papers::envmap_smc::mh::{MhKernel, State};
+use mcbench_papers::envmap_smc::resampling::{normalise_log_weights, resample, Scheme};
+use mcbench_papers::testbeds::sky::Sky;
 use rand::Rng;
 
 fn partial_sum_tree(c: &mut Criterion) {
@@ -79,10 +79,10 @@ fn resampling(c: &mut Criterion) {
 }
 
 fn pmc_hi_iteration(c: &mut Criterion) {
-    let entry = registry::testbed("checker-direct").expect("registered");
-    let bed = (entry.build)("default", &Params::new().with("resolution", 8.0), &estimators::references::NoReferences)
+    let entry = builtins::testbed("checker-direct").expect("registered");
+    let bed = (entry.build)("default", &Params::new().with("resolution", 8.0), &mcbench_core::references::NoReferences)
         .expect("bed");
-    let est = (registry::estimator("pmc_hi").expect("registered").build)(&Params::new()).expect("builds");
+    let est = (builtins::estimator("pmc_hi").expect("registered").build)(&Params::new()).expect("builds");
     // m = lights + 2 mixture components; one population (one iteration) is 2 m samples.
     let m = bed.hemisphere().expect("surface").lights().len() + 2;
     let budget = Budget::samples(2 * m as u64).expect("budget");
@@ -101,16 +101,16 @@ fn pmc_hi_iteration(c: &mut Criterion) {
 
 fn smc_frame(c: &mut Criterion) {
     const FRAMES: usize = 10;
-    let entry = registry::testbed("envmap-sequence").expect("registered");
+    let entry = builtins::testbed("envmap-sequence").expect("registered");
     let params = Params::new().with("resolution", 4.0).with("frames", FRAMES as f64);
-    let bed = (entry.build)("mixed", &params, &estimators::references::NoReferences).expect("bed");
+    let bed = (entry.build)("mixed", &params, &mcbench_core::references::NoReferences).expect("bed");
     let budget = Budget::samples(16).expect("budget");
     // The sequence of the pixel at the image centre (integrals are pixel-major, frames inner).
     let first = (2 * 4 + 2) * FRAMES;
     let mut group = c.benchmark_group("smc_frame_one_pixel");
     group.throughput(Throughput::Elements(FRAMES as u64));
     for id in ["bidirectional_is", "smc", "smc_bridge", "smc_path"] {
-        let est = (registry::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
+        let est = (builtins::estimator(id).expect("registered").build)(&Params::new()).expect("builds");
         let mut rng = stream(5, id);
         group.bench_function(id, |b| {
             b.iter(|| {

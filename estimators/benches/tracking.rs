@@ -9,16 +9,16 @@
 //! loop timed for 0.3 s just before and just after that tracker's bench (their mean), so a change
 //! of machine load during the run does not leak into the ratios. Cheap (approximate-extinction)
 //! fetches are shown apart and are not counted as steps.
-//! Run with `cargo bench -p estimators --bench tracking`.
+//! Run with `cargo bench -p mcbench-papers --bench tracking`.
 
 use criterion::{black_box, Criterion, Throughput};
-use estimators::budget::Budget;
-use estimators::math::Vec3;
-use estimators::params::Params;
-use estimators::registry;
-use estimators::rng::stream;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
+use mcbench_core::budget::Budget;
+use mcbench_core::math::Vec3;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
 use rand::Rng;
 use std::cell::RefCell;
 use std::time::{Duration, Instant};
@@ -56,8 +56,8 @@ impl Tally {
 }
 
 fn bed(id: &str, variant: &str) -> Box<dyn TestBed> {
-    let entry = registry::testbed(id).expect("registered medium");
-    (entry.build)(variant, &Params::new(), &estimators::references::NoReferences).expect("builds")
+    let entry = builtins::testbed(id).expect("registered medium");
+    (entry.build)(variant, &Params::new(), &mcbench_core::references::NoReferences).expect("builds")
 }
 
 /// 1024 random points along the central ray (where the trackers step, so the bare loop and the
@@ -110,7 +110,7 @@ fn bare_fetch(c: &mut Criterion, medium: &str, bed: &dyn TestBed, tally: &mut Ta
 /// One estimate of `RAYS` rays on the last central-ray integral (s = 20).
 fn tracker(c: &mut Criterion, medium: &str, bed: &dyn TestBed, label: &str, id: &str, params: &[(&str, f64)]) -> Tally {
     let params = params.iter().fold(Params::new(), |p, (k, v)| p.with(k, *v));
-    let estimator = (registry::estimator(id).expect("registered").build)(&params).expect("builds");
+    let estimator = (builtins::estimator(id).expect("registered").build)(&params).expect("builds");
     let integral = bed.integrals() - 1;
     let budget = Budget::samples(RAYS).expect("budget");
     let mut rng = stream(11, label);

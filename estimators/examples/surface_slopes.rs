@@ -3,20 +3,20 @@
 //! the fitted log-log slope with its 95% interval, and the mean cache diagnostics per estimate.
 //!
 //! ```text
-//! cargo run --release -p estimators --example surface_slopes -- [variant] [reps] [kmax] [res] [ids...]
-//! cargo run --release -p estimators --example surface_slopes -- long [id] [spp] [variant]
+//! cargo run --release -p mcbench-papers --example surface_slopes -- [variant] [reps] [kmax] [res] [ids...]
+//! cargo run --release -p mcbench-papers --example surface_slopes -- long [id] [spp] [variant]
 //! ```
 //! Defaults: `default 8 6 32 is0_cv0 is1_cv2` (spp 4 .. 4096 on 32x32). `long` runs one estimate
 //! of pixel 0 with a huge budget (default `is1_cv2`, 1e7 samples): the stability case.
 
-use estimators::budget::Budget;
-use estimators::params::Params;
-use estimators::registry;
-use estimators::rng::{stream, StreamKey};
-use estimators::stats::log_log_fit;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
-use estimators::testbeds::gradient_plane::GradientPlane;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_core::rng::{stream, StreamKey};
+use mcbench_core::stats::log_log_fit;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
+use mcbench_papers::testbeds::gradient_plane::GradientPlane;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -34,7 +34,7 @@ fn main() {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!("gradient-plane/{variant} {res}x{res}, {reps} reps, {threads} threads");
     for id in &ids {
-        let est = (registry::estimator(id).expect("id").build)(&Params::new()).expect("build");
+        let est = (builtins::estimator(id).expect("id").build)(&Params::new()).expect("build");
         let (mut spps, mut rmses) = (Vec::new(), Vec::new());
         for k in 1..=kmax {
             let spp = 4u64.pow(k);
@@ -109,7 +109,7 @@ fn long(args: &[String]) {
     let spp: u64 = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(10_000_000);
     let variant = args.get(2).map_or("default", String::as_str);
     let bed = GradientPlane::new(variant, &Params::new().with("resolution", 4.0)).expect("test bed");
-    let est = (registry::estimator(id).expect("id").build)(&Params::new()).expect("build");
+    let est = (builtins::estimator(id).expect("id").build)(&Params::new()).expect("build");
     let start = Instant::now();
     let task = Task::new(&bed, 5, Budget::samples(spp).expect("spp"));
     let v = est.estimate(&task, &mut stream(9, "long")).expect("estimate");

@@ -1,41 +1,31 @@
-//! # estimators
+//! # mcbench-papers
 //!
-//! The library half of `mcbench`, a convergence-study harness for adaptive Monte Carlo rendering
-//! estimators: the plug-in traits ([`testbed::TestBed`], [`estimator::Estimator`],
-//! [`budget::Budget`]), the registries, the analytic test beds with their references, samplers,
-//! the estimator families, and the small statistics the harness and the sampler tests share.
+//! The estimators of five adaptive Monte Carlo rendering papers with their biased controls, and
+//! the test beds they run on, as plug-ins of `mcbench-core`; [`builtins`] lists them all and hands
+//! them to a harness registry as one [`mcbench_core::Catalog`] ([`catalog`]):
+//! `mcbench::Registry::new().with_catalog(mcbench_papers::catalog())`.
+//!
+//! One module per family, named like the experiment that measures it: [`independent`] (the
+//! baseline and the clamped control), [`surface_smc`] (paper 001's adaptive surface estimators
+//! with [`cache`], their radiance cache), [`media_smc`] (paper 000 in a medium), [`tracking`] and
+//! [`single_scatter`] (paper 002's trackers with their moment theory, and its single-scattering
+//! estimators), [`pmc`] (paper 003), [`envmap_smc`] (paper 004); and [`testbeds`], the eight test
+//! beds with their references.
 //!
 //! No I/O, plotting or CLI lives here (that is the `mcbench` crate, in `harness/`).
 #![warn(missing_docs)]
 
-pub mod accumulate;
-pub mod brdf;
-pub mod budget;
+pub mod builtins;
 pub mod cache;
-pub mod envmap;
-pub mod error;
-pub mod estimator;
+pub mod envmap_smc;
 pub mod independent;
-pub mod lighting;
-pub mod math;
-pub mod media;
 pub mod media_smc;
-pub mod memo;
-pub mod parallel;
-pub mod params;
-pub mod perception;
-pub mod phase;
 pub mod pmc;
-pub mod quadrature;
-pub mod references;
-pub mod registry;
-pub mod rng;
-pub mod samplers;
+#[cfg(test)]
+mod repository;
 pub mod single_scatter;
-pub mod smc;
-pub mod smc_surface;
-pub mod stats;
-pub mod task;
-pub mod testbed;
+pub mod surface_smc;
 pub mod testbeds;
 pub mod tracking;
+
+pub use builtins::catalog;

@@ -19,15 +19,15 @@
 //! Run: `cargo run --release -p experiments --example eq21_signatures` (about a minute on two
 //! cores; seed fixed, the same output at any thread count).
 
-use estimators::budget::Budget;
-use estimators::math::Vec3;
-use estimators::media::{density, Field, MediumBed};
-use estimators::params::Params;
-use estimators::references::NoReferences;
-use estimators::registry;
-use estimators::rng::StreamKey;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
+use mcbench_core::budget::Budget;
+use mcbench_core::math::Vec3;
+use mcbench_core::params::Params;
+use mcbench_core::references::NoReferences;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins as registry;
+use mcbench_papers::testbeds::medium::{density, Field, MediumBed};
 use rayon::prelude::*;
 
 /// The two readings of Eq. 21.

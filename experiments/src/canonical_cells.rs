@@ -1,22 +1,22 @@
 //! The per-cell analysis of `canonical-sweep`: for every (profile, target T, estimator, ratio) the
 //! measured mean and variance of one estimate, its cost in fetches, variance x cost, the harness's
 //! unbiasedness verdict (`analysis.rs`: Holm t-tests against the closed form), and the predicted
-//! moments (paper 002 Eq. 16-20 and the higher moments of `estimators::media::moments`), from
+//! moments (paper 002 Eq. 16-20 and the higher moments of `mcbench_papers::tracking::moments`), from
 //! which the error bar of the measured variance and the agreement verdict follow. Pairs that did
 //! not run keep their reason.
 
 use crate::canonical_sweep::{family_of, spec, terminating_min_ratio, FAMILIES, RATIOS};
-use estimators::estimator::Bias;
-use estimators::media::moments::EstimateMoments;
-use estimators::registry;
-use estimators::stats::detectable_shift;
-use estimators::task::Task;
-use estimators::testbeds::canonical_1d::parse_variant;
-use estimators::testbeds::canonical_profiles::Profile;
 use mcbench::claims::decisive_test;
 use mcbench::output::RunReport;
 use mcbench::plan::{Plan, Skipped};
 use mcbench::runner::RunResults;
+use mcbench_core::estimator::Bias;
+use mcbench_core::estimator::EstimateMoments;
+use mcbench_core::stats::detectable_shift;
+use mcbench_core::task::Task;
+use mcbench_papers::builtins;
+use mcbench_papers::testbeds::canonical_1d::parse_variant;
+use mcbench_papers::testbeds::canonical_profiles::Profile;
 
 /// A measured variance is resolved when its predicted error bar (one standard deviation of the
 /// sample variance, from the predicted fourth moment) is at most this fraction of the prediction.
@@ -183,7 +183,7 @@ pub fn z_crit(m: usize) -> f64 {
 /// reason.
 pub fn refused_terminating(plan: &Plan) -> Vec<Skipped> {
     let mut out = Vec::new();
-    let Ok(entry) = registry::estimator("single_particle_terminating") else { return out };
+    let Ok(entry) = builtins::estimator("single_particle_terminating") else { return out };
     if !plan.estimators.iter().any(|e| e.spec.id == entry.id) {
         return out;
     }
@@ -264,7 +264,7 @@ pub fn cell_rows(plan: &Plan, run: &RunResults, report: &RunReport) -> Vec<CellR
             family,
             ratio,
             estimator: s.estimator.clone(),
-            claim: registry::estimator(&spec.id).map_or(Bias::Unbiased, |e| e.bias),
+            claim: builtins::estimator(&spec.id).map_or(Bias::Unbiased, |e| e.bias),
             measured: None,
             predicted: None,
             skipped: Some(s.reason.clone()),

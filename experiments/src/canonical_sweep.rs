@@ -18,8 +18,8 @@
 //! adaptive sigma_samp) and `ray-marching` (the biased control, step 0.5) once per test bed.
 
 use crate::ExperimentDef;
-use estimators::params::{ParamValue, Params};
 use mcbench::config::{EstimatorSpec, Mode};
+use mcbench_core::params::{ParamValue, Params};
 
 /// Sampling density ratios `sigma_samp / max sigma_t`.
 pub const RATIOS: [f64; 8] = [0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 4.0, 8.0];

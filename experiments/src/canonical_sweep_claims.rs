@@ -7,13 +7,13 @@
 use crate::canonical_cells::{Agreement, CellRow, AGREEMENT_ALPHA, RESOLVED_REL_SD};
 use crate::canonical_sweep::FAMILIES;
 use crate::canonical_sweep_post::{short, Analysis};
-use estimators::estimator::Bias;
-use estimators::stats::holm_bonferroni;
-use estimators::testbeds::canonical_1d::{REFERENCE_REL_BOUND, TARGETS};
-use estimators::testbeds::canonical_profiles::Profile;
 use mcbench::analysis::UNBIASEDNESS_ALPHA;
 use mcbench::output::Claim;
 use mcbench::report::sig;
+use mcbench_core::estimator::Bias;
+use mcbench_core::stats::holm_bonferroni;
+use mcbench_papers::testbeds::canonical_1d::{REFERENCE_REL_BOUND, TARGETS};
+use mcbench_papers::testbeds::canonical_profiles::Profile;
 
 const TB: &str = "canonical-1d";
 

@@ -8,11 +8,11 @@ use crate::canonical_cells::{Agreement, CellRow};
 use crate::canonical_sweep::{FAMILIES, RATIOS};
 use crate::canonical_sweep_post::Analysis;
 use crate::canonical_winners::cell_win;
-use estimators::testbeds::canonical_1d::TARGETS;
-use estimators::testbeds::canonical_profiles::Profile;
 use mcbench::error::Result;
 use mcbench::plot::heatmap::{write_heatmap, Fill, HeatCell, HeatFigure, Panel, Scale};
 use mcbench::report::sig;
+use mcbench_papers::testbeds::canonical_1d::TARGETS;
+use mcbench_papers::testbeds::canonical_profiles::Profile;
 use std::path::{Path, PathBuf};
 
 /// Relative variance x cost below this is drawn as an exact (zero-variance) estimator.

@@ -5,13 +5,13 @@
 
 use crate::canonical_cells::{cell_rows, refused_terminating, z_crit, Agreement, CellRow};
 use crate::canonical_sweep::FAMILIES;
-use estimators::budget::BudgetKind;
-use estimators::testbeds::canonical_profiles::Profile;
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::output::RunReport;
 use mcbench::plan::Plan;
 use mcbench::runner::RunResults;
+use mcbench_core::budget::BudgetKind;
+use mcbench_papers::testbeds::canonical_profiles::Profile;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

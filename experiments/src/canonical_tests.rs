@@ -6,14 +6,14 @@ use crate::canonical_cells::{Agreement, CellRow, Measured};
 use crate::canonical_sweep::{family_of, spec, FAMILIES, IDS};
 use crate::canonical_sweep_post::Analysis;
 use crate::canonical_winners::cell_win;
-use estimators::budget::Budget;
-use estimators::estimator::Bias;
-use estimators::media::moments::EstimateMoments;
-use estimators::params::Params;
-use estimators::testbeds::canonical_profiles::Profile;
 use mcbench::config::{Mode, Sweep, TestBedSpec};
 use mcbench::execute::{execute, prepare, ExecOptions};
 use mcbench::runner::Silent;
+use mcbench_core::budget::Budget;
+use mcbench_core::estimator::Bias;
+use mcbench_core::estimator::EstimateMoments;
+use mcbench_core::params::Params;
+use mcbench_papers::testbeds::canonical_profiles::Profile;
 
 fn family(key: &str) -> usize {
     FAMILIES.iter().position(|f| f.key == key).unwrap()

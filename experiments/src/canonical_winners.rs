@@ -9,10 +9,10 @@
 use crate::canonical_cells::{Agreement, CellRow};
 use crate::canonical_sweep::{FAMILIES, RATIOS};
 use crate::canonical_sweep_post::{short, Analysis};
-use estimators::estimator::Bias;
-use estimators::testbeds::canonical_1d::TARGETS;
-use estimators::testbeds::canonical_profiles::Profile;
 use mcbench::report::{markdown_table, md_text, sig};
+use mcbench_core::estimator::Bias;
+use mcbench_papers::testbeds::canonical_1d::TARGETS;
+use mcbench_papers::testbeds::canonical_profiles::Profile;
 use serde::Serialize;
 
 /// Whether a family subtracts a control variate (explorer fetches; exact on some profiles).

@@ -19,9 +19,6 @@ use crate::{envmap_smc_post, ExperimentDef};
 use mcbench::config::Mode;
 use mcbench::output::{Claim, RunReport};
 
-/// Every id the experiment runs.
-pub const IDS: &[&str] = &["bidirectional_is", "smc", "smc_bridge", "smc_path", "smc_adaptive", "bidirectional_is_sn"];
-
 /// Particles per pixel and frame (the paper's N).
 pub const N: u64 = 16;
 

@@ -7,14 +7,14 @@
 //! estimate); `smc_path` (exponentiated log) and `smc_adaptive` (particle-dependent schedule) only
 //! consistent; `bidirectional_is_sn` is the biased control and must be flagged.
 
-use estimators::budget::Budget;
-use estimators::params::Params;
-use estimators::rng::StreamKey;
-use estimators::task::Task;
 use mcbench::analysis::{unbiasedness, TestRow};
 use mcbench::config::Mode;
 use mcbench::error::Result;
 use mcbench::registry::Registry;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
 use rayon::prelude::*;
 
 /// (estimator id, its parameters) checked.
@@ -67,7 +67,7 @@ pub fn check(mode: Mode, seed: u64, registry: &Registry) -> Result<Vec<TestRow>>
                                     Task::new(
                                         bed.as_ref(),
                                         i,
-                                        Budget { kind: estimators::budget::BudgetKind::Samples, amount: n },
+                                        Budget { kind: mcbench_core::budget::BudgetKind::Samples, amount: n },
                                     )
                                 })
                                 .collect();
@@ -90,7 +90,7 @@ pub fn check(mode: Mode, seed: u64, registry: &Registry) -> Result<Vec<TestRow>>
             for mut row in unbiasedness(&cell, reference, entry.bias, Some(&gate), DEDICATED_TOLERANCE) {
                 row.test.push_str("_dedicated");
                 // The self-normalised control is only biased for L_r; its L_ns estimate is unbiased.
-                if entry.bias == estimators::estimator::Bias::Biased && variant.ends_with("-lns") {
+                if entry.bias == mcbench_core::estimator::Bias::Biased && variant.ends_with("-lns") {
                     row.agrees = true;
                 }
                 rows.push(row);

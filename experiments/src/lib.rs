@@ -66,30 +66,56 @@ impl ExperimentDef {
     }
 }
 
-/// Every experiment, in the order the default suite runs them.
-pub static EXPERIMENTS: &[&ExperimentDef] = &[
-    &surface_smc::DEF,
-    &media_smc::DEF,
-    &transmittance::DEF,
-    &particle_sweep::DEF,
-    &pmc_hi::DEF,
-    &pmc_ip::DEF,
-    &envmap_smc::DEF,
-    &single_scatter::DEF,
-    &canonical_sweep::DEF,
-    &stability::DEF,
+/// One step of the default suite: an experiment file of this crate, or the harness's
+/// `unbiasedness`, which runs over every registered estimator.
+pub enum Step {
+    /// An experiment of the suite.
+    Paper(&'static ExperimentDef),
+    /// The harness's `unbiasedness` experiment.
+    Unbiasedness,
+}
+
+impl Step {
+    /// The harness's experiment.
+    pub fn experiment(&self) -> Experiment {
+        match self {
+            Step::Paper(d) => d.experiment(),
+            Step::Unbiasedness => mcbench::unbiasedness::experiment(),
+        }
+    }
+}
+
+/// The default suite, in the order it runs.
+pub static SUITE: &[Step] = &[
+    Step::Paper(&surface_smc::DEF),
+    Step::Paper(&media_smc::DEF),
+    Step::Paper(&transmittance::DEF),
+    Step::Paper(&particle_sweep::DEF),
+    Step::Paper(&pmc_hi::DEF),
+    Step::Paper(&pmc_ip::DEF),
+    Step::Paper(&envmap_smc::DEF),
+    Step::Paper(&single_scatter::DEF),
+    Step::Paper(&canonical_sweep::DEF),
+    Step::Unbiasedness,
+    Step::Paper(&stability::DEF),
 ];
 
-/// The built-in estimators and test beds with every experiment of the suite, in the order the
-/// default suite runs them (the harness's `unbiasedness` before `stability`), and the harness's
-/// `calibration` and the suite's `sensitivity`, which run only when named: what the `mcbench`
-/// binary runs.
+/// Every experiment file of the suite, in suite order.
+pub fn experiment_files() -> impl Iterator<Item = &'static ExperimentDef> {
+    SUITE.iter().filter_map(|s| match s {
+        Step::Paper(d) => Some(*d),
+        Step::Unbiasedness => None,
+    })
+}
+
+/// The built-in estimators and test beds ([`mcbench_papers::catalog`]) with the default suite
+/// ([`SUITE`]), and the harness's `calibration` and the suite's `sensitivity`, which run only when
+/// named: what the `mcbench` binary runs.
 pub fn registry() -> Registry {
-    let (papers, last) = EXPERIMENTS.split_at(EXPERIMENTS.len() - 1);
-    let r = papers.iter().fold(Registry::builtin().without_experiments(), |r, d| r.with_experiment(d.experiment()));
-    let r = r.with_experiment(mcbench::unbiasedness::experiment());
-    let r = last.iter().fold(r, |r, d| r.with_experiment(d.experiment()));
-    r.with_experiment_on_demand(mcbench::calibration::experiment())
+    SUITE
+        .iter()
+        .fold(Registry::empty().with_catalog(mcbench_papers::catalog()), |r, s| r.with_experiment(s.experiment()))
+        .with_experiment_on_demand(mcbench::calibration::experiment())
         .with_experiment_on_demand(sensitivity::experiment())
         .with_display_names(names::DISPLAY)
 }
@@ -109,7 +135,7 @@ mod tests {
     /// Every experiment file parses and gives valid sweeps in both modes.
     #[test]
     fn every_experiment_file_parses() {
-        for d in super::EXPERIMENTS {
+        for d in super::experiment_files() {
             let e = mcbench::declare::experiment(d.toml, d.claims, d.post).expect("parses");
             assert!(!e.name.is_empty());
         }
@@ -126,7 +152,7 @@ mod tests {
         use mcbench::config::Mode;
         let registry = super::test_registry();
         let mut judged = 0;
-        for d in super::EXPERIMENTS {
+        for d in super::experiment_files() {
             let file = mcbench::declare::ExperimentFile::parse(d.toml).expect("parses");
             let quick = file.sweep(Mode::Quick).expect("quick sweep");
             for mode in [Mode::Quick, Mode::Full] {

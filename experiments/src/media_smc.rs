@@ -7,12 +7,6 @@
 
 use crate::ExperimentDef;
 
-/// Every id the experiment runs.
-pub const IDS: &[&str] = &["is0_cv0", "is0_cv1", "is0_cv2", "is1_cv0", "is1_cv1", "is1_cv2", "rm_is1_cv2"];
-
-/// The albedo variants (paper 000 Fig. 3, left to right).
-pub const VARIANTS: &[&str] = &["albedo-1", "albedo-0.8", "albedo-0.5"];
-
 /// Definition.
 pub static DEF: ExperimentDef =
     ExperimentDef { toml: include_str!("media_smc.toml"), claims: None, post: Some(crate::media_smc_post::post) };

@@ -144,7 +144,7 @@ mod tests {
 
     #[test]
     fn every_registered_estimator_has_a_name() {
-        for e in estimators::registry::ESTIMATORS {
+        for e in mcbench_papers::builtins::ESTIMATORS {
             assert!(estimator(e.id).is_some(), "{} has no display name", e.id);
         }
     }
@@ -158,7 +158,7 @@ mod tests {
             Some("canonical 1D segment, linear-up profile, T = 0.5")
         );
         assert_eq!(testbed("somewhere", "default"), None);
-        for bed in estimators::registry::TESTBEDS {
+        for bed in mcbench_papers::builtins::TESTBEDS {
             assert!(testbed(bed.id, "default").is_some(), "{} has no display name", bed.id);
         }
     }

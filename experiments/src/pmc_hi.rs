@@ -5,9 +5,6 @@
 
 use crate::ExperimentDef;
 
-/// Every id the experiment runs.
-pub const IDS: &[&str] = &["mis", "pmc_hi", "pmc_hi_feedback", "clamped_is0_cv0"];
-
 /// Definition.
 pub static DEF: ExperimentDef =
     ExperimentDef { toml: include_str!("pmc_hi.toml"), claims: None, post: Some(crate::pmc_hi_post::post) };

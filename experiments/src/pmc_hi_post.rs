@@ -5,15 +5,15 @@
 //! (the paper's "16 total samples per estimate", two populations of 8), as maps (bright = high
 //! weight) and in `alpha_maps.csv`.
 
-use estimators::budget::Budget;
-use estimators::rng::StreamKey;
-use estimators::task::Task;
 use mcbench::error::{HarnessError, Result};
 use mcbench::folder::OutputDir;
 use mcbench::output::RunReport;
 use mcbench::plan::Plan;
 use mcbench::plot::maps::{write_maps, Map, Scale};
 use mcbench::runner::RunResults;
+use mcbench_core::budget::Budget;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

@@ -8,9 +8,6 @@ use crate::{pmc_ip_post, ExperimentDef};
 use mcbench::metrics::SummaryRow;
 use mcbench::output::{Claim, RunReport};
 
-/// Every id the experiment runs.
-pub const IDS: &[&str] = &["uniform_image", "pmc_ip", "threshold_image"];
-
 /// The name of PMC-IP 4+6+6 (the initial image takes 4 spp).
 pub const PMC_IP_4: &str = "pmc_ip[initial=4]";
 

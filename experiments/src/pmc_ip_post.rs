@@ -7,17 +7,17 @@
 //! run's repetitions (`pixels.csv` holds the same per pixel).
 
 use crate::pmc_ip::{row, PMC_IP_4};
-use estimators::budget::Budget;
-use estimators::math::Rgb;
-use estimators::pmc::ip::{image_probes, PmcIp, Trace};
-use estimators::rng::StreamKey;
-use estimators::task::Task;
 use mcbench::error::{HarnessError, Result};
 use mcbench::folder::OutputDir;
 use mcbench::output::RunReport;
 use mcbench::plan::{Plan, PreparedBed};
 use mcbench::plot::maps::{write_maps, Map, Scale};
 use mcbench::runner::RunResults;
+use mcbench_core::budget::Budget;
+use mcbench_core::math::Rgb;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::Task;
+use mcbench_papers::pmc::ip::{image_probes, PmcIp, Trace};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -170,8 +170,8 @@ fn one_run(plan: &Plan, bed: &PreparedBed, ip: &PmcIp, budget: u64) -> Result<(T
     let (probes, spp) = image_probes(&tasks, "pmc_ip").map_err(|e| HarnessError::write("pmc-ip maps", e))?;
     let trace = ip.run(&probes, spp, &mut key("pmc_ip/fig4").rng());
     let tasks: Vec<Task<'_>> = (0..n).map(|i| Task::new(bed.bed.as_ref(), i, b)).collect();
-    let uniform = estimators::pmc::uniform_image::UniformImage;
-    let image = estimators::estimator::Estimator::estimate_sequence(&uniform, &tasks, &mut key("uniform/fig4").rng())
+    let uniform = mcbench_papers::pmc::uniform_image::UniformImage;
+    let image = mcbench_core::estimator::Estimator::estimate_sequence(&uniform, &tasks, &mut key("uniform/fig4").rng())
         .map_err(|e| HarnessError::write("pmc-ip maps", e))?;
     Ok((trace, image))
 }

@@ -11,18 +11,15 @@
 use crate::stability_cases::{self as sc, CaseFile, Expect, Outcome};
 use crate::stability_numeric::{self as num, Sequence};
 use crate::ExperimentDef;
-use estimators::params::Params;
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::guarded::one_line;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::runner::RunResults;
+use mcbench_core::params::Params;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
-
-/// Ids of the harness sweep (the post hook names its own).
-pub const IDS: &[&str] = &["is0_cv0", "is1_cv2"];
 
 /// Definition.
 pub static DEF: ExperimentDef = ExperimentDef { toml: include_str!("stability.toml"), claims: None, post: Some(post) };
@@ -57,8 +54,8 @@ fn numeric_cases() -> Vec<(&'static str, &'static str, Expect, Outcome)> {
 fn params_text(p: &Params) -> String {
     p.0.iter()
         .map(|(k, v)| match v {
-            estimators::params::ParamValue::Number(x) => format!("{k}={x}"),
-            estimators::params::ParamValue::Text(t) => format!("{k}={t}"),
+            mcbench_core::params::ParamValue::Number(x) => format!("{k}={x}"),
+            mcbench_core::params::ParamValue::Text(t) => format!("{k}={t}"),
         })
         .collect::<Vec<_>>()
         .join(";")

@@ -14,19 +14,19 @@
 //! The cases themselves, and the table of places where a pdf can be zero, are data:
 //! `stability_cases.toml` beside this file, embedded and read by [`CaseFile::load`].
 
-use estimators::budget::Budget;
-use estimators::error::EstimateError;
-use estimators::params::Params;
-use estimators::rng::StreamKey;
-use estimators::stats::Moments;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
 use mcbench::analysis::unbiasedness;
 use mcbench::claims::decisive_test;
 use mcbench::config::Mode;
 use mcbench::error::HarnessError;
 use mcbench::guarded::{self, one_line, Stopped};
 use mcbench::registry::Registry;
+use mcbench_core::budget::Budget;
+use mcbench_core::error::EstimateError;
+use mcbench_core::params::Params;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::stats::Moments;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -155,7 +155,7 @@ impl Outcome {
 
 /// One repetition's estimates of every integral, or the error that stopped it.
 fn one_rep(
-    est: &dyn estimators::estimator::Estimator,
+    est: &dyn mcbench_core::estimator::Estimator,
     bed: &dyn TestBed,
     case: &Case,
     seed: u64,
@@ -228,7 +228,7 @@ fn run_inner(case: &Case, seed: u64, registry: &Registry) -> Outcome {
     let n = bed.integrals();
     let per_rep: Vec<Vec<[f64; 3]>> = reps.into_iter().flatten().collect();
     let budget =
-        Budget::samples(case.samples).unwrap_or(Budget { kind: estimators::budget::BudgetKind::Samples, amount: 1 });
+        Budget::samples(case.samples).unwrap_or(Budget { kind: mcbench_core::budget::BudgetKind::Samples, amount: 1 });
     let cell = guarded::cell_of(bed.as_ref(), &case.estimator, budget, seed, &per_rep);
     let moments = &cell.moments;
     if moments.iter().flatten().any(|m| !m.mean().is_finite()) {
@@ -253,7 +253,7 @@ fn run_inner(case: &Case, seed: u64, registry: &Registry) -> Outcome {
         est_entry.bias.name()
     );
     let correct = match est_entry.bias {
-        estimators::estimator::Bias::Unbiased => t.verdict != "biased",
+        mcbench_core::estimator::Bias::Unbiased => t.verdict != "biased",
         _ => t.agrees,
     };
     Outcome {
@@ -267,14 +267,14 @@ fn run_inner(case: &Case, seed: u64, registry: &Registry) -> Outcome {
 }
 
 /// Where the estimator knows the exact variance of one sample on every integral (paper 002 §3.4
-/// trackers, [`estimators::estimator::Estimator::sample_moments`]), the error bars come from it: a
+/// trackers, [`mcbench_core::estimator::Estimator::sample_moments`]), the error bars come from it: a
 /// z-test of the summed deviation over the integrals (channel 0) against the exact standard error.
 /// This is the only honest test for a rare-event configuration such as `sigma_samp = 1e-6 x
 /// sigma_t`, whose collisions (weight `1 - r ~ -1e6`) a few hundred repetitions never see, so their
 /// sample variance is 0 and a sample-based test would call an unbiased estimator biased. `None`
 /// when any integral lacks exact moments or its variance is not finite.
 fn exact_moments_test(
-    est: &dyn estimators::estimator::Estimator,
+    est: &dyn mcbench_core::estimator::Estimator,
     bed: &dyn TestBed,
     case: &Case,
     moments: &[[Moments; 3]],
@@ -292,7 +292,7 @@ fn exact_moments_test(
         reference += r;
         var += v / (case.samples * case.reps) as f64;
     }
-    let t = estimators::stats::z_test(reference + dev, var.sqrt(), reference);
+    let t = mcbench_core::stats::z_test(reference + dev, var.sqrt(), reference);
     let agrees = t.p_value >= mcbench::analysis::UNBIASEDNESS_ALPHA
         || (var == 0.0 && dev.abs() <= 1e-12 * reference.abs().max(1e-300));
     Some(Outcome {
@@ -313,11 +313,11 @@ fn exact_moments_test(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use estimators::math::Rgb;
-    use estimators::rng::StreamRng;
+    use mcbench_core::math::Rgb;
+    use mcbench_core::rng::StreamRng;
 
     struct Panics;
-    impl estimators::estimator::Estimator for Panics {
+    impl mcbench_core::estimator::Estimator for Panics {
         fn estimate(&self, _: &Task<'_>, _: &mut StreamRng) -> Result<Rgb, EstimateError> {
             panic!("boom\nsecond line")
         }
@@ -360,20 +360,33 @@ mod tests {
 
     #[test]
     fn outcomes_are_correct_refused_or_failed_never_a_panic() {
-        let ok = run(&case("delta_tracking", Params::new(), Expect::Correct), 1, &Registry::builtin());
+        let ok = run(
+            &case("delta_tracking", Params::new(), Expect::Correct),
+            1,
+            &Registry::new().with_catalog(mcbench_papers::catalog()),
+        );
         assert_eq!(ok.outcome, "correct", "{ok:?}");
         // Optical depth ln 2 (the default of constant-T0.5): r = 1e6 > 2/(a+1), the model refuses.
         let terminating = Case {
             bed: Params::new(),
             ..case("single_particle_terminating", Params::new().with("sigma_samp_ratio", 1e-6), Expect::Refused)
         };
-        let refused = run(&terminating, 1, &Registry::builtin());
+        let refused = run(&terminating, 1, &Registry::new().with_catalog(mcbench_papers::catalog()));
         assert!(refused.outcome == "refused" && refused.text.contains("sigma_samp"), "{refused:?}");
-        let unknown = run(&case("no_such_estimator", Params::new(), Expect::Refused), 1, &Registry::builtin());
+        let unknown = run(
+            &case("no_such_estimator", Params::new(), Expect::Refused),
+            1,
+            &Registry::new().with_catalog(mcbench_papers::catalog()),
+        );
         assert!(unknown.outcome == "refused" && unknown.text.contains("no_such_estimator"), "{unknown:?}");
         // A panicking estimator is caught and reported in one line.
         let c = case("delta_tracking", Params::new(), Expect::Correct);
-        let bed = Registry::builtin().test_bed("canonical-1d").unwrap().build_exact(&c.variant, &c.bed).unwrap();
+        let bed = Registry::new()
+            .with_catalog(mcbench_papers::catalog())
+            .test_bed("canonical-1d")
+            .unwrap()
+            .build_exact(&c.variant, &c.bed)
+            .unwrap();
         let err = one_rep(&Panics, bed.as_ref(), &c, 1, 0).unwrap_err();
         assert_eq!(err, "panic: boom");
     }

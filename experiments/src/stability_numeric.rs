@@ -7,12 +7,12 @@
 //! count at the end.
 
 use crate::stability_cases::Outcome;
-use estimators::accumulate::RgbMean;
-use estimators::cache::domain::Domain;
-use estimators::cache::grid::Grid;
-use estimators::math::Rgb;
-use estimators::smc::resampling::{effective_sample_size, normalise_log_weights};
-use estimators::stats::Moments;
+use mcbench_core::accumulate::RgbMean;
+use mcbench_core::math::Rgb;
+use mcbench_core::stats::Moments;
+use mcbench_papers::cache::domain::Domain;
+use mcbench_papers::cache::grid::Grid;
+use mcbench_papers::envmap_smc::resampling::{effective_sample_size, normalise_log_weights};
 
 /// The relative drift a running mean of 1e8 values may show (book: stability.md).
 pub const MEAN_DRIFT_LIMIT: f64 = 1e-12;

@@ -7,14 +7,14 @@
 //! markers, Eq. 16's prediction dashed.
 
 use crate::variance_claims::{build, central_ray, measure, Measured, CASES};
-use estimators::math::Vec3;
-use estimators::media::variance::predicted;
 use mcbench::error::Result;
 use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::plot::{write_panels, Figure, Key, Line, Panels, Series};
 use mcbench::runner::RunResults;
+use mcbench_core::math::Vec3;
+use mcbench_papers::tracking::variance::predicted;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

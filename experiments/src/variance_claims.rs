@@ -2,18 +2,18 @@
 //! estimates of T(s) at s = 5 and 10, 20000 rays per point; held when the measured variance is
 //! within 4 standard errors (from the sample fourth moment) of the prediction.
 
-use estimators::budget::Budget;
-use estimators::estimator::Estimator;
-use estimators::math::Vec3;
-use estimators::media::variance::{predicted, Model};
-use estimators::media::{Field, MediumBed};
-use estimators::params::Params;
-use estimators::registry;
-use estimators::rng::stream;
-use estimators::stats::Moments;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
 use mcbench::output::Claim;
+use mcbench_core::budget::Budget;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::Vec3;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::stats::Moments;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
+use mcbench_papers::builtins;
+use mcbench_papers::testbeds::medium::{Field, MediumBed};
+use mcbench_papers::tracking::variance::{predicted, Model};
 
 /// Albedo of the eq21 medium (the non-terminating model's `w` depends on it).
 const ALBEDO: f64 = 0.7;
@@ -44,7 +44,7 @@ pub fn measure(est: &dyn Estimator, bed: &dyn TestBed, k: usize, n: usize, seed:
     let mut xs = Vec::with_capacity(n);
     let mut m = Moments::default();
     for _ in 0..n {
-        let task = Task::new(bed, k, Budget { kind: estimators::budget::BudgetKind::Samples, amount: 1 });
+        let task = Task::new(bed, k, Budget { kind: mcbench_core::budget::BudgetKind::Samples, amount: 1 });
         let x = est.estimate(&task, &mut rng).map(|v| v[0]).unwrap_or(f64::NAN);
         m.push(x);
         xs.push(x);
@@ -71,7 +71,7 @@ pub fn central_ray(points: usize) -> Option<(MediumBed, Vec<f64>)> {
         Field::Eq21,
         "central-ray",
         &Params::new().with("points", points as f64),
-        &estimators::references::NoReferences,
+        &mcbench_core::references::NoReferences,
     )
     .ok()?;
     let grid: Vec<f64> = (0..points).filter_map(|k| bed.medium().map(|m| m.ray(k).length)).collect();
@@ -80,7 +80,7 @@ pub fn central_ray(points: usize) -> Option<(MediumBed, Vec<f64>)> {
 
 /// Builds the estimator of a case (None when the id is not registered).
 pub fn build(id: &str, samp: f64) -> Option<Box<dyn Estimator>> {
-    registry::estimator(id).and_then(|e| (e.build)(&Params::new().with("sigma_samp", samp))).ok()
+    builtins::estimator(id).and_then(|e| (e.build)(&Params::new().with("sigma_samp", samp))).ok()
 }
 
 /// The Eq. 16 claims.

@@ -12,14 +12,14 @@
 //! `resolution` pixels (default 8); `case` is `default`, `stiff` or `all` (default). Seeds are
 //! `first seed` (default 1) and the `seeds - 1` (default 199) after it; everything is deterministic.
 
-use estimators::params::Params;
-use estimators::stats::log_log_fit;
 use mcbench::analysis::{fits, RIGHT_END_BUDGETS};
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::metrics::SummaryRow;
 use mcbench::plan::Plan;
 use mcbench::registry::Registry;
 use mcbench::runner::{run, RunOptions, Silent};
+use mcbench_core::params::Params;
+use mcbench_core::stats::log_log_fit;
 
 const TRUE_SLOPE: f64 = -0.5;
 
@@ -95,7 +95,7 @@ fn main() {
     let resolution: f64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(8.0);
     let only: Option<String> = args.next().filter(|o| o != "all");
     let first: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(1);
-    let registry = Registry::builtin();
+    let registry = Registry::new().with_catalog(mcbench_papers::catalog());
     println!("| case | fit | method | seeds | covers -0.5 | mean slope | mean width |");
     println!("|---|---|---|---|---|---|---|");
     for (variant, reps) in [("default", 16), ("stiff", 8)] {

@@ -5,8 +5,8 @@
 use crate::error::Result;
 use crate::plan::Plan;
 use crate::runner::{run_sequence, CellRun, Item, PILOT_REP};
-use estimators::budget::Budget;
-use estimators::task::FETCH_BUDGET_SAMPLE_CAP;
+use mcbench_core::budget::Budget;
+use mcbench_core::task::FETCH_BUDGET_SAMPLE_CAP;
 use rayon::prelude::*;
 
 /// At most this many sequences run in a pilot.

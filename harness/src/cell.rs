@@ -6,9 +6,9 @@
 //! resampling needs: the intervals of ratio claims are a bootstrap over them
 //! ([`crate::claims::bootstrap`]).
 
-use estimators::budget::Budget;
-use estimators::stats::Moments;
-use estimators::task::Costs;
+use mcbench_core::budget::Budget;
+use mcbench_core::stats::Moments;
+use mcbench_core::task::Costs;
 use serde::{Deserialize, Serialize};
 
 /// What identifies a cell's result: equal keys give equal results.
@@ -49,7 +49,7 @@ impl CellKey {
             clean(&self.estimator),
             self.budget.kind.name(),
             self.budget.amount,
-            estimators::rng::fnv1a(&text)
+            mcbench_core::rng::fnv1a(&text)
         )
     }
 }
@@ -165,7 +165,7 @@ impl RepBlock {
         self.p_err += o.p_err;
         self.cpu_seconds += o.cpu_seconds;
         self.wall_seconds += o.wall_seconds;
-        crate::runner::add_costs(&mut self.costs, &o.costs);
+        self.costs += o.costs;
     }
 }
 

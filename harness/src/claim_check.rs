@@ -301,8 +301,8 @@ fn one_line(text: &str) -> String {
 
 /// The error of the claim at `index` of a sweep, as bad input: one line naming the claim, its
 /// text and the field.
-pub fn config_error(index: usize, claim: &ClaimSpec, e: ClaimError) -> estimators::error::ConfigError {
-    estimators::error::ConfigError::invalid(
+pub fn config_error(index: usize, claim: &ClaimSpec, e: ClaimError) -> mcbench_core::error::ConfigError {
+    mcbench_core::error::ConfigError::invalid(
         format!("claims[{index}].{}", e.field),
         one_line(&e.value),
         one_line(&format!("{} (the claim: {})", e.problem, claim.describe())),

@@ -11,7 +11,7 @@ use crate::progress::Progress;
 use crate::registry::Registry;
 use crate::shard::ShardSpec;
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use estimators::params::Params;
+use mcbench_core::params::Params;
 use std::ffi::OsString;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -195,7 +195,7 @@ impl RunArgs {
 ///
 /// ```no_run
 /// // The whole body of `main`:
-/// std::process::exit(mcbench::cli::main_with(mcbench::Registry::builtin()));
+/// std::process::exit(mcbench::cli::main_with(mcbench::Registry::new().with_catalog(mcbench_papers::catalog())));
 /// ```
 pub fn main_with(registry: Registry) -> i32 {
     main_with_args(registry, std::env::args_os())
@@ -240,7 +240,7 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
         None => {
             let names: Vec<String> = registry.suite().map(|e| e.name.clone()).collect();
             if names.is_empty() {
-                return Err(estimators::error::ConfigError::invalid(
+                return Err(mcbench_core::error::ConfigError::invalid(
                     "experiment",
                     "(none)",
                     "this binary registers no named experiment: use `run --config FILE`",
@@ -300,7 +300,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     let mut plans = Vec::new();
     if names.is_empty() {
         let file = file.ok_or_else(|| {
-            estimators::error::ConfigError::invalid(
+            mcbench_core::error::ConfigError::invalid(
                 "experiment",
                 "(none)",
                 format!("name one (valid: {}) or give --config", valid_experiments(registry)),
@@ -397,7 +397,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
 /// `e` naming the `--config` file when it is about a claim and the claims came from that file.
 fn in_config(e: HarnessError, args: &RunArgs, file_claims: bool) -> HarnessError {
     match (&e, args.config.as_deref()) {
-        (HarnessError::Config(estimators::error::ConfigError::InvalidValue { field, .. }), Some(path))
+        (HarnessError::Config(mcbench_core::error::ConfigError::InvalidValue { field, .. }), Some(path))
             if file_claims && field.starts_with("claims[") =>
         {
             HarnessError::bad_file(path, e)
@@ -409,7 +409,7 @@ fn in_config(e: HarnessError, args: &RunArgs, file_claims: bool) -> HarnessError
 /// `mcbench conformance`: every check on the named estimators (all when none is named); one line
 /// per estimator, the failures below it.
 fn conformance(ids: &[String], registry: &Registry) -> Result<()> {
-    let entries: Vec<&estimators::registry::EstimatorEntry> = if ids.is_empty() {
+    let entries: Vec<&mcbench_core::entry::EstimatorEntry> = if ids.is_empty() {
         registry.estimators().to_vec()
     } else {
         ids.iter().map(|id| registry.estimator(id)).collect::<std::result::Result<_, _>>()?
@@ -488,10 +488,10 @@ fn reference(args: ReferenceArgs, registry: &Registry) -> Result<()> {
     let made = crate::references::make(entry, &variant, &params, args.samples, &folder, args.wait)?;
     let r = &made.stored.reference;
     let kind = match &r.kind {
-        estimators::testbed::ReferenceKind::Exact { method, bound } => {
+        mcbench_core::testbed::ReferenceKind::Exact { method, bound } => {
             format!("exact: {method}; absolute error bound {bound:.3e}")
         }
-        estimators::testbed::ReferenceKind::Stored { command, samples } => {
+        mcbench_core::testbed::ReferenceKind::Stored { command, samples } => {
             format!("stored: `{command}`, {samples} samples per value")
         }
     };
@@ -510,11 +510,11 @@ fn param_pairs(pairs: &[String]) -> Result<Params> {
     let mut p = Params::new();
     for pair in pairs {
         let (k, v) = pair.split_once('=').ok_or_else(|| {
-            estimators::error::ConfigError::invalid("--param", pair, "must be key=value (e.g. --param resolution=8)")
+            mcbench_core::error::ConfigError::invalid("--param", pair, "must be key=value (e.g. --param resolution=8)")
         })?;
         let value = match v.trim().parse::<f64>() {
-            Ok(x) => estimators::params::ParamValue::Number(x),
-            Err(_) => estimators::params::ParamValue::Text(v.trim().to_string()),
+            Ok(x) => mcbench_core::params::ParamValue::Number(x),
+            Err(_) => mcbench_core::params::ParamValue::Text(v.trim().to_string()),
         };
         p.0.insert(k.trim().to_string(), value);
     }

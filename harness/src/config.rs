@@ -20,9 +20,9 @@
 use crate::claim_spec::ClaimSpec;
 pub use crate::cost_model::CostModel;
 use crate::error::{HarnessError, Result};
-use estimators::budget::{Budget, BudgetKind};
-use estimators::error::ConfigError;
-use estimators::params::{ParamValue, Params};
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::{ParamValue, Params};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 

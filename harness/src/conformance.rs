@@ -4,14 +4,14 @@
 //!
 //! 1. **builds** with its default parameters;
 //! 2. **finite output on the stability cases** (book: stability.md) it runs on (the `Stability` cases the test
-//!    beds declare, [`estimators::registry::BedCase`]: albedo 1 and 0, optical depth 1e4 and 0,
+//!    beds declare, [`mcbench_core::entry::BedCase`]: albedo 1 and 0, optical depth 1e4 and 0,
 //!    rays missing the medium, Phong n = 10000, an environment of dynamic range 1e6, mostly
 //!    occluded lights): every estimate finite or a clean one-line
 //!    refusal, never a panic, a NaN or an infinity; a validation error must be one line;
 //! 3. **determinism**: the same stream key gives the same bits twice;
 //! 4. **chi-square of its samplers**: the samplers its registry entry names
-//!    ([`estimators::registry::EstimatorEntry::samplers`]) are registered in
-//!    [`estimators::samplers::registry`] and pass their checks at the Sidak family level;
+//!    ([`mcbench_core::entry::EstimatorEntry::samplers`]) are registered in
+//!    [`mcbench_core::samplers::registry`] and pass their checks at the Sidak family level;
 //! 5. **unbiasedness at a small budget** (estimators whose bias claim is `unbiased`): on every small
 //!    case it runs on (the `Check` cases the test beds declare), 4 samples per estimate, the
 //!    harness's own test ([`crate::analysis::unbiasedness`], deciding test as in the claims; about
@@ -19,7 +19,7 @@
 //!    not flag it. The same check must flag the known-biased control `clamped_is0_cv0`
 //!    (`tests/conformance.rs` asserts that), so it has teeth;
 //! 6. **independence** (estimators that declare
-//!    [`estimators::estimator::Estimator::integrals_independent`]): on the first bed with sequences
+//!    [`mcbench_core::estimator::Estimator::integrals_independent`]): on the first bed with sequences
 //!    longer than one integral, the sequence estimated at once equals its tasks estimated one by
 //!    one from the same stream (no state carried from task to task).
 
@@ -28,16 +28,16 @@ use crate::cell::CellResult;
 use crate::claims::decisive_test;
 use crate::guarded::{self, Stopped};
 use crate::registry::Registry;
-use estimators::budget::Budget;
-use estimators::error::ConfigError;
-use estimators::error::EstimateError;
-use estimators::estimator::{Bias, Estimator};
-use estimators::params::Params;
-use estimators::registry::{CaseRole, EstimatorEntry};
-use estimators::rng::StreamKey;
-use estimators::samplers::registry as samplers;
-use estimators::samplers::testing::sampler_alpha;
-use estimators::testbed::TestBed;
+use mcbench_core::budget::Budget;
+use mcbench_core::entry::{CaseRole, EstimatorEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::params::Params;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::samplers::registry as samplers;
+use mcbench_core::samplers::testing::sampler_alpha;
+use mcbench_core::testbed::TestBed;
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -61,7 +61,7 @@ impl std::fmt::Display for Failure {
 type Beds = Vec<(String, Box<dyn TestBed>)>;
 
 /// The test beds of the suite, built once: every registered test bed's declared cases
-/// ([`estimators::registry::BedCase`]) of the roles `Stability` and `Check`.
+/// ([`mcbench_core::entry::BedCase`]) of the roles `Stability` and `Check`.
 pub struct Conformance {
     stability: Beds,
     check: Beds,
@@ -219,8 +219,8 @@ fn independence<'a>(
     let budget = Budget::samples(4).ok()?;
     let key = StreamKey { seed: 9, testbed: label, estimator: entry.id, budget: 4, rep: 0, integral: 0 };
     // Tasks count what they spend, so each pass gets its own.
-    let tasks = || -> Vec<estimators::task::Task<'_>> {
-        (0..bed.sequence_length()).map(|i| estimators::task::Task::new(bed.as_ref(), i, budget)).collect()
+    let tasks = || -> Vec<mcbench_core::task::Task<'_>> {
+        (0..bed.sequence_length()).map(|i| mcbench_core::task::Task::new(bed.as_ref(), i, budget)).collect()
     };
     let at_once = est.estimate_sequence(&tasks(), &mut key.rng()).ok()?;
     let mut rng = key.rng();

@@ -28,7 +28,7 @@
 //! measured BRDF, a cache whose cells miss the processor's caches).
 
 use crate::metrics::SummaryRow;
-use estimators::error::ConfigError;
+use mcbench_core::error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 /// Unit costs of counted operations, in nanoseconds of one CPU thread.

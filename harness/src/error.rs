@@ -8,7 +8,7 @@
 //! | 2 | bad input: nothing was run or written | unknown names, values out of bounds, a config, stored cell, reference, manifest or summary file that is malformed or inconsistent, an output path that is not a writable folder, a symbolic link in place of a lock file or of an experiment's folder |
 //! | 3 | busy: another mcbench holds the results folder | a second run into the same folder (`--wait` waits instead) |
 
-use estimators::error::ConfigError;
+use mcbench_core::error::ConfigError;
 use std::path::PathBuf;
 use thiserror::Error;
 
@@ -62,7 +62,7 @@ pub enum HarnessError {
         /// Test bed and variant.
         testbed: String,
         /// The failure.
-        source: estimators::error::EstimateError,
+        source: mcbench_core::error::EstimateError,
     },
     /// A check failed (exit 1): an estimator that does not pass the conformance suite.
     #[error("{0}")]

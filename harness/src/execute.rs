@@ -13,7 +13,7 @@ use crate::plan::{Plan, PreparedBed, PreparedEstimator};
 use crate::plot::DisplayNames;
 use crate::registry::{Experiment, Registry};
 use crate::runner::{self, Observer, RunOptions, RunResults};
-use estimators::budget::BudgetKind;
+use mcbench_core::budget::BudgetKind;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -157,10 +157,10 @@ pub fn finish(
     let mut notes = Vec::new();
     for b in &plan.beds {
         notes.push(match &b.bed.reference().kind {
-            estimators::testbed::ReferenceKind::Exact { method, bound } => {
+            mcbench_core::testbed::ReferenceKind::Exact { method, bound } => {
                 format!("{}: exact reference ({method}), absolute error bound {bound:.3e}", b.label())
             }
-            estimators::testbed::ReferenceKind::Stored { command, samples } => format!(
+            mcbench_core::testbed::ReferenceKind::Stored { command, samples } => format!(
                 "{}: stored reference from `{command}` ({samples} samples per value); its variance is subtracted from the MSE",
                 b.label()
             ),

@@ -4,13 +4,13 @@
 //! unbiasedness tests ([`crate::analysis::unbiasedness`]) read.
 
 use crate::cell::{CellKey, CellResult};
-use estimators::budget::Budget;
-use estimators::error::EstimateError;
-use estimators::estimator::Estimator;
-use estimators::rng::StreamKey;
-use estimators::stats::Moments;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
+use mcbench_core::budget::Budget;
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::stats::Moments;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 /// Why a guarded sequence produced no estimates.
@@ -63,7 +63,7 @@ pub fn cell_of(bed: &dyn TestBed, estimator: &str, budget: Budget, seed: u64, pe
     let mut moments = vec![[Moments::new(), Moments::new(), Moments::new()]; n];
     let (mut rep_dev, mut rep_sq) = (Moments::new(), Moments::new());
     for v in per_rep {
-        let (mut dev, mut sq) = (estimators::stats::NeumaierSum::new(), estimators::stats::NeumaierSum::new());
+        let (mut dev, mut sq) = (mcbench_core::stats::NeumaierSum::new(), mcbench_core::stats::NeumaierSum::new());
         for (i, (m, x)) in moments.iter_mut().zip(v).enumerate() {
             for c in 0..3 {
                 m[c].push(x[c]);

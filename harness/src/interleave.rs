@@ -12,10 +12,10 @@
 use crate::cell::{add_diagnostics, rep_block_count, rep_block_size, CellKey, CellResult, RepBlock, TimeStats};
 use crate::error::Result;
 use crate::plan::Plan;
-use crate::runner::{add_costs, calibrated_samples, cell_key, run_sequence, CellRun, Item, REP_BLOCK};
-use estimators::budget::Budget;
-use estimators::stats::{Moments, NeumaierSum};
-use estimators::task::Costs;
+use crate::runner::{calibrated_samples, cell_key, run_sequence, CellRun, Item, REP_BLOCK};
+use mcbench_core::budget::Budget;
+use mcbench_core::stats::{Moments, NeumaierSum};
+use mcbench_core::task::Costs;
 use rayon::prelude::*;
 
 /// Integrals per work item: small enough to balance, large enough to amortise scheduling.
@@ -41,7 +41,7 @@ pub struct GroupCell<'a> {
 /// at a time so that memory stays bounded whatever the repetition count.
 ///
 /// Work items are whole sequences (test beds whose integrals come in frames,
-/// [`estimators::testbed::TestBed::sequence_length`]), batched to about `BATCH` integrals; each
+/// [`mcbench_core::testbed::TestBed::sequence_length`]), batched to about `BATCH` integrals; each
 /// sequence draws from the stream of its first integral, so a static test bed (sequence length 1)
 /// keeps exactly the per-integral streams and batches it always had. A fetch or time budget first
 /// becomes a fixed sample count per cell (its pilot is deterministic for fetch budgets, so every
@@ -73,8 +73,10 @@ pub fn run_group_with(
     let keys: Vec<CellKey> = cells.iter().map(|c| cell_key(plan, bi, c.ei, budget)).collect();
     let reference = &b.bed.reference().value;
     // Paper 003's per-integral weight 1 / tvi(L_ref), for each repetition's `Err`.
-    let inv_tvi: Vec<f64> =
-        reference.iter().map(|v| 1.0 / estimators::perception::tvi(estimators::perception::luminance(*v))).collect();
+    let inv_tvi: Vec<f64> = reference
+        .iter()
+        .map(|v| 1.0 / mcbench_core::perception::tvi(mcbench_core::perception::luminance(*v)))
+        .collect();
     let block_size = rep_block_size(reps);
     let per_chunk = (MAX_ITEMS / (REP_BLOCK * batches * cells.len()).max(1)).max(1);
     for start in (0..longest).step_by(per_chunk) {
@@ -138,7 +140,7 @@ pub fn run_group_with(
                 acc.integrals += 1;
             }
             part.estimates += r.values.len() as u64;
-            add_costs(&mut part.costs, &r.costs);
+            part.costs += r.costs;
             part.time.merge(&r.time);
             if let Some(t) = &mut part.cpu_time {
                 t.merge(&r.cpu_time);
@@ -147,7 +149,7 @@ pub fn run_group_with(
             if let Some(blk) = part.blocks.get_mut(rep / block_size) {
                 blk.cpu_seconds += r.cpu_time.total;
                 blk.wall_seconds += r.time.total;
-                add_costs(&mut blk.costs, &r.costs);
+                blk.costs += r.costs;
             }
         }
         for (k, acc) in rep_acc.into_iter().enumerate() {

@@ -16,15 +16,14 @@
 //! ## Quick start: your own estimator, from your own crate
 //!
 //! ```no_run
-//! use mcbench::{Checks, EstimateError, Estimator, EstimatorEntry, ParamSpec, Registry, Rgb, StreamRng, Task};
-//! use mcbench::estimators::{estimator::Bias, testbed::Needs};
+//! use mcbench::{Bias, Checks, EstimateError, Estimator, EstimatorEntry, Needs, ParamSpec, Registry, Rgb, StreamRng, Task};
 //!
 //! /// Independent uniform-hemisphere sampling of a surface integral.
 //! struct Uniform;
 //!
 //! impl Estimator for Uniform {
 //!     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
-//!         use mcbench::estimators::{math::Frame, samplers::uniform_hemisphere};
+//!         use mcbench::mcbench_core::{math::Frame, samplers::uniform_hemisphere};
 //!         let probe = task.hemisphere().ok_or(EstimateError::Refused("needs a surface".into()))?;
 //!         let frame = Frame::around(probe.point().normal);
 //!         let (mut sum, mut n) = (Rgb::ZERO, 0.0);
@@ -46,7 +45,7 @@
 //!     samplers: &["uniform_hemisphere"],
 //!     summary: "independent uniform sampling of the hemisphere",
 //!     build: |params| {
-//!         mcbench::estimators::params::parse::<mcbench::estimators::params::NoParams>("my_uniform", params)?;
+//!         mcbench_core::params::parse::<mcbench_core::params::NoParams>("my_uniform", params)?;
 //!         Ok(Box::new(Uniform))
 //!     },
 //!     params: ParamSpec::NONE,
@@ -54,9 +53,10 @@
 //! };
 //!
 //! fn main() {
-//!     // The whole CLI (run, list, plot, shards, merge, conformance) over the built-in plug-ins
-//!     // and this one: `cargo run -- run --config my-sweep.toml`.
-//!     std::process::exit(mcbench::cli::main_with(Registry::builtin().with_estimator(&UNIFORM)));
+//!     // The whole CLI (run, list, plot, shards, merge, conformance) over the papers' plug-ins
+//!     // (crate `mcbench-papers`, for their test beds) and this one:
+//!     // `cargo run -- run --config my-sweep.toml`.
+//!     std::process::exit(mcbench::cli::main_with(Registry::new().with_catalog(mcbench_papers::catalog()).with_estimator(&UNIFORM)));
 //! }
 //! ```
 #![warn(missing_docs)]
@@ -106,15 +106,12 @@ pub mod shard;
 pub mod store;
 pub mod unbiasedness;
 
-pub use estimators;
-pub use estimators::error::{ConfigError, EstimateError};
-pub use estimators::estimator::{Bias, Estimator};
-pub use estimators::math::Rgb;
-pub use estimators::params::ParamSpec;
-pub use estimators::registry::{BedCase, CaseRole, Checks, EstimatorEntry, Exemption, TestBedEntry};
-pub use estimators::rng::StreamRng;
-pub use estimators::task::Task;
-pub use estimators::testbed::{Needs, Reference, TestBed};
+/// The plug-in API (`mcbench-core`), for crates that depend on the harness alone.
+pub use mcbench_core;
+pub use mcbench_core::{
+    BedCase, Bias, Budget, CaseRole, Catalog, Checks, ConfigError, EstimateError, Estimator, EstimatorEntry, Exemption,
+    Needs, ParamSpec, Reference, Rgb, StreamRng, Task, TestBed, TestBedEntry,
+};
 pub use registry::{Experiment, Registry};
 
 /// The README's code blocks, compiled and run as doc tests.

@@ -29,8 +29,8 @@ pub const MAX_ENTRIES: usize = 256;
 pub const MAX_THREADS: u64 = 1024;
 
 /// The largest budget of a kind.
-pub fn max_budget(kind: estimators::budget::BudgetKind) -> u64 {
-    use estimators::budget::BudgetKind::*;
+pub fn max_budget(kind: mcbench_core::budget::BudgetKind) -> u64 {
+    use mcbench_core::budget::BudgetKind::*;
     match kind {
         Samples => MAX_SAMPLES,
         Fetches => MAX_FETCHES,

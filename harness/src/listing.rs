@@ -4,7 +4,7 @@
 
 use crate::registry::Registry;
 use crate::report::markdown_table;
-use estimators::params::ParamDoc;
+use mcbench_core::params::ParamDoc;
 use std::fmt::Write;
 
 /// What to list.
@@ -88,7 +88,7 @@ mod tests {
 
     #[test]
     fn parameters_are_listed_with_their_docs() {
-        let text = list(Some(What::TestBeds), true, &Registry::builtin());
+        let text = list(Some(What::TestBeds), true, &Registry::new().with_catalog(mcbench_papers::catalog()));
         assert!(text.contains("### gradient-box") && text.contains("sigma_t"), "{text}");
         assert!(text.contains("Extinction of the box"), "{text}");
         assert!(!text.contains("| estimator |"));

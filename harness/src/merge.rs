@@ -13,7 +13,7 @@ use crate::plan::Plan;
 use crate::runner::{self, RunResults};
 use crate::shard::{self, Manifest, ShardSpec, MANIFEST};
 use crate::store::{Store, StoreWriter};
-use estimators::error::ConfigError;
+use mcbench_core::error::ConfigError;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

@@ -5,8 +5,8 @@
 //! seconds are reported beside them.
 
 use crate::cell::{CellResult, RepBlock};
-use estimators::stats::NeumaierSum;
-use estimators::testbed::Reference;
+use mcbench_core::stats::NeumaierSum;
+use mcbench_core::testbed::Reference;
 use serde::{Deserialize, Serialize};
 
 /// One row of `summary.csv` (the first 18 columns are the original contract, the rest extend it; book: contract.md).
@@ -113,12 +113,12 @@ pub struct SummaryRow {
     /// counted apart); `rays - shadow_rays - free_flights` are primary rays.
     #[serde(default)]
     pub free_flights: f64,
-    /// Target-density evaluations per estimate ([`estimators::task::Costs::target_evals`]: paper
+    /// Target-density evaluations per estimate ([`mcbench_core::task::Costs::target_evals`]: paper
     /// 004's `p~` evaluations, paper 003's PMC population members; 0 elsewhere and in files
     /// written before they were counted).
     #[serde(default)]
     pub target_evals: f64,
-    /// Radiance-cache operations per estimate ([`estimators::task::Costs::cache_ops`]: reads,
+    /// Radiance-cache operations per estimate ([`mcbench_core::task::Costs::cache_ops`]: reads,
     /// records and refinements of papers 000 and 001's caches; 0 elsewhere and in files written
     /// before they were counted).
     #[serde(default)]
@@ -232,7 +232,7 @@ pub fn summarize(cell: &CellResult, reference: &Reference) -> SummaryRow {
     let mut rel_n = 0usize;
     let mut p_err = NeumaierSum::new();
     for (i, m) in cell.moments.iter().enumerate() {
-        let tvi = estimators::perception::tvi(estimators::perception::luminance(reference.value[i]));
+        let tvi = mcbench_core::perception::tvi(mcbench_core::perception::luminance(reference.value[i]));
         let mut e2_mean = 0.0;
         for (c, mc) in m.iter().enumerate() {
             let (r, rse2) = (reference.value[i][c], reference.std_err[i][c].powi(2));

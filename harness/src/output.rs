@@ -164,7 +164,7 @@ pub struct RunReport {
 }
 
 /// The adaptive methods' counted operations of one cell, per estimate
-/// ([`estimators::task::Costs::target_evals`], [`estimators::task::Costs::cache_ops`]).
+/// ([`mcbench_core::task::Costs::target_evals`], [`mcbench_core::task::Costs::cache_ops`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CellCounts {
     /// Test bed id.

@@ -6,11 +6,11 @@
 use crate::config::{EstimatorSpec, Sweep, TestBedSpec};
 use crate::error::Result;
 use crate::registry::Registry;
-use estimators::budget::BudgetKind;
-use estimators::error::ConfigError;
-use estimators::estimator::Estimator;
-use estimators::registry::{EstimatorEntry, TestBedEntry};
-use estimators::testbed::{Needs, TestBed};
+use mcbench_core::budget::BudgetKind;
+use mcbench_core::entry::{EstimatorEntry, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::testbed::{Needs, TestBed};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::sync::{Mutex, OnceLock};
@@ -231,7 +231,7 @@ mod tests {
     /// judged on its own.
     #[test]
     fn validation_is_remembered_per_configuration() {
-        let registry = Registry::builtin();
+        let registry = Registry::new().with_catalog(mcbench_papers::catalog());
         let bad = sweep("[[estimators]]\nid='delta_tracking'\nparams={sigma_samp=0.01}\n");
         let first = Plan::prepare(bad.clone(), &registry).err().expect("no majorant").to_string();
         assert!(first.contains("majorant"), "{first}");

@@ -1,15 +1,15 @@
 //! Stored references as files: the folder the harness reads them from and writes them to
 //! (`<results>/references`, or `--references DIR`). A reference is found by its key
-//! ([`estimators::references::ReferenceKey`]: test bed, variant, and the parameters its values
+//! ([`mcbench_core::references::ReferenceKey`]: test bed, variant, and the parameters its values
 //! depend on), never through a path compiled into the binary: a binary copied elsewhere is pointed
 //! at the folder with `--references` (or `--results`), and a reference made with parameters
 //! (`mcbench reference --param k=v`) is found by any run that uses them.
 
 use crate::error::{HarnessError, Result};
-use estimators::error::ConfigError;
-use estimators::params::Params;
-use estimators::references::{NoReferences, ReferenceKey, ReferenceSource, StoredReference};
-use estimators::registry::TestBedEntry;
+use mcbench_core::entry::TestBedEntry;
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::Params;
+use mcbench_core::references::{NoReferences, ReferenceKey, ReferenceSource, StoredReference};
 use std::path::{Path, PathBuf};
 
 /// A folder of stored references, one JSON file per key ([`ReferenceKey::file_name`]).

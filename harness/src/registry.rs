@@ -1,14 +1,16 @@
 //! The registry a run looks names up in: estimators, test beds and named experiments. It is a
 //! value, built in `main` and handed to [`crate::cli::main_with`] and to planning, so a crate of
-//! your own adds its plug-ins to the built-in ones without touching mcbench:
+//! your own adds its plug-ins (and, if it wants them, a [`Catalog`] such as the papers' built-ins
+//! of `mcbench-papers`) without touching mcbench:
 //!
 //! ```
 //! use mcbench::{EstimatorEntry, Registry};
 //!
-//! // An estimator of your own: here the built-in independent estimator under another id.
-//! static MINE: EstimatorEntry = EstimatorEntry { id: "my_estimator", ..estimators::independent::is0_cv0::ENTRY };
+//! // An estimator of your own: here the papers' independent estimator under another id.
+//! static MINE: EstimatorEntry = EstimatorEntry { id: "my_estimator", ..mcbench_papers::independent::is0_cv0::ENTRY };
 //!
-//! let registry = Registry::builtin().with_estimator(&MINE);
+//! // The harness's own experiments, the papers' estimators and test beds, and yours.
+//! let registry = Registry::new().with_catalog(mcbench_papers::catalog()).with_estimator(&MINE);
 //! assert!(registry.estimator("my_estimator").is_ok());
 //! assert!(registry.estimator("is1_cv2").is_ok(), "the built-in ones stay");
 //! registry.check().expect("no id registered twice");
@@ -23,9 +25,10 @@ use crate::plan::Plan;
 use crate::plot::DisplayNames;
 use crate::references::ReferenceDir;
 use crate::runner::RunResults;
-use estimators::error::ConfigError;
-use estimators::references::ReferenceSource;
-use estimators::registry::{EstimatorEntry, TestBedEntry};
+use mcbench_core::entry::{EstimatorEntry, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::references::ReferenceSource;
+use mcbench_core::Catalog;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -143,17 +146,21 @@ impl Registry {
         Registry::default()
     }
 
-    /// Every estimator and test bed of the `estimators` crate (the five papers' and the biased
-    /// controls), and the harness's own experiment `unbiasedness`, which runs over whatever is
-    /// registered.
-    pub fn builtin() -> Self {
-        Registry {
-            estimators: estimators::registry::ESTIMATORS.to_vec(),
-            test_beds: estimators::registry::TESTBEDS.to_vec(),
-            ..Registry::default()
-        }
-        .with_experiment(crate::unbiasedness::experiment())
-        .with_experiment_on_demand(crate::calibration::experiment())
+    /// The harness's own experiments and no plug-in: `unbiasedness`, which runs over whatever
+    /// is registered, in the default suite, and `calibration` on demand. Add estimators and test
+    /// beds with [`Registry::with_catalog`], [`Registry::with_estimator`] and
+    /// [`Registry::with_test_bed`].
+    pub fn new() -> Self {
+        Registry::default()
+            .with_experiment(crate::unbiasedness::experiment())
+            .with_experiment_on_demand(crate::calibration::experiment())
+    }
+
+    /// Adds every estimator and test bed of `catalog`, in its order.
+    pub fn with_catalog(mut self, catalog: Catalog) -> Self {
+        self.estimators.extend(catalog.estimators);
+        self.test_beds.extend(catalog.testbeds);
+        self
     }
 
     /// The same without any named experiment (to register them in another order).
@@ -283,12 +290,12 @@ mod tests {
 
     #[test]
     fn lookups_name_the_valid_ids_and_duplicates_are_found() {
-        let r = Registry::builtin();
+        let r = Registry::new().with_catalog(mcbench_papers::catalog());
         assert!(r.estimator("is1_cv2").is_ok() && r.test_bed("gradient-box").is_ok());
         let e = r.estimator("nope").err().map(|e| e.to_string()).unwrap_or_default();
         assert!(e.contains("is0_cv0"), "{e}");
         assert!(r.check().is_ok());
-        let twice = r.clone().with_estimator(estimators::registry::ESTIMATORS[0]);
+        let twice = r.clone().with_estimator(mcbench_papers::builtins::ESTIMATORS[0]);
         assert!(twice.check().expect_err("duplicate").to_string().contains("registered twice"));
         assert!(Registry::empty().estimators().is_empty());
     }

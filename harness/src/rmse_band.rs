@@ -61,7 +61,7 @@ pub fn rmse_band(blocks: &[RepBlock], mse_offset: f64, seed: u64) -> Option<(f64
 #[cfg(test)]
 mod tests {
     use super::*;
-    use estimators::task::Costs;
+    use mcbench_core::task::Costs;
 
     fn block(reps: u64, sq: f64) -> RepBlock {
         RepBlock {

@@ -22,8 +22,8 @@
 //! zero-variance there.
 
 use crate::cell::CellResult;
-use estimators::budget::BudgetKind;
-use estimators::testbed::{Reference, ReferenceKind};
+use mcbench_core::budget::BudgetKind;
+use mcbench_core::testbed::{Reference, ReferenceKind};
 
 /// Ulps of the magnitude that round-off may account for beyond the summation's one ulp per
 /// operation.
@@ -120,7 +120,7 @@ mod tests {
         let mut stored = r.clone();
         stored.kind = ReferenceKind::Stored { command: "x".into(), samples: 10 };
         assert_eq!(rmse_bound(&cell, &stored), (u * u * 2.0).sqrt(), "a stored reference without error");
-        stored.std_err = vec![estimators::math::Rgb::splat(1e-3)];
+        stored.std_err = vec![mcbench_core::math::Rgb::splat(1e-3)];
         assert!(rmse_bound(&cell, &stored).is_nan());
     }
 }

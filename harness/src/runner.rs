@@ -12,11 +12,11 @@ pub use crate::interleave::{run_group_with, GroupCell};
 use crate::plan::Plan;
 pub use crate::resume::{preload, preload_from};
 use crate::store::StoreWriter;
-use estimators::budget::{Budget, BudgetKind};
-use estimators::error::EstimateError;
-use estimators::math::Rgb;
-use estimators::rng::StreamKey;
-use estimators::task::{Costs, Task};
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::error::EstimateError;
+use mcbench_core::math::Rgb;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::task::{Costs, Task};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -80,17 +80,6 @@ pub(crate) struct Item {
     pub(crate) diagnostics: Vec<(String, f64)>,
 }
 
-pub(crate) fn add_costs(a: &mut Costs, b: &Costs) {
-    a.samples += b.samples;
-    a.fetches += b.fetches;
-    a.cheap_fetches += b.cheap_fetches;
-    a.rays += b.rays;
-    a.shadow_rays += b.shadow_rays;
-    a.free_flights += b.free_flights;
-    a.target_evals += b.target_evals;
-    a.cache_ops += b.cache_ops;
-}
-
 /// Repetition index of the pilot stream that calibrates fetch budgets (never a real repetition).
 pub(crate) const PILOT_REP: u64 = u64::MAX;
 
@@ -147,7 +136,7 @@ pub(crate) fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut
         }
         out.time.push(seconds);
         out.cpu_time.push(cpu_seconds);
-        add_costs(&mut out.costs, &task.costs());
+        out.costs += task.costs();
         add_diagnostics(&mut out.diagnostics, &task.diagnostics());
         out.values.push(v);
     }
@@ -174,7 +163,7 @@ pub fn sequence_estimates(
 }
 
 /// Repetitions per block. A cell's repetitions are reduced block by block (Welford pushes in
-/// repetition order inside a block, [`Moments::merge`](estimators::stats::Moments::merge) of the
+/// repetition order inside a block, [`Moments::merge`](mcbench_core::stats::Moments::merge) of the
 /// blocks in block order), so the block is the unit a shard (`--shard i/n`) can own: the split is
 /// fixed by the sweep's `reps` alone, never by the thread or shard count, and a merge of shards
 /// reproduces a single run bit for bit.
@@ -247,7 +236,7 @@ fn merge_into(out: &mut CellResult, p: &CellResult) {
         }
     }
     out.estimates += p.estimates;
-    add_costs(&mut out.costs, &p.costs);
+    out.costs += p.costs;
     out.time.merge(&p.time);
     out.merge_cpu_time(p);
     add_diagnostics(&mut out.diagnostics, &p.diagnostics);

@@ -10,7 +10,7 @@
 //! split depends on the sweep alone, and a single run reduces the same blocks in the same order
 //! ([`runner::run_cell`]), which is why a merge reproduces it bit for bit.
 //!
-//! [`Moments`]: estimators::stats::Moments
+//! [`Moments`]: mcbench_core::stats::Moments
 
 use crate::cell::{CellKey, CellResult};
 use crate::config::Sweep;
@@ -120,7 +120,7 @@ pub struct Manifest {
 
 /// The digest recorded in [`Manifest::sweep_digest`].
 pub fn sweep_digest(sweep: &Sweep) -> String {
-    format!("{:016x}", estimators::rng::fnv1a(&serde_json::to_string(sweep).unwrap_or_default()))
+    format!("{:016x}", mcbench_core::rng::fnv1a(&serde_json::to_string(sweep).unwrap_or_default()))
 }
 
 /// One stored unit: a repetition block's statistics under the whole cell's key.
@@ -183,8 +183,8 @@ pub struct ShardPreflight {
 /// calibrated per machine, so its blocks could not be merged exactly), the shard folder can be
 /// written, and every block its store already holds is well formed.
 pub fn preflight(plan: &Plan, shard: ShardSpec, results_root: &Path) -> Result<ShardPreflight> {
-    if plan.sweep.budgets.iter().any(|b| b.kind == estimators::budget::BudgetKind::Micros) {
-        return Err(estimators::error::ConfigError::invalid(
+    if plan.sweep.budgets.iter().any(|b| b.kind == mcbench_core::budget::BudgetKind::Micros) {
+        return Err(mcbench_core::error::ConfigError::invalid(
             "budget_kind",
             "micros",
             "time budgets are calibrated on each machine, so their shards could not be merged exactly; use samples or fetches",

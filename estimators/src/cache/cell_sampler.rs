@@ -206,7 +206,7 @@ impl CellSampler {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::stream;
+    use mcbench_core::rng::stream;
 
     /// The block sampler draws exactly the cell the full tree over the cells' `q` draws, for the
     /// same random stream, in both precisions, with zeros, and after updates.

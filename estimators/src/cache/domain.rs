@@ -4,8 +4,8 @@
 //! (sphere, media): `s = phi / 2 pi`, `t = (1 - cos(theta)) / 2`. In both, `d omega` is a constant
 //! times `ds dt`, so a regular partition of the unit square gives cells of equal solid angle.
 
-use crate::math::Vec3;
-use crate::samplers::spherical_direction;
+use mcbench_core::math::Vec3;
+use mcbench_core::samplers::spherical_direction;
 use std::f64::consts::{PI, TAU};
 
 /// A point of the unit parameter square: `s` is the azimuth, `t` the polar coordinate.

@@ -20,8 +20,8 @@
 
 use super::domain::{Domain, St};
 use super::storage::Scalar;
-use crate::math::Rgb;
-use crate::stats::NeumaierSum;
+use mcbench_core::math::Rgb;
+use mcbench_core::stats::NeumaierSum;
 
 /// Which maintained coefficient sum.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

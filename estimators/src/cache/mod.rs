@@ -31,7 +31,7 @@ pub use partial_sum_tree::PartialSumTree;
 pub use reconstruction::ControlVariate;
 pub use storage::{Scalar, Storage};
 
-use crate::math::Rgb;
+use mcbench_core::math::Rgb;
 use rand::Rng;
 
 /// The largest `max_depth` a cache accepts (`4^12` cells on the hemisphere).

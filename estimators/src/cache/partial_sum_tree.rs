@@ -113,9 +113,9 @@ impl PartialSumTree {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::stream;
-    use crate::samplers::testing::sampler_alpha;
-    use crate::stats::chi_square_gof;
+    use mcbench_core::rng::stream;
+    use mcbench_core::samplers::testing::sampler_alpha;
+    use mcbench_core::stats::chi_square_gof;
 
     /// Chi-square of the tree sampler against its reported probabilities, on a non-power-of-two
     /// tree with weights spanning ten orders of magnitude and some zeros (book: statistics.md).

@@ -21,7 +21,7 @@
 use super::domain::St;
 use super::grid::{floor_index, Grid};
 use super::storage::Scalar;
-use crate::math::Rgb;
+use mcbench_core::math::Rgb;
 
 /// The control variate of an estimator: `cv0`, `cv1` or `cv2` (paper 001 Fig. 4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -105,8 +105,8 @@ fn bilinear<S: Scalar>(grid: &Grid<S>, st: St) -> Rgb {
 mod tests {
     use super::*;
     use crate::cache::domain::Domain;
-    use crate::quadrature::gauss_legendre;
-    use crate::rng::stream;
+    use mcbench_core::quadrature::gauss_legendre;
+    use mcbench_core::rng::stream;
     use rand::Rng;
 
     /// The integral of `g` over the domain by Gauss-Legendre on sub-rectangles bounded by the cell
@@ -114,7 +114,7 @@ mod tests {
     fn integrate<S: Scalar>(cv: ControlVariate, grid: &Grid<S>) -> Rgb {
         let (ns, nt) = grid.resolution();
         let (x, w) = gauss_legendre(3);
-        let mut sum = [crate::stats::NeumaierSum::new(), Default::default(), Default::default()];
+        let mut sum = [mcbench_core::stats::NeumaierSum::new(), Default::default(), Default::default()];
         let (hs, ht) = (0.5 / ns as f64, 0.5 / nt as f64);
         for a in 0..2 * ns {
             for b in 0..2 * nt {

@@ -2,9 +2,9 @@
 //! (inheritance rule) and the refinement rules.
 
 use super::*;
-use crate::math::Vec3;
-use crate::rng::stream;
-use crate::samplers::testing::{assert_sampler_fits, SphereGrid};
+use mcbench_core::math::Vec3;
+use mcbench_core::rng::stream;
+use mcbench_core::samplers::testing::{assert_sampler_fits, SphereGrid};
 use std::f64::consts::FRAC_1_SQRT_2;
 
 /// A cache refined `depth` times whose PDF coefficients vary over four orders of magnitude.

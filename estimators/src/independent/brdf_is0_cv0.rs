@@ -1,14 +1,14 @@
 //! `brdf_is0_cv0`: BRDF importance sampling (paper 001 §4.5): the diffuse cosine lobe and the
-//! Phong lobe as a mixture, weighted by the exact mixture pdf ([`crate::brdf::Phong::pdf`]).
+//! Phong lobe as a mixture, weighted by the exact mixture pdf ([`mcbench_core::brdf::Phong::pdf`]).
 
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, NoParams, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::task::Task;
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, NoParams, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::Needs;
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

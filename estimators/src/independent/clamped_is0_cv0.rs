@@ -2,15 +2,15 @@
 //! sample's contribution `f / p` clamped per channel at `clamp` (a "firefly clamp"). Its only
 //! purpose is to prove that the unbiasedness test can fail: every run of the suite must flag it.
 
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, ParamSet, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::uniform_hemisphere;
-use crate::task::Task;
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSet, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::uniform_hemisphere;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::Needs;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 

@@ -1,15 +1,15 @@
 //! `is0_cv0`: uniform hemisphere sampling without control variate, the independent-sample
 //! baseline of papers 000/001 (their "MCMC"): `(1/N) sum 2 pi f(w_k)`.
 
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, NoParams, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::uniform_hemisphere;
-use crate::task::Task;
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, NoParams, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::uniform_hemisphere;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::Needs;
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

@@ -5,11 +5,11 @@ pub mod brdf_is0_cv0;
 pub mod clamped_is0_cv0;
 pub mod is0_cv0;
 
-use crate::accumulate::RgbMean;
-use crate::error::EstimateError;
-use crate::math::{Frame, Rgb};
-use crate::rng::StreamRng;
-use crate::task::{HemisphereProbe, Task};
+use mcbench_core::accumulate::RgbMean;
+use mcbench_core::error::EstimateError;
+use mcbench_core::math::{Frame, Rgb};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::{HemisphereProbe, Task};
 
 /// Averages `sample(probe, frame, rng)` while the budget lasts; refuses scenes without a surface.
 pub(crate) fn average(

@@ -22,14 +22,14 @@ pub mod octree;
 pub mod params;
 pub mod walk;
 
-use crate::accumulate::RgbMean;
 use crate::cache::{CacheConfig, ControlVariate, Domain, Scalar, Storage};
-use crate::error::EstimateError;
-use crate::estimator::Estimator;
-use crate::math::{Rgb, Vec3};
-use crate::rng::StreamRng;
-use crate::task::{MediumProbe, Task};
-use crate::testbed::TestBed;
+use mcbench_core::accumulate::RgbMean;
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::{MediumProbe, Task};
+use mcbench_core::testbed::TestBed;
 use octree::Octree;
 use params::MediaSmcParams;
 pub use walk::{Sampling, Transport};
@@ -148,7 +148,7 @@ impl Estimator for MediaSmc {
 /// (transmittances, point-light single scattering): these ids trace multiple scattering.
 pub fn supports_radiance(bed: &dyn TestBed) -> Result<(), String> {
     match bed.medium().map(|m| m.ray(0).quantity) {
-        Some(crate::testbed::MediumQuantity::Radiance) => Ok(()),
+        Some(mcbench_core::testbed::MediumQuantity::Radiance) => Ok(()),
         _ => Err("traces multiple scattering under the environment; this test bed asks for another quantity".into()),
     }
 }

@@ -10,7 +10,7 @@
 //! resolution is tied to its depth.
 
 use crate::cache::{CacheConfig, RadianceCache, Scalar, St};
-use crate::math::{Rgb, Vec3};
+use mcbench_core::math::{Rgb, Vec3};
 
 /// Counters are divided by the dimensionality of a split: 2 x 2 directional x 8 spatial = 32.
 pub const SPLIT_DIVISOR: u32 = 32;

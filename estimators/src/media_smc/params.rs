@@ -2,9 +2,9 @@
 //! ids) and of `rm_is1_cv2` ([`RmIs1Cv2Params`]).
 
 use crate::cache::Storage;
-use crate::error::ConfigError;
-use crate::params::{check_range, ParamSet};
-use crate::smc_surface::params::check_refinement;
+use crate::surface_smc::params::check_refinement;
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::{check_range, ParamSet};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 

@@ -12,10 +12,10 @@
 use super::params::RmIs1Cv2Params;
 use super::{MediaSmc, Sampling};
 use crate::cache::ControlVariate;
-use crate::estimator::Bias;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry, Exemption};
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry, Exemption};
+use mcbench_core::estimator::Bias;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::testbed::Needs;
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

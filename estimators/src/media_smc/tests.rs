@@ -3,26 +3,22 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::*;
-use crate::budget::Budget;
-use crate::params::Params;
-use crate::registry;
-use crate::rng::StreamKey;
-use crate::stats::{holm_bonferroni, one_sample_t, Moments};
-use crate::testbed::{ReferenceKind, TestBed};
+use crate::builtins;
 use crate::testbeds::gradient_box::GradientBox;
+use mcbench_core::budget::Budget;
+use mcbench_core::params::Params;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
+use mcbench_core::testbed::{ReferenceKind, TestBed};
 
 fn bed(variant: &str, resolution: usize) -> GradientBox {
-    GradientBox::new(
-        variant,
-        &Params::new().with("resolution", resolution as f64),
-        &crate::references::repository::Repository,
-    )
-    .unwrap()
+    GradientBox::new(variant, &Params::new().with("resolution", resolution as f64), &crate::repository::Repository)
+        .unwrap()
 }
 
 /// `reps` independent whole-image estimates of `id` at `spp`; per pixel and channel moments.
 fn image_moments(id: &str, params: &Params, bed: &GradientBox, reps: u64, spp: u64) -> Vec<[Moments; 3]> {
-    let est = (registry::estimator(id).unwrap().build)(params).unwrap();
+    let est = (builtins::estimator(id).unwrap().build)(params).unwrap();
     let n = bed.integrals();
     let mut m = vec![<[Moments; 3]>::default(); n];
     for rep in 0..reps {
@@ -91,7 +87,7 @@ fn octree_invariants_hold_after_adaptation() {
     let params = MediaSmcParams { criterion: 4.0, ..MediaSmcParams::default() };
     let est = MediaSmc::from_params(Sampling::Cache, ControlVariate::Bilinear, &params);
     let mut tree = Octree::<f64>::new(Vec3::default(), 0.5, est.config);
-    let mut rng = crate::rng::stream(3, "octree");
+    let mut rng = mcbench_core::rng::stream(3, "octree");
     let mut vertices = Vec::new();
     let task = Task::new(&b, 100, Budget::samples(1).unwrap());
     let probe = task.medium().unwrap();
@@ -125,7 +121,7 @@ fn octree_invariants_hold_after_adaptation() {
 /// passes, the ray-marching control is flagged by the image-mean test.
 #[test]
 fn unbiased_against_stored_references_and_ray_marching_flagged() {
-    use crate::stats::welch;
+    use mcbench_core::stats::welch;
     let reps = 16;
     for variant in ["albedo-1", "albedo-0.8"] {
         let b = bed(variant, 16);
@@ -133,7 +129,7 @@ fn unbiased_against_stored_references_and_ray_marching_flagged() {
         let ReferenceKind::Stored { samples, .. } = r.kind else { panic!("stored") };
         let ref_mean = r.value.iter().map(|v| v.mean()).sum::<f64>() / r.value.len() as f64;
         for id in IDS.iter().copied().chain(["rm_is1_cv2"]) {
-            let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+            let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
             let n = b.integrals();
             let (mut m, mut image) = (vec![<[Moments; 3]>::default(); n], Moments::default());
             for rep in 0..reps {
@@ -174,8 +170,8 @@ fn unbiased_against_stored_references_and_ray_marching_flagged() {
 /// with its stored reference; albedo 1 and 0 and the furnace are covered above.
 #[test]
 fn optically_thick_box_is_finite_and_agrees_with_its_reference() {
-    use crate::stats::welch;
-    let b = GradientBox::new("thick", &Params::new(), &crate::references::repository::Repository).unwrap();
+    use mcbench_core::stats::welch;
+    let b = GradientBox::new("thick", &Params::new(), &crate::repository::Repository).unwrap();
     let r = b.reference();
     let ReferenceKind::Stored { samples, .. } = r.kind else { panic!("stored") };
     for id in ["is0_cv0", "is1_cv2"] {
@@ -200,7 +196,7 @@ fn cache_operations_are_two_per_vertex_plus_one_per_split() {
     let params = MediaSmcParams { criterion: 4.0, ..MediaSmcParams::default() };
     let est = MediaSmc::from_params(Sampling::Cache, ControlVariate::Bilinear, &params);
     let mut tree = Octree::<f64>::new(Vec3::default(), 0.5, est.config);
-    let mut rng = crate::rng::stream(4, "cache ops");
+    let mut rng = mcbench_core::rng::stream(4, "cache ops");
     let mut vertices = Vec::new();
     let task = Task::new(&b, 100, Budget::samples(1).unwrap());
     let probe = task.medium().unwrap();
@@ -233,9 +229,9 @@ fn cache_operations_are_two_per_vertex_plus_one_per_split() {
 fn image_cache_operations_add_up_and_the_path_tracer_counts_none() {
     let b = GradientBox::without_reference("albedo-0.8", &Params::new().with("resolution", 4.0)).unwrap();
     for (id, cached) in [("is1_cv2", true), ("rm_is1_cv2", true), ("is0_cv0", false)] {
-        let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+        let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
         let tasks: Vec<Task<'_>> = (0..b.integrals()).map(|i| Task::new(&b, i, Budget::samples(16).unwrap())).collect();
-        est.estimate_sequence(&tasks, &mut crate::rng::stream(6, id)).unwrap();
+        est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(6, id)).unwrap();
         let (ops, flights) =
             tasks.iter().fold((0, 0), |(o, f), t| (o + t.costs().cache_ops, f + t.costs().free_flights));
         if cached {

@@ -11,9 +11,9 @@
 
 use super::octree::Octree;
 use crate::cache::{ControlVariate, Scalar, St};
-use crate::math::{Rgb, Vec3};
-use crate::phase::{Phase, ISOTROPIC};
-use crate::task::MediumProbe;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::phase::{Phase, ISOTROPIC};
+use mcbench_core::task::MediumProbe;
 use rand::Rng;
 
 /// Below this product of albedos a vertex survives with probability `a` (weight 1).

@@ -16,7 +16,7 @@
 //! initial image, §4.2), whose sub-image is either pooled with the rest (the best any weighting
 //! can do) or weighted by a constant (the combinations of [`super::sub_images`]).
 
-use crate::perception::tvi;
+use mcbench_core::perception::tvi;
 
 /// The best `Err` an allocation can reach, beside uniform sampling's.
 #[derive(Clone, Debug, PartialEq)]

@@ -2,10 +2,10 @@
 //! constant combinations, and its value on the stored `checker-image` references.
 
 use super::*;
-use crate::params::Params;
-use crate::references::repository::Repository;
+use crate::repository::Repository;
 use crate::testbeds::checker_image::CheckerImage;
 use crate::testbeds::checker_image_reference::sample_variances;
+use mcbench_core::params::Params;
 use rand::Rng;
 
 /// A constant luminance: every pixel weighs the same in `Err`.
@@ -29,7 +29,7 @@ fn equal_variances_gain_nothing_and_one_noisy_pixel_of_two_gains_two() {
 /// Random allocations of the same total (each with at least the floor) never do better.
 #[test]
 fn no_allocation_beats_the_ceiling() {
-    let mut rng = crate::rng::stream(5, "ceiling");
+    let mut rng = mcbench_core::rng::stream(5, "ceiling");
     let variance: Vec<f64> = (0..40).map(|i| if i % 7 == 0 { 0.0 } else { rng.gen::<f64>().powi(4) * 100.0 }).collect();
     let luminance: Vec<f64> = (0..40).map(|i| 0.01 * (i as f64 + 1.0).powi(2)).collect();
     let (spp, floor) = (6.0, 1.0);
@@ -80,9 +80,9 @@ fn constant_initial_weights_cap_the_gain() {
 fn ceilings_on_the_stored_checker_image_references() {
     for variant in ["default", "occluded", "soft-shadow"] {
         let bed = CheckerImage::new(variant, &Params::new(), &Repository).unwrap();
-        let reference = crate::testbed::TestBed::reference(&bed);
+        let reference = mcbench_core::testbed::TestBed::reference(&bed);
         let variance = sample_variances(reference).unwrap();
-        let luminance: Vec<f64> = reference.value.iter().map(|v| crate::perception::luminance(*v)).collect();
+        let luminance: Vec<f64> = reference.value.iter().map(|v| mcbench_core::perception::luminance(*v)).collect();
         let any = allocation_ceiling(&variance, &luminance, 10.0, 1.0);
         let pooled = schedule_ceiling(&variance, &luminance, 10.0, 2.0, None, 2.0);
         let fixed = schedule_ceiling(&variance, &luminance, 10.0, 2.0, Some(0.2), 2.0);

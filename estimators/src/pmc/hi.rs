@@ -17,15 +17,15 @@
 //! default ones. All samples of all passes are averaged.
 
 use super::kernel::{Cone, Kernel};
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::{Bias, Estimator};
-use crate::math::{Rgb, Vec3};
-use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::mixture::dms_counts;
-use crate::task::{HemisphereProbe, Task};
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{check_count, check_range, parse, ParamSet, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::mixture::dms_counts;
+use mcbench_core::task::{HemisphereProbe, Task};
+use mcbench_core::testbed::Needs;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -297,7 +297,7 @@ impl Estimator for PmcHi {
         }
         Ok(if s.n > 0 { s.sum / s.n as f64 } else { Rgb::ZERO })
     }
-    fn supports(&self, bed: &dyn crate::testbed::TestBed) -> Result<(), String> {
+    fn supports(&self, bed: &dyn mcbench_core::testbed::TestBed) -> Result<(), String> {
         match bed.hemisphere() {
             Some(h) if !h.lights().is_empty() => Ok(()),
             _ => Err("pmc_hi needs a scene with area lights".into()),

@@ -5,8 +5,8 @@
 
 use super::tests::{build, moments};
 use super::*;
-use crate::params::{ParamValue, Params};
-use crate::testbed::{ImagePlaneScene, Needs, Reference, ReferenceKind, TestBed};
+use mcbench_core::params::{ParamValue, Params};
+use mcbench_core::testbed::{ImagePlaneScene, Needs, Reference, ReferenceKind, TestBed};
 
 fn with_text(name: &str, v: &str) -> Params {
     let mut p = Params::new();
@@ -81,10 +81,10 @@ fn allocation_options_change_the_kernel_weights_as_documented() {
     let (s, eps) = (10.0, base.eps);
     let scaled = PmcIp::from_params(&Params::new().with("luminance_scale", s)).unwrap();
     let m = &stats[1];
-    let expected = eps + s * s * m.variance() / crate::perception::tvi(s * m.mean());
+    let expected = eps + s * s * m.variance() / mcbench_core::perception::tvi(s * m.mean());
     assert!((scaled.raw_weight(m) - expected).abs() < 1e-12 * expected);
     let sd = PmcIp::from_params(&with_text("allocate", "std_dev")).unwrap();
-    let expected = eps + m.variance().sqrt() / crate::perception::tvi(m.mean()).sqrt();
+    let expected = eps + m.variance().sqrt() / mcbench_core::perception::tvi(m.mean()).sqrt();
     assert!((sd.raw_weight(m) - expected).abs() < 1e-12 * expected);
     // A noiseless pixel keeps the eps floor under every rule.
     for ip in [&base, &scaled, &sd] {
@@ -113,11 +113,11 @@ fn inverse_variance_weights_lower_the_error_where_noise_is_coherent() {
         let m = moments(&bed, build("pmc_ip", params).as_ref(), combine, spp, 2000);
         let z = m.iter().map(|mi| (mi.mean() - 1.0) / mi.std_err()).fold(0.0f64, |a, z| a.max(z.abs()));
         assert!(z < 5.0, "{combine}: largest |z| {z}");
-        m.iter().map(|mi| (mi.variance() + (mi.mean() - 1.0).powi(2)) / crate::perception::tvi(1.0)).sum::<f64>()
+        m.iter().map(|mi| (mi.variance() + (mi.mean() - 1.0).powi(2)) / mcbench_core::perception::tvi(1.0)).sum::<f64>()
     };
     let uniform = {
         let m = moments(&bed, build("uniform_image", Params::new()).as_ref(), "uniform", spp, 2000);
-        m.iter().map(|mi| mi.variance() / crate::perception::tvi(1.0)).sum::<f64>()
+        m.iter().map(|mi| mi.variance() / mcbench_core::perception::tvi(1.0)).sum::<f64>()
     };
     let (fixed, unweighted, inverse) = (err("fixed"), err("unweighted"), err("inverse_variance"));
     eprintln!(

@@ -5,15 +5,15 @@
 //! stability cases (a zero pixel, a pixel 1e6 times brighter than the others).
 
 use super::*;
-use crate::budget::Budget;
-use crate::error::EstimateError;
-use crate::params::Params;
-use crate::registry;
-use crate::rng::{stream, StreamKey};
-use crate::samplers::testing::sampler_alpha;
-use crate::stats::{chi_square_gof, holm_bonferroni, one_sample_t, welch};
-use crate::testbed::{ImagePlaneScene, Needs, Reference, ReferenceKind, TestBed};
+use crate::builtins;
 use crate::testbeds::checker_image::CheckerImage;
+use mcbench_core::budget::Budget;
+use mcbench_core::error::EstimateError;
+use mcbench_core::params::Params;
+use mcbench_core::rng::{stream, StreamKey};
+use mcbench_core::samplers::testing::sampler_alpha;
+use mcbench_core::stats::{chi_square_gof, holm_bonferroni, one_sample_t, welch};
+use mcbench_core::testbed::{ImagePlaneScene, Needs, Reference, ReferenceKind, TestBed};
 
 /// A 4 x 4 image with exact pixel integrals: pixel `p` shows `a_p` left of a vertical edge at
 /// `u = e_p` and `b_p` right of it, each sample multiplied by `Bernoulli(q_p) / q_p` (a rarely hit
@@ -144,7 +144,7 @@ fn min_holm_exact(bed: &dyn TestBed, m: &[Moments]) -> f64 {
 }
 
 pub(super) fn build(id: &str, params: Params) -> Box<dyn Estimator> {
-    (registry::estimator(id).unwrap().build)(&params).unwrap()
+    (builtins::estimator(id).unwrap().build)(&params).unwrap()
 }
 
 #[test]
@@ -153,7 +153,7 @@ fn pmc_ip_is_unbiased_on_exact_pixel_integrals_and_the_controls_are_flagged() {
     let reps = 4000;
     let text = |name: &str, v: &str| {
         let mut p = Params::new();
-        p.0.insert(name.into(), crate::params::ParamValue::Text(v.into()));
+        p.0.insert(name.into(), mcbench_core::params::ParamValue::Text(v.into()));
         p
     };
     for (id, params, spp) in [
@@ -199,7 +199,7 @@ fn without_a_reserved_sample_pmc_ip_is_unbiased_but_heavy_tailed() {
     // The same with inverse-variance weights, whose Horvitz-Thompson sub-images are weighted by
     // expected counts (committed before the draw, never the realised ones).
     let mut inverse = params.clone();
-    inverse.0.insert("combine".into(), crate::params::ParamValue::Text("inverse_variance".into()));
+    inverse.0.insert("combine".into(), mcbench_core::params::ParamValue::Text("inverse_variance".into()));
     let p = min_holm_exact(&mild, &moments(&mild, build(id, inverse).as_ref(), id, 10, 4000));
     eprintln!("pmc_ip[combine=inverse_variance,min_samples=0], mild image: smallest Holm-adjusted p {p:.3e}");
     assert!(p > 1e-3, "inverse_variance flagged on the mild image: {p:e}");
@@ -309,7 +309,7 @@ fn weights_are_positive_for_zero_and_extreme_pixels_and_budgets_are_spent_exactl
 }
 
 fn estimators_budget_micros(bed: &dyn TestBed) -> Result<Vec<Rgb>, EstimateError> {
-    let b = Budget::new(crate::budget::BudgetKind::Micros, 100).unwrap();
+    let b = Budget::new(mcbench_core::budget::BudgetKind::Micros, 100).unwrap();
     let tasks: Vec<Task<'_>> = (0..bed.integrals()).map(|i| Task::new(bed, i, b)).collect();
     build("pmc_ip", Params::new()).estimate_sequence(&tasks, &mut stream(1, "micros"))
 }

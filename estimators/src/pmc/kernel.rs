@@ -3,10 +3,10 @@
 //! `K(w) = alpha_BRDF h_BRDF(w) + sum_l alpha_l h_l(w) + alpha_cone h_cone(w | d, beta)`.
 //! Component order: 0 = BRDF, 1..=L = lights, L + 1 = cone.
 
-use crate::lighting::RectLight;
-use crate::math::{Frame, Vec3};
-use crate::samplers::{cone, rect_light};
-use crate::testbed::ShadingPoint;
+use mcbench_core::lighting::RectLight;
+use mcbench_core::math::{Frame, Vec3};
+use mcbench_core::samplers::{cone, rect_light};
+use mcbench_core::testbed::ShadingPoint;
 use rand::Rng;
 
 /// Parameters of the cone component: unit axis `d` and `cos(beta)`.
@@ -73,10 +73,10 @@ impl<'a> Kernel<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::brdf::Phong;
-    use crate::math::Rgb;
-    use crate::samplers::mixture::dms_counts;
-    use crate::samplers::testing::{assert_sampler_fits, SphereGrid};
+    use mcbench_core::brdf::Phong;
+    use mcbench_core::math::Rgb;
+    use mcbench_core::samplers::mixture::dms_counts;
+    use mcbench_core::samplers::testing::{assert_sampler_fits, SphereGrid};
 
     fn scene() -> (ShadingPoint, [RectLight; 2]) {
         let point = ShadingPoint {
@@ -130,8 +130,8 @@ mod tests {
         let (point, lights) = scene();
         let cone = Some(Cone { axis: Vec3::new(0.2, 0.3, 0.9).normalize(), cos_max: 0.3f64.cos() });
         let k = Kernel::new(&point, &lights, vec![0.3, 0.3, 0.2, 0.2], cone);
-        let mut rng = crate::rng::stream(52, "kernel");
-        let mut m = vec![crate::stats::Moments::default(); 4];
+        let mut rng = mcbench_core::rng::stream(52, "kernel");
+        let mut m = vec![mcbench_core::stats::Moments::default(); 4];
         for _ in 0..20_000 {
             for (c, n) in dms_counts(&k.alpha, 8, &mut rng).into_iter().enumerate() {
                 for _ in 0..n {

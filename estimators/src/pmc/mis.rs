@@ -6,17 +6,17 @@
 //! point-light single scattering in a medium the same id is paper 002's MIS
 //! ([`crate::single_scatter::mis`]).
 
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
 use crate::single_scatter::mis::MisScatter;
 use crate::single_scatter::params::MisParams;
 use crate::single_scatter::SingleScatterOr;
-use crate::task::{HemisphereProbe, Task};
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::{HemisphereProbe, Task};
+use mcbench_core::testbed::Needs;
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {
@@ -44,12 +44,12 @@ pub struct Mis {
     pub power: f64,
 }
 
-pub use crate::lighting::{light_pdf, light_selection};
-use crate::lighting::{mis_round, MisStrategy};
+pub use mcbench_core::lighting::{light_pdf, light_selection};
+use mcbench_core::lighting::{mis_round, MisStrategy};
 
 impl Mis {
     /// One round: a BRDF sample and (when `light` is set) a light sample
-    /// ([`crate::lighting::mis_round`] through the counted integrand).
+    /// ([`mcbench_core::lighting::mis_round`] through the counted integrand).
     pub fn round(&self, probe: &HemisphereProbe<'_>, select: &[f64], light: bool, rng: &mut StreamRng) -> Rgb {
         let strategy = MisStrategy { lights: probe.lights(), select, power: self.power };
         mis_round(probe.point(), &strategy, light, |w| probe.integrand(w), rng)
@@ -67,7 +67,7 @@ impl Estimator for Mis {
         let budget = task.budget();
         while task.more() {
             let left = match budget.kind {
-                crate::budget::BudgetKind::Samples => budget.amount - task.costs().samples,
+                mcbench_core::budget::BudgetKind::Samples => budget.amount - task.costs().samples,
                 _ => 2,
             };
             sum += self.round(&probe, &select, left >= 2, rng);
@@ -75,7 +75,7 @@ impl Estimator for Mis {
         }
         Ok(if rounds > 0 { sum / rounds as f64 } else { Rgb::ZERO })
     }
-    fn supports(&self, bed: &dyn crate::testbed::TestBed) -> Result<(), String> {
+    fn supports(&self, bed: &dyn mcbench_core::testbed::TestBed) -> Result<(), String> {
         match bed.hemisphere() {
             Some(h) if !h.lights().is_empty() => Ok(()),
             _ => Err("mis needs a surface with area lights (paper 003) or point-light single scattering in a medium (paper 002)".into()),

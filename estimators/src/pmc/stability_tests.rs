@@ -5,18 +5,18 @@
 //! integrand is zero. Every estimate must be finite, agree with the exact value (one-sample
 //! t-tests, Holm at family-wise 1e-3), and the PMC-HI weights must stay positive and finite.
 
-use crate::brdf::Phong;
-use crate::budget::Budget;
-use crate::lighting::RectLight;
-use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::registry;
-use crate::rng::StreamKey;
-use crate::stats::{holm_bonferroni, one_sample_t, Moments};
-use crate::task::Task;
-use crate::testbed::{HemisphereScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
+use crate::builtins;
 use crate::testbeds::checker::{CheckerGeometry, Occluder};
 use crate::testbeds::checker_reference::direct_lighting;
+use mcbench_core::brdf::Phong;
+use mcbench_core::budget::Budget;
+use mcbench_core::lighting::RectLight;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::Params;
+use mcbench_core::rng::StreamKey;
+use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{HemisphereScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
 
 /// Chosen shading points under a checker geometry.
 struct Points {
@@ -102,7 +102,7 @@ fn points(geo: &CheckerGeometry) -> Vec<ShadingPoint> {
 /// Smallest Holm-adjusted p of `id` over the points (400 repetitions, channel 0); every estimate
 /// must be finite and every noted weight positive where the kernel has it.
 fn check(bed: &Points, id: &str, spp: u64) -> f64 {
-    let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+    let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
     let mut ps = Vec::new();
     for i in 0..bed.integrals() {
         let mut m = Moments::default();

@@ -30,7 +30,7 @@
 //!   of the initial sub-image it weights.
 
 use super::ip::{Allocation, PmcIp};
-use crate::stats::Moments;
+use mcbench_core::stats::Moments;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -203,7 +203,7 @@ pub fn neighbours(pixels: &[usize], width: usize, height: usize) -> Vec<Vec<usiz
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::Params;
+    use mcbench_core::params::Params;
 
     #[test]
     fn neighbours_stay_inside_the_image_and_leave_the_pixel_out() {
@@ -227,11 +227,11 @@ mod tests {
         let nb = neighbours(&(0..6).collect::<Vec<_>>(), 3, 2);
         for combine in ["fixed", "unweighted", "inverse_variance"] {
             let mut params = Params::new();
-            params.0.insert("combine".into(), crate::params::ParamValue::Text(combine.into()));
+            params.0.insert("combine".into(), mcbench_core::params::ParamValue::Text(combine.into()));
             let ip = PmcIp::from_params(&params).unwrap();
             let mut w = SubImageWeights::new(&ip, 6, 2, vec![12, 12], 36);
             let mut sum = w.initial(&ip, &stats, &nb);
-            let mut rng = crate::rng::stream(1, "sub-images");
+            let mut rng = mcbench_core::rng::stream(1, "sub-images");
             for t in 0..2 {
                 let alpha = ip.weights(&stats);
                 let a = ip.allocate(&alpha, 12, &mut rng);

@@ -3,16 +3,16 @@
 //! that must be flagged: the clamped independent-MC control and a threshold-stopping adaptive
 //! sampler of the kind paper 003 §2 criticises (Kirk and Arvo 1991).
 
-use crate::budget::Budget;
-use crate::estimator::Estimator;
-use crate::math::{Frame, Rgb};
-use crate::params::Params;
-use crate::registry;
-use crate::rng::{StreamKey, StreamRng};
-use crate::samplers::uniform_hemisphere;
-use crate::stats::{holm_bonferroni, one_sample_t, Moments};
-use crate::task::Task;
-use crate::testbed::TestBed;
+use crate::builtins;
+use mcbench_core::budget::Budget;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::{Frame, Rgb};
+use mcbench_core::params::Params;
+use mcbench_core::rng::{StreamKey, StreamRng};
+use mcbench_core::samplers::uniform_hemisphere;
+use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 
 const REPS: usize = 400;
 
@@ -51,16 +51,16 @@ fn min_holm_p(bed: &dyn TestBed, est: &dyn Estimator, name: &str, spp: u64) -> f
 }
 
 fn bed(variant: &str) -> Box<dyn TestBed> {
-    (registry::testbed("checker-direct").unwrap().build)(
+    (builtins::testbed("checker-direct").unwrap().build)(
         variant,
         &Params::new().with("resolution", 5.0),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .unwrap()
 }
 
 fn check(id: &str, params: Params, spp: u64) -> (f64, f64) {
-    let est = (registry::estimator(id).unwrap().build)(&params).unwrap();
+    let est = (builtins::estimator(id).unwrap().build)(&params).unwrap();
     let a = min_holm_p(bed("default").as_ref(), est.as_ref(), id, spp);
     let b = min_holm_p(bed("occluded").as_ref(), est.as_ref(), id, spp);
     eprintln!("{id}: smallest Holm-adjusted p default {a:.3e}, occluded {b:.3e}");
@@ -89,7 +89,7 @@ fn mis_and_pmc_hi_pass_and_the_controls_are_flagged() {
 struct ThresholdStop;
 
 impl Estimator for ThresholdStop {
-    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, crate::error::EstimateError> {
+    fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, mcbench_core::error::EstimateError> {
         let probe = task.hemisphere().unwrap();
         let frame = Frame::around(probe.point().normal);
         let mut m = Moments::default();
@@ -118,25 +118,22 @@ fn a_threshold_stopping_sampler_is_detected_as_biased() {
 fn pmc_evaluates_its_target_once_per_sample() {
     let b = bed("default");
     for (id, per_sample) in [("pmc_hi", 1), ("pmc_hi_feedback", 1), ("mis", 0)] {
-        let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+        let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
         for spp in [1u64, 7, 64] {
             let task = Task::new(b.as_ref(), 12, Budget::samples(spp).unwrap());
-            est.estimate(&task, &mut crate::rng::stream(spp, id)).unwrap();
+            est.estimate(&task, &mut mcbench_core::rng::stream(spp, id)).unwrap();
             let c = task.costs();
             assert_eq!((c.target_evals, c.cache_ops), (per_sample * c.samples, 0), "{id} at {spp} spp");
         }
     }
-    let image = (registry::testbed("checker-image").unwrap().build)(
-        "default",
-        &Params::new(),
-        &crate::references::repository::Repository,
-    )
-    .unwrap();
+    let image =
+        (builtins::testbed("checker-image").unwrap().build)("default", &Params::new(), &crate::repository::Repository)
+            .unwrap();
     for (id, per_sample) in [("pmc_ip", 1), ("uniform_image", 0), ("threshold_image", 0)] {
-        let est = (registry::estimator(id).unwrap().build)(&Params::new()).unwrap();
+        let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
         let tasks: Vec<Task<'_>> =
             (0..image.integrals()).map(|i| Task::new(image.as_ref(), i, Budget::samples(10).unwrap())).collect();
-        est.estimate_sequence(&tasks, &mut crate::rng::stream(3, id)).unwrap();
+        est.estimate_sequence(&tasks, &mut mcbench_core::rng::stream(3, id)).unwrap();
         let (evals, samples) =
             tasks.iter().fold((0, 0), |(e, s), t| (e + t.costs().target_evals, s + t.costs().samples));
         assert!(samples > 0, "{id}");

@@ -7,16 +7,16 @@
 //! at most the image budget (less when every pixel has stopped).
 
 use super::ip::image_probes;
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec};
-use crate::perception::luminance;
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::stats::Moments;
-use crate::task::{ImageProbe, Task};
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{check_count, check_range, parse, ParamSet, ParamSpec};
+use mcbench_core::perception::luminance;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::stats::Moments;
+use mcbench_core::task::{ImageProbe, Task};
+use mcbench_core::testbed::Needs;
 use rand::Rng;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};

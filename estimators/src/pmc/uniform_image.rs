@@ -3,14 +3,14 @@
 //! is their mean (Eq. 3 with `p = h_p`, the same per-sample sampler PMC-IP uses, so the two differ
 //! only in where the samples go).
 
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, NoParams, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::task::Task;
-use crate::testbed::Needs;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, NoParams, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::Needs;
 use rand::Rng;
 
 /// Registry entry.

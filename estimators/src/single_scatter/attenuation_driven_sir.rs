@@ -10,16 +10,16 @@
 use super::params::AttenuationSirParams;
 use super::transmittance::PrimaryTracker;
 use super::{run, supports_single_scatter, ShadowRays};
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::mixture::pick;
-use crate::task::Task;
-use crate::testbed::{Needs, TestBed};
 use crate::tracking::residual_ratio_tracking::ResidualRatioTracking;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::mixture::pick;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{Needs, TestBed};
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {
@@ -88,9 +88,9 @@ impl Estimator for AttenuationDrivenSir {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::stream;
-    use crate::samplers::testing::sampler_alpha;
-    use crate::stats::chi_square_gof;
+    use mcbench_core::rng::stream;
+    use mcbench_core::samplers::testing::sampler_alpha;
+    use mcbench_core::stats::chi_square_gof;
 
     /// Chi-square of the resampled indices against `|w_k| / W`, with a negative weight and a zero
     /// weight (never drawn) among the candidates.

@@ -5,14 +5,14 @@
 //! (0 or 1, unbiased for `T_l`). No collision before the medium ends: 0.
 
 use super::{run, supports_single_scatter};
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::Estimator;
-use crate::math::Rgb;
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::task::Task;
-use crate::testbed::TestBed;
 use crate::tracking::{track, Rule};
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::Rgb;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 use rand::Rng;
 
 /// The estimator.

@@ -8,14 +8,14 @@ use super::points::PointEstimator;
 use super::scattering_driven::ScatterDensity;
 use super::source_driven::equiangular;
 use super::{run, supports_single_scatter};
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::Estimator;
-use crate::math::Rgb;
-use crate::rng::StreamRng;
-use crate::samplers::equiangular::Equiangular;
-use crate::task::Task;
-use crate::testbed::TestBed;
 use crate::tracking::residual_ratio_tracking::ResidualRatioTracking;
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::Rgb;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::equiangular::Equiangular;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 use rand::Rng;
 
 /// The estimator.

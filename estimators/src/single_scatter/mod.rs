@@ -33,18 +33,18 @@ pub mod scattering_driven;
 pub mod source_driven;
 pub mod transmittance;
 
-use crate::accumulate::RgbMean;
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::Estimator;
-use crate::lighting::PointLight;
-use crate::math::{Rgb, Vec3};
-use crate::phase::Phase;
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::task::{MediumProbe, Task};
-use crate::testbed::{MediumQuantity, TestBed};
 use crate::tracking::residual_ratio_tracking::{main_part_along, MainPart, RecentMaximum, ResidualRatioTracking};
 use crate::tracking::{track, Rule};
+use mcbench_core::accumulate::RgbMean;
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::Estimator;
+use mcbench_core::lighting::PointLight;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::phase::Phase;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::task::{MediumProbe, Task};
+use mcbench_core::testbed::{MediumQuantity, TestBed};
 
 /// The geometry of one pixel's integral: the primary ray's medium segment and the light.
 #[derive(Clone, Copy, Debug)]
@@ -222,7 +222,7 @@ impl Estimator for SingleScatterOr {
             self.other.validate(bed)
         }
     }
-    fn sample_moments(&self, task: &Task<'_>) -> Option<crate::media::moments::EstimateMoments> {
+    fn sample_moments(&self, task: &Task<'_>) -> Option<mcbench_core::estimator::EstimateMoments> {
         self.pick(task).sample_moments(task)
     }
 }

@@ -2,10 +2,10 @@
 //! tracking, so each struct lists [`ResidualParams`]' fields (`attenuation_driven` takes exactly
 //! those) beside its own; `mis` fixes `control` at its default.
 
-use crate::error::ConfigError;
-use crate::params::{check_count, ParamSet};
 use crate::tracking::params::ResidualParams;
 use crate::tracking::residual_ratio_tracking::ResidualRatioTracking;
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::{check_count, ParamSet};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -265,7 +265,7 @@ impl ParamSet for MisParams {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::params::describe;
+    use mcbench_core::params::describe;
 
     /// The tracking fields every struct lists read as [`ResidualParams`]' do: same docs (up to
     /// `mis`'s "On single scattering: " prefix), same defaults.

@@ -8,11 +8,11 @@
 
 use super::transmittance::PrimaryTracker;
 use super::{Geometry, ShadowRays};
-use crate::error::EstimateError;
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::task::MediumProbe;
 use crate::tracking::residual_ratio_tracking::ResidualRatioTracking;
+use mcbench_core::error::EstimateError;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::task::MediumProbe;
 
 /// Per-pixel state: the primary ray's tracker and the shadow rays.
 pub struct PointEstimator {

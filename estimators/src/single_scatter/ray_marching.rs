@@ -16,14 +16,14 @@
 //! exactly one primary ray is marched.
 
 use super::{run, setup, supports_single_scatter, Geometry};
-use crate::budget::BudgetKind;
-use crate::error::EstimateError;
-use crate::estimator::Estimator;
-use crate::math::{Rgb, Vec3};
-use crate::quadrature::gauss_legendre;
-use crate::rng::StreamRng;
-use crate::task::{MediumProbe, Task};
-use crate::testbed::TestBed;
+use mcbench_core::budget::BudgetKind;
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::quadrature::gauss_legendre;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::{MediumProbe, Task};
+use mcbench_core::testbed::TestBed;
 use rand::Rng;
 
 /// The estimator.

@@ -10,16 +10,16 @@
 use super::params::ScatteringDrivenParams;
 use super::points::PointEstimator;
 use super::{run, supports_single_scatter, Geometry};
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::task::Task;
-use crate::testbed::{Needs, TestBed};
 use crate::tracking::residual_ratio_tracking::ResidualRatioTracking;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{Needs, TestBed};
 use rand::Rng;
 
 /// Registry entry.

@@ -1,22 +1,22 @@
 //! `source_driven` (paper 002 §4.3, \[KF12\]): per primary ray, `points` scattering points
 //! (default one) from the equiangular (Cauchy) density mimicking `1 / (D^2 + (t - t_l)^2)`
-//! ([`crate::samplers::equiangular`]), drawn before the primary ray is tracked; the integrand at
+//! ([`mcbench_core::samplers::equiangular`]), drawn before the primary ray is tracked; the integrand at
 //! each by the continuous transmittance and a residual-ratio-tracking shadow ray
 //! ([`super::points`]); estimate `(1/n) sum f(t_i) / p(t_i)`.
 
 use super::params::SourceDrivenParams;
 use super::points::PointEstimator;
 use super::{run, supports_single_scatter, Geometry};
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::equiangular::Equiangular;
-use crate::task::Task;
-use crate::testbed::{Needs, TestBed};
 use crate::tracking::residual_ratio_tracking::ResidualRatioTracking;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::equiangular::Equiangular;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{Needs, TestBed};
 use rand::Rng;
 
 /// Registry entry.

@@ -1,15 +1,15 @@
 //! Unbiasedness (book: statistics.md), stability (book: stability.md), refusals and costs of the single-scatter
 //! estimators, on `eq21-medium/single-scatter` (exact references by nested quadrature).
 
-use crate::budget::{Budget, BudgetKind};
-use crate::estimator::{Bias, Estimator};
-use crate::media::{Field, MediumBed};
-use crate::params::Params;
-use crate::registry::{self, ESTIMATORS};
-use crate::rng::stream;
-use crate::stats::{holm_bonferroni, one_sample_t, Moments};
-use crate::task::Task;
-use crate::testbed::TestBed;
+use crate::builtins::{self, ESTIMATORS};
+use crate::testbeds::medium::{Field, MediumBed};
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 
 /// The ids of paper 002 Fig. 12.
 const IDS: [&str; 7] = [
@@ -23,11 +23,11 @@ const IDS: [&str; 7] = [
 ];
 
 fn build(id: &str, p: Params) -> Box<dyn Estimator> {
-    (registry::estimator(id).unwrap().build)(&p).unwrap()
+    (builtins::estimator(id).unwrap().build)(&p).unwrap()
 }
 
 fn bed(params: Params) -> MediumBed {
-    MediumBed::new(Field::Eq21, "single-scatter", &params, &crate::references::repository::Repository).unwrap()
+    MediumBed::new(Field::Eq21, "single-scatter", &params, &crate::repository::Repository).unwrap()
 }
 
 /// Per-pixel moments of `reps` estimates of `spp` primary rays each (pixels `pixels`).
@@ -72,7 +72,7 @@ fn unbiased_ids_pass_and_ray_marching_is_flagged() {
     let pixels: Vec<usize> = (0..16).filter(|i| ![0, 3, 12, 15].contains(i)).collect();
     for (b, bed) in beds.iter().enumerate() {
         for (k, id) in IDS.iter().enumerate().skip(1) {
-            assert_eq!(registry::estimator(id).unwrap().bias, Bias::Unbiased);
+            assert_eq!(builtins::estimator(id).unwrap().bias, Bias::Unbiased);
             let m = moments(bed, build(id, Params::new()).as_ref(), &pixels, 400, 4, 1000 * b as u64 + 50 * k as u64);
             let p = holm_p(bed, &m, &pixels);
             assert!(p > 1e-3, "{id} on bed {b}: Holm p = {p:e}");
@@ -88,9 +88,7 @@ fn unbiased_ids_pass_and_ray_marching_is_flagged() {
 /// fetch budgets make the ray count a stopping time; these budgets do not).
 #[test]
 fn unbiased_ids_pass_on_the_perlin_medium() {
-    let bed =
-        MediumBed::new(Field::Perlin, "single-scatter", &Params::new(), &crate::references::repository::Repository)
-            .unwrap();
+    let bed = MediumBed::new(Field::Perlin, "single-scatter", &Params::new(), &crate::repository::Repository).unwrap();
     let pixels: Vec<usize> = (0..16).filter(|i| ![0, 3, 12, 15].contains(i)).collect();
     for (k, id) in IDS.iter().enumerate().skip(1) {
         let m = moments(&bed, build(id, Params::new()).as_ref(), &pixels, 300, 4, 500 + 50 * k as u64);
@@ -153,7 +151,7 @@ fn bad_input_is_refused_naming_the_field() {
         Field::Eq21,
         "single-scatter",
         &Params::new().with("resolution", 4.0).with("light_x", -2.5).with("light_z", 12.5),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .err()
     .map(|e| e.to_string())
@@ -163,7 +161,7 @@ fn bad_input_is_refused_naming_the_field() {
         Field::Eq21,
         "transmittance",
         &Params::new().with("light_x", 1.0),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .err()
     .map(|e| e.to_string());
@@ -177,11 +175,11 @@ fn bad_input_is_refused_naming_the_field() {
         ("ray_marching", Params::new().with("step", 0.0), "ray_marching.step"),
         ("ray_marching", Params::new().with("jitter", 0.5), "ray_marching.jitter"),
     ] {
-        let err = (registry::estimator(id).unwrap().build)(&p).err().map(|e| e.to_string()).unwrap_or_default();
+        let err = (builtins::estimator(id).unwrap().build)(&p).err().map(|e| e.to_string()).unwrap_or_default();
         assert!(err.contains(field), "{id}: {err}");
     }
     // The shared ids still take their other halves' parameters.
-    assert!((registry::estimator("mis").unwrap().build)(&Params::new().with("power", 2.0)).is_ok());
+    assert!((builtins::estimator("mis").unwrap().build)(&Params::new().with("power", 2.0)).is_ok());
     let bed = bed(Params::new().with("resolution", 4.0));
     let err = build("delta_tracking", Params::new().with("sigma_samp", 0.5)).validate(&bed).unwrap_err().to_string();
     assert!(err.contains("delta_tracking.sigma_samp"), "{err}");
@@ -196,13 +194,13 @@ fn supports_accepts_the_single_scatter_ids_only() {
         Field::Eq21,
         "transmittance",
         &Params::new().with("resolution", 2.0),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .unwrap();
-    let checker = (registry::testbed("checker-direct").unwrap().build)(
+    let checker = (builtins::testbed("checker-direct").unwrap().build)(
         "default",
         &Params::new().with("resolution", 2.0),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .unwrap();
     for entry in ESTIMATORS {
@@ -211,7 +209,7 @@ fn supports_accepts_the_single_scatter_ids_only() {
         assert_eq!(runs, IDS.contains(&entry.id), "{} on single-scatter", entry.id);
     }
     for id in ["attenuation_driven", "attenuation_driven_sir", "source_driven", "scattering_driven"] {
-        let entry = registry::estimator(id).unwrap();
+        let entry = builtins::estimator(id).unwrap();
         let est = (entry.build)(&Params::new()).unwrap();
         assert!(entry.skip_reason(transmittance.provides()).is_some() || est.supports(&transmittance).is_err(), "{id}");
     }

@@ -11,12 +11,12 @@
 //! every scattering point at or before `end`.
 
 use super::Geometry;
-use crate::error::EstimateError;
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::task::MediumProbe;
 use crate::tracking::residual_ratio_tracking::{main_part, RecentMaximum, ResidualRatioTracking};
 use crate::tracking::{track, Interaction, Rule};
+use mcbench_core::error::EstimateError;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::task::MediumProbe;
 
 /// The primary ray's tracker of one pixel: the main part through explorer points (built once per
 /// pixel, cheap fetches) and the recent-maximum `sigma_samp`.
@@ -102,12 +102,12 @@ impl Track<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::budget::Budget;
-    use crate::media::{Field, MediumBed};
-    use crate::params::Params;
-    use crate::rng::stream;
-    use crate::stats::{holm_bonferroni, one_sample_t, Moments};
-    use crate::task::Task;
+    use crate::testbeds::medium::{Field, MediumBed};
+    use mcbench_core::budget::Budget;
+    use mcbench_core::params::Params;
+    use mcbench_core::rng::stream;
+    use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
+    use mcbench_core::task::Task;
 
     /// The continuous estimate is unbiased at points between interactions (not only at the
     /// tracked segment's end): one run of the central ray's [0, 20] per repetition, T^(s) read at
@@ -121,13 +121,15 @@ mod tests {
             Field::Eq21,
             "central-ray",
             &Params::new().with("points", 10.0),
-            &crate::references::repository::Repository,
+            &crate::repository::Repository,
         )
         .unwrap();
-        let z = crate::math::Vec3::Z;
+        let z = mcbench_core::math::Vec3::Z;
         let exact: Vec<f64> = points
             .iter()
-            .map(|&s| (-crate::media::reference::optical_depth(&bed, Default::default(), z, 0.0, s).value).exp())
+            .map(|&s| {
+                (-crate::testbeds::medium::reference::optical_depth(&bed, Default::default(), z, 0.0, s).value).exp()
+            })
             .collect();
         let task = Task::new(&bed, 9, Budget::samples(1).unwrap());
         let probe = task.medium().unwrap();
@@ -136,11 +138,11 @@ mod tests {
             origin: ray.origin,
             dir: ray.dir,
             seg: (0.0, 20.0),
-            light: crate::media::LIGHT,
+            light: crate::testbeds::medium::LIGHT,
             t_l: 10.0,
             d: 1.0,
             albedo: 0.7,
-            phase: crate::phase::Phase::Rayleigh,
+            phase: mcbench_core::phase::Phase::Rayleigh,
         };
         let cfg = ResidualRatioTracking {
             spacing: 2.0,

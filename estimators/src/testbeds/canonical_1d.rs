@@ -16,11 +16,11 @@
 //! scene has no approximate extinction, so explorer points of control variates cost full fetches.
 
 use super::canonical_profiles::Profile;
-use crate::error::ConfigError;
-use crate::math::{Rgb, Vec3};
-use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
-use crate::registry::{BedCase, CaseRole, TestBedEntry};
-use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, ReferenceKind, TestBed};
+use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, ReferenceKind, TestBed};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -239,11 +239,11 @@ impl MediumScene for Canonical1d {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::budget::Budget;
-    use crate::registry;
-    use crate::rng::stream;
-    use crate::stats::{holm_bonferroni, one_sample_t, Moments};
-    use crate::task::Task;
+    use crate::builtins;
+    use mcbench_core::budget::Budget;
+    use mcbench_core::rng::stream;
+    use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
+    use mcbench_core::task::Task;
 
     #[test]
     fn variants_parse_and_references_hit_their_targets() {
@@ -269,7 +269,7 @@ mod tests {
     /// lies on its grid (checked on the constant profile: every estimate equals the reference).
     #[test]
     fn trackers_run_unchanged_and_ray_marching_is_exact_only_on_aligned_profiles() {
-        let delta = (registry::estimator("delta_tracking").unwrap().build)(&Params::new()).unwrap();
+        let delta = (builtins::estimator("delta_tracking").unwrap().build)(&Params::new()).unwrap();
         let mut ps = Vec::new();
         for p in Profile::ALL {
             let bed = Canonical1d::new(&variant_name(p, 0.5), &Params::new().with("points", 4.0)).unwrap();
@@ -285,7 +285,7 @@ mod tests {
         }
         let min_p = holm_bonferroni(&ps).into_iter().fold(1.0, f64::min);
         assert!(min_p > 1e-3, "delta tracking flagged on canonical-1d: {min_p:e}");
-        let marching = (registry::estimator("ray_marching").unwrap().build)(&Params::new()).unwrap();
+        let marching = (builtins::estimator("ray_marching").unwrap().build)(&Params::new()).unwrap();
         let run = |v: &str| {
             let bed = Canonical1d::new(v, &Params::new()).unwrap();
             let mut m = Moments::default();

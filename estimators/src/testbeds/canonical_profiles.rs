@@ -22,7 +22,7 @@
 //! marcher with `n` steps is exact unless `n` divides `m` (the periodic rectangle rule integrates
 //! `cos(2 pi m t)` exactly), which a first version with three periods showed (exact with 2 steps).
 
-use crate::math::erf;
+use mcbench_core::math::erf;
 use std::f64::consts::PI;
 
 /// One canonical extinction profile.
@@ -149,7 +149,7 @@ impl Profile {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quadrature::gauss_kronrod_multi;
+    use mcbench_core::quadrature::gauss_kronrod_multi;
 
     fn quad(p: Profile, s: f64) -> f64 {
         let mut breaks = vec![0.0];

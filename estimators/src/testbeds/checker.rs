@@ -24,13 +24,13 @@
 
 use super::checker_reference::reference;
 use super::pinhole::Pinhole;
-use crate::brdf::Phong;
-use crate::error::ConfigError;
-use crate::lighting::RectLight;
-use crate::math::{Rgb, Vec3};
-use crate::params::{check_count, parse, ParamSet, ParamSpec, Params};
-use crate::registry::{BedCase, CaseRole, TestBedEntry};
-use crate::testbed::{HemisphereScene, Needs, Reference, ShadingPoint, TestBed};
+use mcbench_core::brdf::Phong;
+use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::lighting::RectLight;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{check_count, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::testbed::{HemisphereScene, Needs, Reference, ShadingPoint, TestBed};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 

@@ -7,7 +7,7 @@
 //! One *pixel sample* is a position in the footprint plus one MIS direct-lighting estimate with
 //! `light_samples` (default 8, paper 003's Buddha: "8 lighting samples for each pixel sample")
 //! light samples, each paired with a BRDF sample and combined by the balance heuristic (the
-//! `mis` baseline's round, [`crate::lighting::mis_round`]). Its expectation over the MIS
+//! `mis` baseline's round, [`mcbench_core::lighting::mis_round`]). Its expectation over the MIS
 //! randomness is `L(x)`, so the mean over uniform footprint positions is `I_p`: image-plane
 //! samplers (`uniform_image`, `pmc_ip`) only choose where the pixel samples go.
 //!
@@ -20,14 +20,14 @@
 //! resolution in the reference source the caller gives.
 
 use super::checker::{CheckerGeometry, ENTRY as DIRECT};
-use crate::error::ConfigError;
-use crate::lighting::{light_selection, mis_round, MisStrategy};
-use crate::math::{Rgb, Vec3};
-use crate::params::{check_count, parse, ParamSet, ParamSpec, Params};
-use crate::references::{ReferenceKey, ReferenceSource};
-use crate::registry::{BedCase, CaseRole, TestBedEntry};
-use crate::rng::StreamRng;
-use crate::testbed::{ImagePlaneScene, Needs, Reference, ShadingPoint, TestBed};
+use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::lighting::{light_selection, mis_round, MisStrategy};
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{check_count, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::references::{ReferenceKey, ReferenceSource};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::testbed::{ImagePlaneScene, Needs, Reference, ShadingPoint, TestBed};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -94,7 +94,8 @@ impl CheckerImage {
     /// sample change its variance, not its expectation).
     pub fn new(variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let bed = Self::without_reference(variant, params)?;
-        let reference = crate::references::load(refs, &bed.reference_key(), bed.size * bed.size, bed.resolution())?;
+        let reference =
+            mcbench_core::references::load(refs, &bed.reference_key(), bed.size * bed.size, bed.resolution())?;
         Ok(CheckerImage { reference, ..bed })
     }
 
@@ -199,9 +200,9 @@ impl ImagePlaneScene for CheckerImage {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::stream;
-    use crate::stats::Moments;
     use crate::testbeds::checker::CheckerDirect;
+    use mcbench_core::rng::stream;
+    use mcbench_core::stats::Moments;
 
     /// At a pixel centre, the mean of many pixel samples is the exact direct lighting of
     /// `checker-direct` at the same point (the MIS estimate is unbiased), for a diffuse, a glossy
@@ -235,14 +236,10 @@ mod tests {
         assert!(e.err().unwrap().to_string().contains("checker-image/nope"));
         // No reference is stored at resolution 7 (the error names the resolution, or the missing
         // file when no reference is stored at all).
-        let e = CheckerImage::new(
-            "default",
-            &Params::new().with("resolution", 7.0),
-            &crate::references::repository::Repository,
-        )
-        .err()
-        .unwrap()
-        .to_string();
+        let e = CheckerImage::new("default", &Params::new().with("resolution", 7.0), &crate::repository::Repository)
+            .err()
+            .unwrap()
+            .to_string();
         assert!(e.contains("resolution") || e.contains("checker-image_default.json"), "{e}");
     }
 }

@@ -4,13 +4,13 @@
 //! [--samples N]`; the command, seed and sample count are stored in the file.
 
 use super::checker_image::CheckerImage;
-use crate::error::ConfigError;
-use crate::math::Rgb;
-use crate::params::Params;
-use crate::references::{ReferenceKey, StoredReference};
-use crate::rng::StreamKey;
-use crate::stats::Moments;
-use crate::testbed::{ImagePlaneScene, Reference, ReferenceKind, TestBed};
+use mcbench_core::error::ConfigError;
+use mcbench_core::math::Rgb;
+use mcbench_core::params::Params;
+use mcbench_core::references::{ReferenceKey, StoredReference};
+use mcbench_core::rng::StreamKey;
+use mcbench_core::stats::Moments;
+use mcbench_core::testbed::{ImagePlaneScene, Reference, ReferenceKind, TestBed};
 
 /// The variance of one pixel sample of every pixel (mean over the channels), from a reference
 /// made here: its standard error is that of the mean of all its samples, `sigma / sqrt(samples)`,
@@ -70,7 +70,7 @@ pub fn compute_reference(
         }
         (Rgb([m[0].mean(), m[1].mean(), m[2].mean()]), Rgb([m[0].std_err(), m[1].std_err(), m[2].std_err()]))
     };
-    let results = crate::parallel::map_indices(n, threads, pixel);
+    let results = mcbench_core::parallel::map_indices(n, threads, pixel);
     if results.iter().any(|(m, se)| !m.is_finite() || !se.is_finite()) {
         return Err(ConfigError::invalid("reference", variant, "a pixel's estimate was not finite"));
     }

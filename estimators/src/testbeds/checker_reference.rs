@@ -17,10 +17,10 @@
 //!   independent brute-force quadrature is below it and below 1e-9 relative.
 
 use super::checker::CheckerGeometry;
-use crate::lighting::RectLight;
-use crate::math::{Rgb, Vec3};
-use crate::quadrature::gauss_legendre;
-use crate::testbed::{Reference, ReferenceKind, ShadingPoint};
+use mcbench_core::lighting::RectLight;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::quadrature::gauss_legendre;
+use mcbench_core::testbed::{Reference, ReferenceKind, ShadingPoint};
 
 /// Relative tolerance per pixel (the test bed promises 1e-9).
 const REL_TOL: f64 = 1e-11;

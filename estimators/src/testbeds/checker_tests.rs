@@ -1,9 +1,9 @@
 //! Tests of the checker scene and its quadrature reference.
 
 use super::*;
-use crate::params::Params;
-use crate::testbed::{HemisphereScene, TestBed};
 use crate::testbeds::checker::CheckerDirect;
+use mcbench_core::params::Params;
+use mcbench_core::testbed::{HemisphereScene, TestBed};
 
 /// Independent brute force: a uniform grid of `nx x ny` cells per light, 10-point Gauss-Legendre
 /// per cell and axis, visibility by the scene's own ray cast at every node.
@@ -60,7 +60,7 @@ fn probe_pixels(bed: &CheckerDirect) -> Vec<usize> {
 fn unoccluded_reference_is_within_its_bound_and_1e_9_relative() {
     let bed = CheckerDirect::new("default", &Params::new().with("resolution", 24.0)).unwrap();
     let geo = bed.geometry();
-    let crate::testbed::ReferenceKind::Exact { bound, .. } = bed.reference().kind.clone() else { panic!() };
+    let mcbench_core::testbed::ReferenceKind::Exact { bound, .. } = bed.reference().kind.clone() else { panic!() };
     for i in probe_pixels(&bed) {
         let p = bed.shading(i);
         let r = bed.reference().value[i][0];
@@ -189,7 +189,7 @@ fn uncovered_rectangles_tile_the_lit_part_of_the_light() {
     ];
     let parts = uncovered(light, &shadows);
     let inside = |r: &Rect, u: f64, v: f64| r.x0 < u && u < r.x1 && r.y0 < v && v < r.y1;
-    let mut rng = crate::rng::stream(3, "uncovered");
+    let mut rng = mcbench_core::rng::stream(3, "uncovered");
     for _ in 0..20_000 {
         use rand::Rng;
         let (u, v) = (rng.gen_range(-1.0..1.0), rng.gen_range(-0.5..1.5));

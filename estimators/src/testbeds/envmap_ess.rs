@@ -26,9 +26,9 @@
 
 use super::envmap_reference::TexelTable;
 use super::envmap_sequence::EnvmapSequence;
-use crate::error::ConfigError;
-use crate::params::Params;
-use crate::testbed::{EnvSequenceScene, TestBed};
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::Params;
+use mcbench_core::testbed::{EnvSequenceScene, TestBed};
 use rayon::prelude::*;
 use std::f64::consts::TAU;
 
@@ -43,9 +43,9 @@ pub fn expected_ess(bed: &EnvmapSequence, table: &TexelTable, pixel: usize, fram
     let g = prev.map.grid();
     let point = bed.shading(pixel);
     // Frame n-1's map coordinates: the shading point rotated by -rotation (as the reference does).
-    let rot = |v: crate::math::Vec3| {
+    let rot = |v: mcbench_core::math::Vec3| {
         let (s, c) = (-prev.rotation).sin_cos();
-        crate::math::Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
+        mcbench_core::math::Vec3::new(c * v.x - s * v.y, s * v.x + c * v.y, v.z)
     };
     let (n, wo) = (rot(point.normal), rot(point.wo));
     let r = wo.reflect(n);
@@ -135,7 +135,7 @@ pub fn expected_resampled_share(params: &Params, variant: &str) -> Result<f64, C
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::Vec3;
+    use mcbench_core::math::Vec3;
 
     fn params(rotation: f64) -> Params {
         Params::new()
@@ -177,9 +177,9 @@ mod tests {
         let table = TexelTable::new(g.width, g.height);
         let exact = expected_ess(&bed, &table, 4, 1);
         let (prev, next, point) = (bed.environment(0), bed.environment(1), bed.shading(4));
-        let mut rng = crate::rng::stream(3, "ess");
+        let mut rng = mcbench_core::rng::stream(3, "ess");
         let (mut z, mut m1, mut m2) = (0.0, 0.0, 0.0);
-        let target = |env: &crate::envmap::EnvFrame<'_>, w: Vec3| {
+        let target = |env: &mcbench_core::envmap::EnvFrame<'_>, w: Vec3| {
             let cos = w.dot(point.normal);
             if cos <= 0.0 {
                 0.0
@@ -203,7 +203,7 @@ mod tests {
 
     /// The table of expected shares against rotation at the `envmap-smc` quick size (10x10
     /// pixels, 6 frames); seconds in a release build:
-    /// `cargo test --release -p estimators expected_share_table -- --ignored --nocapture`.
+    /// `cargo test --release -p mcbench-papers expected_share_table -- --ignored --nocapture`.
     #[test]
     #[ignore = "prints a table for the docs; about 2 min in a release build"]
     fn expected_share_table() {

@@ -24,11 +24,11 @@
 //! more panels per texel (the bound is 1e-9: the rules used should reach it on smooth
 //! texels, but the brute force cannot show it, so it is not claimed).
 
-use crate::brdf::Phong;
-use crate::envmap::EnvFrame;
-use crate::math::{Rgb, Vec3};
-use crate::quadrature::gauss_legendre;
-use crate::testbed::ShadingPoint;
+use mcbench_core::brdf::Phong;
+use mcbench_core::envmap::EnvFrame;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::quadrature::gauss_legendre;
+use mcbench_core::testbed::ShadingPoint;
 use std::f64::consts::{PI, TAU};
 
 /// Relative quadrature accuracy promised beyond the skipped mass (the level the tests check).

@@ -1,7 +1,7 @@
 //! `envmap-sequence` (paper 004; book: testbeds.md): an orthographic view of a unit sphere (one shading
 //! point per pixel, default 32x32, view along +y; the image covers the square inscribed in the
 //! sphere's disc so every pixel centre hits it) with a modified-Phong BRDF, lit by a lat-long
-//! environment map (256x128 texels tabulated from [`crate::envmap::sky::Sky`]) rotating by
+//! environment map (256x128 texels tabulated from [`crate::testbeds::sky::Sky`]) rotating by
 //! 1.5 degrees a frame about +z for F = 10 frames; an infinite ground plane at z = -1 gives
 //! `V = 1` iff `w_z >= 0`.
 //!
@@ -10,7 +10,7 @@
 //! are exact per texel ([`super::envmap_reference`]).
 //!
 //! The `moving` variants keep the `mixed` BRDF under a map closer to paper 004 §7's
-//! ([`crate::envmap::moving_sky::MovingSky`]): five narrow bright lobes off the rotation axis at
+//! ([`crate::testbeds::moving_sky::MovingSky`]): five narrow bright lobes off the rotation axis at
 //! elevations 8 to 62 degrees over a dim background brighter on one side, so the rotation moves
 //! the target's mass (under the default sky only the sun moves it). The expected share of pixels
 //! the SMC reweighting must resample is computed exactly in [`super::envmap_ess`].
@@ -28,16 +28,16 @@
 //! `env_height` (128, even).
 
 use super::envmap_reference::{PixelReference, TexelTable};
-use crate::brdf::Phong;
-use crate::envmap::moving_sky::MovingSky;
-use crate::envmap::sky::{Sky, SkyModel};
-use crate::envmap::{EnvFrame, EnvMap};
-use crate::error::ConfigError;
-use crate::math::{Rgb, Vec3};
-use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
-use crate::references::{ReferenceKey, ReferenceSource};
-use crate::registry::{BedCase, CaseRole, TestBedEntry};
-use crate::testbed::{EnvQuantity, EnvSequenceScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
+use crate::testbeds::moving_sky::MovingSky;
+use crate::testbeds::sky::{Sky, SkyModel};
+use mcbench_core::brdf::Phong;
+use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
+use mcbench_core::envmap::{EnvFrame, EnvMap};
+use mcbench_core::error::ConfigError;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::references::{ReferenceKey, ReferenceSource};
+use mcbench_core::testbed::{EnvQuantity, EnvSequenceScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
 use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -47,6 +47,18 @@ use serde::{Deserialize, Serialize};
 const ENVMAP_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1500, 20_000) };
 
 /// Registry entry.
+///
+/// ```
+/// use mcbench_papers::builtins::testbed;
+/// use mcbench_core::params::Params;
+///
+/// let params = Params::new().with("resolution", 2.0).with("frames", 3.0).with("env_width", 16.0).with("env_height", 8.0);
+/// let bed = testbed("envmap-sequence").unwrap().build_exact("mixed", &params).unwrap();
+/// let env = bed.env_sequence().unwrap();
+/// assert_eq!((env.frames(), bed.integrals()), (3, 2 * 2 * 3));
+/// let sun_side = env.environment(0).radiance(mcbench_core::math::Vec3::new(0.0, 0.0, 1.0));
+/// assert!(sun_side.is_finite());
+/// ```
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "envmap-sequence",
     variants: &["specular", "mixed", "specular-lns", "mixed-lns", "moving", "moving-lns", "moving-wall"],
@@ -188,15 +200,15 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
 impl EnvmapSequence {
     /// Builds a variant and computes its exact reference (parallel over pixels).
     pub fn new(variant: &str, params: &Params) -> Result<Self, ConfigError> {
-        Self::with_references(variant, params, &crate::references::NoReferences)
+        Self::with_references(variant, params, &mcbench_core::references::NoReferences)
     }
 
     /// Builds a variant with its exact reference: the one stored in `refs` under its key when it
-    /// was made by the current quadrature ([`crate::references::stored_exact`]: the quadrature
+    /// was made by the current quadrature ([`mcbench_core::references::stored_exact`]: the quadrature
     /// over every texel takes seconds per setup at every run), else computed.
     pub fn with_references(variant: &str, params: &Params, refs: &dyn ReferenceSource) -> Result<Self, ConfigError> {
         let mut bed = Self::without_reference(variant, params)?;
-        bed.reference = match crate::references::stored_exact(
+        bed.reference = match mcbench_core::references::stored_exact(
             refs,
             &bed.key,
             METHOD,
@@ -262,7 +274,7 @@ impl EnvmapSequence {
     /// and setup (the quadrature over every texel takes seconds; an experiment builds the bed per
     /// plan and seed).
     pub fn pixel_references(&self) -> Vec<PixelReference> {
-        static COMPUTED: crate::memo::Memo<Vec<PixelReference>> = crate::memo::Memo::new();
+        static COMPUTED: mcbench_core::memo::Memo<Vec<PixelReference>> = mcbench_core::memo::Memo::new();
         COMPUTED.get_or_compute(self.setup.clone(), || self.compute_pixel_references())
     }
 

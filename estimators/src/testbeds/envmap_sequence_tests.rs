@@ -2,8 +2,8 @@
 //! quadrature, parameters, stored references.
 
 use super::*;
-use crate::quadrature::gauss_legendre;
 use crate::testbeds::envmap_reference::WALL_QUADRATURE_REL_ERROR;
+use mcbench_core::quadrature::gauss_legendre;
 use std::f64::consts::{PI, TAU};
 
 fn small(variant: &str, extra: Params) -> EnvmapSequence {
@@ -33,7 +33,7 @@ fn brute(bed: &EnvmapSequence, i: usize, sub: usize) -> (Rgb, Rgb) {
                 let th = (a as f64 + 0.5 + 0.5 * xi) * dt;
                 for (xj, wj) in x.iter().zip(&w) {
                     let ph = (b as f64 + 0.5 + 0.5 * xj) * dp + env.rotation;
-                    let d = crate::samplers::spherical_direction(th.cos(), ph);
+                    let d = mcbench_core::samplers::spherical_direction(th.cos(), ph);
                     let cos = d.dot(p.normal);
                     if cos <= 0.0 {
                         continue;
@@ -180,7 +180,7 @@ fn bad_parameters_are_refused_naming_the_field() {
 /// one of another method is ignored.
 #[test]
 fn a_stored_reference_is_read_when_made_by_the_same_method() {
-    use crate::references::{InMemory, StoredReference};
+    use mcbench_core::references::{InMemory, StoredReference};
     let bed = small("mixed", Params::new());
     let key = bed.reference_key().expect("a key");
     let mut stored = StoredReference {

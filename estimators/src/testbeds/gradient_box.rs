@@ -20,14 +20,14 @@
 //! The whole image is one sequence ([`TestBed::sequence_length`] = pixels): estimators that share
 //! one adaptive structure across the image (paper 000 §4.3) get every pixel's task at once.
 
-use crate::error::ConfigError;
-use crate::lighting::Gradient;
-use crate::math::{Rgb, Vec3};
-use crate::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
-use crate::phase::Phase;
-use crate::references::{ReferenceKey, ReferenceSource};
-use crate::registry::{BedCase, CaseRole, TestBedEntry};
-use crate::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, ReferenceKind, TestBed};
+use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::lighting::Gradient;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::phase::Phase;
+use mcbench_core::references::{ReferenceKey, ReferenceSource};
+use mcbench_core::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, ReferenceKind, TestBed};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -135,7 +135,7 @@ impl GradientBox {
                 let t = (-bed.setup.sigma_t).exp();
                 bed.exact(bed.setup.background.c0 * t, "no scattering: exp(-sigma_t) L_b(+y)")
             }
-            _ => crate::references::load(refs, &bed.reference_key(), bed.size * bed.size, bed.resolution())?,
+            _ => mcbench_core::references::load(refs, &bed.reference_key(), bed.size * bed.size, bed.resolution())?,
         };
         Ok(GradientBox { reference, ..bed })
     }

@@ -21,14 +21,14 @@
 //! per-channel standard error. Made by `mcbench reference gradient-box --variant V [--samples N]`.
 
 use super::gradient_box::GradientBox;
-use crate::error::ConfigError;
-use crate::lighting::Gradient;
-use crate::math::{Rgb, Vec3};
-use crate::params::Params;
-use crate::phase::Phase;
-use crate::references::{ReferenceKey, StoredReference};
-use crate::rng::StreamKey;
-use crate::testbed::{Reference, ReferenceKind, TestBed};
+use mcbench_core::error::ConfigError;
+use mcbench_core::lighting::Gradient;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::Params;
+use mcbench_core::phase::Phase;
+use mcbench_core::references::{ReferenceKey, StoredReference};
+use mcbench_core::rng::StreamKey;
+use mcbench_core::testbed::{Reference, ReferenceKind, TestBed};
 use rand::Rng;
 use std::f64::consts::PI;
 
@@ -202,7 +202,8 @@ pub fn compute_reference(
     let s = bed.setup();
     let medium = BoxMedium { sigma_t: s.sigma_t, albedo: s.albedo, phase: s.phase, background: s.background };
     let label = format!("gradient-box/{variant}/independent-reference");
-    let results = crate::parallel::map_indices(size * size, threads, |i| pixel(&medium, size, i, per_batch, &label));
+    let results =
+        mcbench_core::parallel::map_indices(size * size, threads, |i| pixel(&medium, size, i, per_batch, &label));
     if results.iter().any(|(m, e)| !m.is_finite() || !e.is_finite()) {
         return Err(ConfigError::invalid("reference", variant, "a pixel's estimate was not finite"));
     }
@@ -233,7 +234,7 @@ pub fn compute_reference(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testbed::MediumScene;
+    use mcbench_core::testbed::MediumScene;
 
     fn medium(variant: &str) -> BoxMedium {
         let s = super::super::gradient_box::variant_setup(variant).unwrap();

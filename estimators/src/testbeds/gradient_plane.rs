@@ -8,13 +8,13 @@
 
 use super::phong_lobe::clipped_lobe_moments;
 use super::pinhole::Pinhole;
-use crate::brdf::Phong;
-use crate::error::ConfigError;
-use crate::lighting::Gradient;
-use crate::math::{Rgb, Vec3};
-use crate::params::{check_count, parse, ParamSet, ParamSpec, Params};
-use crate::registry::{BedCase, CaseRole, TestBedEntry};
-use crate::testbed::{HemisphereScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
+use mcbench_core::brdf::Phong;
+use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
+use mcbench_core::error::ConfigError;
+use mcbench_core::lighting::Gradient;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{check_count, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::testbed::{HemisphereScene, Needs, Reference, ReferenceKind, ShadingPoint, TestBed};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -23,6 +23,16 @@ use serde::{Deserialize, Serialize};
 pub const SURFACE_PART: CaseRole = CaseRole::Unbiasedness { samples: 64, reps: (512, 8192) };
 
 /// Registry entry.
+///
+/// ```
+/// use mcbench_papers::builtins::testbed;
+/// use mcbench_core::params::Params;
+/// let bed = testbed("gradient-plane").unwrap().build_exact("diffuse", &Params::new().with("resolution", 4.0)).unwrap();
+/// assert_eq!(bed.integrals(), 16);
+/// assert!(bed.reference().is_exact());
+/// // A diffuse pixel integrates to kd (c0 + 2 c1 / 3) in closed form (red: 0.8 * (1 + 2/3)).
+/// assert!((bed.reference().value[0][0] - 0.8 * (1.0 + 2.0 / 3.0)).abs() < 1e-12);
+/// ```
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "gradient-plane",
     variants: &["default", "diffuse", "glossy", "stiff"],
@@ -162,7 +172,7 @@ impl HemisphereScene for GradientPlane {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quadrature::gauss_legendre;
+    use mcbench_core::quadrature::gauss_legendre;
 
     /// Every primary ray hits the plane in front of the camera.
     #[test]
@@ -188,7 +198,7 @@ mod tests {
                         let c = (a as f64 + 0.5 + 0.5 * xi) / nc as f64;
                         for (xj, wj) in x.iter().zip(&w) {
                             let phi = (b as f64 + 0.5 + 0.5 * xj) / np as f64 * std::f64::consts::TAU;
-                            let d = crate::samplers::spherical_direction(c, phi);
+                            let d = mcbench_core::samplers::spherical_direction(c, phi);
                             let f = bed.incident(i, d) * p.brdf.eval(d, p.wo, p.normal) * c;
                             sum += f * (wi * wj * 0.25 / nc as f64 * std::f64::consts::TAU / np as f64);
                         }

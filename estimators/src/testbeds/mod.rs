@@ -1,4 +1,6 @@
-//! The analytic test beds (book: testbeds.md), each with its exact or stored reference.
+//! The test beds (book: testbeds.md), each with its exact or stored reference: `gradient-plane`,
+//! `gradient-box`, `envmap-sequence`, `checker-direct`, `checker-image`, `eq21-medium` and
+//! `perlin-medium` ([`medium`]), `canonical-1d`.
 
 pub mod canonical_1d;
 pub mod canonical_profiles;
@@ -12,5 +14,8 @@ pub mod envmap_sequence;
 pub mod gradient_box;
 pub mod gradient_box_independent;
 pub mod gradient_plane;
+pub mod medium;
+pub mod moving_sky;
 pub mod phong_lobe;
 pub mod pinhole;
+pub mod sky;

@@ -15,8 +15,8 @@
 //! the peak of width `~ 1 / sqrt(n)` for large exponents. `cos(a)^n` is evaluated as
 //! `exp(n ln_1p(-2 sin^2(a / 2)))`, accurate to a few ulps even for `n = 10^4`.
 
-use crate::math::Vec3;
-use crate::quadrature::gauss_kronrod_multi;
+use mcbench_core::math::Vec3;
+use mcbench_core::quadrature::gauss_kronrod_multi;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Internal relative tolerance to use when callers need the glossy reference to `1e-9`.
@@ -171,7 +171,7 @@ pub fn clipped_lobe_moments(r: Vec3, n: f64, rel_tol: f64) -> LobeMoments {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::quadrature::gauss_legendre;
+    use mcbench_core::quadrature::gauss_legendre;
 
     /// Brute force: tensor Gauss-Legendre panels in (theta, phi) around +z, panels farther than
     /// where `cos(a)^n < 1e-40` from the axis skipped.

@@ -1,6 +1,6 @@
 //! A pinhole camera through pixel centres (`gradient-plane`, `checker-direct`).
 
-use crate::math::Vec3;
+use mcbench_core::math::Vec3;
 
 /// A pinhole camera with a square image.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -9,10 +9,10 @@
 //! [`track`]'s (the tests below compare them ray by ray, with the generators' states).
 
 use super::{interact, track, Rule, ScaledWeight};
-use crate::error::EstimateError;
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::task::MediumProbe;
+use mcbench_core::error::EstimateError;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::task::MediumProbe;
 use rand::Rng;
 
 /// [`track`] with `SamplingDensity::constant(sigma)`, no main part and no observer, ray after ray
@@ -142,12 +142,12 @@ fn flight(rng: &mut StreamRng, v: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::budget::Budget;
-    use crate::media::{Field, MediumBed};
-    use crate::params::Params;
-    use crate::rng::stream;
-    use crate::task::Task;
-    use crate::testbed::TestBed;
+    use crate::testbeds::medium::{Field, MediumBed};
+    use mcbench_core::budget::Budget;
+    use mcbench_core::params::Params;
+    use mcbench_core::rng::stream;
+    use mcbench_core::task::Task;
+    use mcbench_core::testbed::TestBed;
 
     fn bed(field: Field, variant: &str, params: Params) -> MediumBed {
         MediumBed::without_reference(field, variant, &params).expect("bed")

@@ -10,16 +10,16 @@ use super::constant::ConstantTracker;
 use super::params::DoubleParticleParams;
 use super::residual_ratio_tracking::{main_part, MainPart};
 use super::{ray_moments, supports_transmittance, track, transmittance, Rule, SigmaSamp};
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::media::moments::EstimateMoments;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::task::Task;
-use crate::testbed::{Needs, TestBed};
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::EstimateMoments;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{Needs, TestBed};
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

@@ -8,21 +8,24 @@
 pub mod constant;
 pub mod delta_tracking;
 pub mod double_particle;
+pub mod moments;
 pub mod params;
 pub mod ratio_tracking;
 pub mod ray_marching;
 pub mod residual_ratio_tracking;
 pub mod single_particle;
 pub mod spm;
+pub mod variance;
 
-use crate::error::{ConfigError, EstimateError};
-use crate::math::{Rgb, Vec3};
-use crate::media::moments::{tracker_moments, EstimateMoments};
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::SamplingDensity;
-use crate::stats::NeumaierSum;
-use crate::task::{MediumProbe, Task};
-use crate::testbed::{MediumQuantity, TestBed};
+use crate::tracking::moments::tracker_moments;
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::EstimateMoments;
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::SamplingDensity;
+use mcbench_core::stats::NeumaierSum;
+use mcbench_core::task::{MediumProbe, Task};
+use mcbench_core::testbed::{MediumQuantity, TestBed};
 use rand::Rng;
 use residual_ratio_tracking::{main_part, MainPart};
 
@@ -241,7 +244,7 @@ pub fn transmittance(
 }
 
 /// The exact moments of one tracker ray on `task`'s transmittance integral
-/// ([`crate::media::moments`]): constant density `sigma_samp`, the rule `rule(albedo)`, and the
+/// ([`crate::tracking::moments`]): constant density `sigma_samp`, the rule `rule(albedo)`, and the
 /// main part `control` (shape, explorer spacing) computed exactly as the estimator computes it;
 /// `None` for radiance integrals or where the rule is invalid on the ray.
 pub fn ray_moments(
@@ -268,17 +271,17 @@ pub fn ray_moments(
 /// (the stability case `sigma_samp = 1e-6 x sigma_t`: the double and non-terminating particle models are
 /// unbiased for any `sigma_samp`, but their second moment `exp(int sigma_samp ((1 - r)^2 - 1))`
 /// is `exp(7e5)` there, so no run of any length estimates anything). Checks the exact moments
-/// ([`crate::estimator::Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.
+/// ([`mcbench_core::estimator::Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.
 pub fn check_finite_variance(
     id: &str,
-    est: &dyn crate::estimator::Estimator,
+    est: &dyn mcbench_core::estimator::Estimator,
     sigma_samp: SigmaSamp,
     bed: &dyn TestBed,
 ) -> Result<(), ConfigError> {
     if bed.medium().is_none() {
         return Ok(());
     }
-    let budget = crate::budget::Budget::samples(1)?;
+    let budget = mcbench_core::budget::Budget::samples(1)?;
     let n = bed.integrals();
     let step = n.div_ceil(16).max(1);
     for i in (0..n).step_by(step) {

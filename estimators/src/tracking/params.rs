@@ -2,8 +2,8 @@
 
 use super::residual_ratio_tracking::{MainPart, ResidualRatioTracking};
 use super::SigmaSamp;
-use crate::error::ConfigError;
-use crate::params::ParamSet;
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::ParamSet;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 

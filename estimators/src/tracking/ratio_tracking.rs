@@ -6,15 +6,15 @@
 use super::constant::ConstantTracker;
 use super::params::SigmaSampParams;
 use super::{ray_moments, supports_transmittance, transmittance, Rule, SigmaSamp};
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::media::moments::EstimateMoments;
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::task::Task;
-use crate::testbed::{Needs, TestBed};
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::EstimateMoments;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::{Needs, TestBed};
 
 /// Registry entry.
 pub static ENTRY: EstimatorEntry = EstimatorEntry {

@@ -10,17 +10,18 @@
 
 use super::params::RayMarchingParams;
 use super::{segment, supports_transmittance, transmittance};
-use crate::budget::{Budget, BudgetKind};
-use crate::error::EstimateError;
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::media::moments::{ray_marching_moments, EstimateMoments};
-use crate::params::{parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry, Exemption};
-use crate::rng::StreamRng;
-use crate::task::Task;
-use crate::testbed::MediumQuantity;
-use crate::testbed::{Needs, TestBed};
+use crate::tracking::moments::ray_marching_moments;
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::entry::{Checks, EstimatorEntry, Exemption};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::EstimateMoments;
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::MediumQuantity;
+use mcbench_core::testbed::{Needs, TestBed};
 use rand::Rng;
 
 /// Registry entry.

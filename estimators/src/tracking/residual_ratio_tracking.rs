@@ -11,15 +11,15 @@
 
 use super::params::ResidualParams;
 use super::{supports_transmittance, track_scaled, transmittance, Rule};
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::{Bias, Estimator};
-use crate::math::{Rgb, Vec3};
-use crate::params::{check_count, parse, ParamSpec};
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::free_flight::{Interp, SamplingDensity};
-use crate::task::{MediumProbe, Task};
-use crate::testbed::{Needs, TestBed};
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::{Rgb, Vec3};
+use mcbench_core::params::{check_count, parse, ParamSpec};
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::free_flight::{Interp, SamplingDensity};
+use mcbench_core::task::{MediumProbe, Task};
+use mcbench_core::testbed::{Needs, TestBed};
 use std::collections::VecDeque;
 
 /// Registry entry.

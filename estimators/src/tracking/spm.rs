@@ -8,17 +8,17 @@
 
 use super::params::SpmParams;
 use super::single_particle::check_terminating;
-use crate::accumulate::RgbMean;
-use crate::error::{ConfigError, EstimateError};
-use crate::estimator::{Bias, Estimator};
-use crate::math::Rgb;
-use crate::params::{parse, ParamSpec};
-use crate::phase::Phase;
-use crate::registry::{Checks, EstimatorEntry};
-use crate::rng::StreamRng;
-use crate::samplers::rayleigh;
-use crate::task::{MediumProbe, Task};
-use crate::testbed::{MediumQuantity, Needs, TestBed};
+use mcbench_core::accumulate::RgbMean;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::{Bias, Estimator};
+use mcbench_core::math::Rgb;
+use mcbench_core::params::{parse, ParamSpec};
+use mcbench_core::phase::Phase;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::samplers::rayleigh;
+use mcbench_core::task::{MediumProbe, Task};
+use mcbench_core::testbed::{MediumQuantity, Needs, TestBed};
 use rand::Rng;
 
 /// The collision rule of a particle.

@@ -1,18 +1,18 @@
 //! Unbiasedness (book: statistics.md), refusal and stability (book: stability.md) tests of the trackers.
 
-use crate::budget::{Budget, BudgetKind};
-use crate::error::EstimateError;
-use crate::estimator::Estimator;
-use crate::media::{Field, MediumBed};
-use crate::params::Params;
-use crate::registry;
-use crate::rng::stream;
-use crate::stats::{holm_bonferroni, one_sample_t, welch, Moments};
-use crate::task::Task;
-use crate::testbed::TestBed;
+use crate::builtins;
+use crate::testbeds::medium::{Field, MediumBed};
+use mcbench_core::budget::{Budget, BudgetKind};
+use mcbench_core::error::EstimateError;
+use mcbench_core::estimator::Estimator;
+use mcbench_core::params::Params;
+use mcbench_core::rng::stream;
+use mcbench_core::stats::{holm_bonferroni, one_sample_t, welch, Moments};
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 
 fn build(id: &str, p: Params) -> Box<dyn Estimator> {
-    (registry::estimator(id).unwrap().build)(&p).unwrap()
+    (builtins::estimator(id).unwrap().build)(&p).unwrap()
 }
 
 /// Smallest Holm-adjusted p-value of per-integral t-tests (reps estimates of `spp` rays each).
@@ -41,18 +41,14 @@ fn holm_p(bed: &MediumBed, est: &dyn Estimator, reps: usize, spp: u64, seed: u64
 /// coarse ray-marching control is flagged.
 #[test]
 fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
-    let eq21 = MediumBed::new(
-        Field::Eq21,
-        "central-ray",
-        &Params::new().with("points", 8.0),
-        &crate::references::repository::Repository,
-    )
-    .unwrap();
+    let eq21 =
+        MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 8.0), &crate::repository::Repository)
+            .unwrap();
     let perlin = MediumBed::new(
         Field::Perlin,
         "central-ray",
         &Params::new().with("points", 4.0),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .unwrap();
     let s = |v: f64| Params::new().with("sigma_samp", v);
@@ -86,13 +82,9 @@ fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
 /// run, naming the field; at run time an out-of-range r is refused, never silently used.
 #[test]
 fn invalid_terminating_configurations_are_refused() {
-    let bed = MediumBed::new(
-        Field::Eq21,
-        "central-ray",
-        &Params::new().with("points", 4.0),
-        &crate::references::repository::Repository,
-    )
-    .unwrap();
+    let bed =
+        MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 4.0), &crate::repository::Repository)
+            .unwrap();
     let err = build("single_particle_terminating", Params::new().with("sigma_samp", 0.4))
         .validate(&bed)
         .unwrap_err()
@@ -110,13 +102,13 @@ fn invalid_terminating_configurations_are_refused() {
             assert!(build(id, Params::new().with("sigma_samp_ratio", v)).supports(&bed).is_ok());
         }
         let both = Params::new().with("sigma_samp", 1.0).with("sigma_samp_ratio", 1.0);
-        assert!((registry::estimator(id).unwrap().build)(&both).err().unwrap().to_string().contains("not both"));
+        assert!((builtins::estimator(id).unwrap().build)(&both).err().unwrap().to_string().contains("not both"));
     }
     for bad in [("control", 3.0), ("control", 0.5), ("sigma_samp_ratio", -1.0)] {
-        let err = (registry::estimator("double_particle").unwrap().build)(&Params::new().with(bad.0, bad.1));
+        let err = (builtins::estimator("double_particle").unwrap().build)(&Params::new().with(bad.0, bad.1));
         assert!(err.err().unwrap().to_string().contains(&format!("double_particle.{}", bad.0)));
     }
-    let err = (registry::estimator("residual_ratio_tracking").unwrap().build)(&Params::new().with("control", 0.0));
+    let err = (builtins::estimator("residual_ratio_tracking").unwrap().build)(&Params::new().with("control", 0.0));
     assert!(err.err().unwrap().to_string().contains("residual_ratio_tracking.control"));
     let multiple =
         MediumBed::without_reference(Field::Eq21, "multiple", &Params::new().with("resolution", 4.0)).unwrap();
@@ -130,7 +122,7 @@ fn invalid_terminating_configurations_are_refused() {
     assert!(skip.contains("spm_terminating.sigma_samp") && skip.contains("2/(a+1)"), "{skip}");
     assert!(build("spm_terminating", Params::new().with("sigma_samp", 0.9)).supports(&multiple).is_ok());
     assert!(matches!(super::interact(super::Rule::Terminating { a: 0.7 }, -0.1, 0.5), Err(EstimateError::Refused(_))));
-    assert!(registry::estimator("double_particle")
+    assert!(builtins::estimator("double_particle")
         .map(|e| (e.build)(&Params::new().with("sigma_samp", 0.0)).is_err())
         .unwrap());
 }
@@ -167,7 +159,7 @@ fn stability_cases_are_finite() {
         Field::Eq21,
         "central-ray",
         &Params::new().with("points", 200.0),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .unwrap();
     for sigma in [1e-6, 1e6] {
@@ -179,7 +171,7 @@ fn stability_cases_are_finite() {
         Field::Eq21,
         "central-ray",
         &Params::new().with("points", 2.0).with("scale", 1500.0),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .unwrap();
     assert!(thick.reference().value[1][0] == 0.0 || thick.reference().value[1][0] < 1e-300);
@@ -192,7 +184,7 @@ fn stability_cases_are_finite() {
         Field::Eq21,
         "transmittance",
         &Params::new().with("resolution", 4.0),
-        &crate::references::repository::Repository,
+        &crate::repository::Repository,
     )
     .unwrap();
     for id in ["ratio_tracking", "residual_ratio_tracking", "ray_marching", "delta_tracking"] {

@@ -3,9 +3,9 @@
 //! average of `f / p` over the budget is unbiased, and on integrands that vary smoothly with the
 //! azimuth the pair's errors partly cancel.
 
-use mcbench::estimators::math::{Frame, Vec3};
-use mcbench::estimators::params::{check_range, parse, ParamSet, ParamSpec, Params};
 use mcbench::{Bias, Checks, ConfigError, EstimateError, Estimator, EstimatorEntry, Needs, Rgb, StreamRng, Task};
+use mcbench_core::math::{Frame, Vec3};
+use mcbench_core::params::{check_range, parse, ParamSet, ParamSpec, Params};
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 

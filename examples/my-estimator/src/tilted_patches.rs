@@ -4,13 +4,13 @@
 //! `int L(w) kd / pi (w . n)+ dw = kd (c0 + 2/3 c1 n_z)` (the cosine lobe's mean direction is
 //! `2/3 n`): the reference is exact.
 
-use mcbench::estimators::brdf::Phong;
-use mcbench::estimators::math::Vec3;
-use mcbench::estimators::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
-use mcbench::estimators::references::ReferenceSource;
-use mcbench::estimators::registry::{BedCase, CaseRole};
-use mcbench::estimators::testbed::{HemisphereScene, ReferenceKind, ShadingPoint};
 use mcbench::{ConfigError, Needs, Reference, Rgb, TestBed, TestBedEntry};
+use mcbench_core::brdf::Phong;
+use mcbench_core::entry::{BedCase, CaseRole};
+use mcbench_core::math::Vec3;
+use mcbench_core::params::{check_count, check_range, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::references::ReferenceSource;
+use mcbench_core::testbed::{HemisphereScene, ReferenceKind, ShadingPoint};
 use serde::{Deserialize, Serialize};
 
 /// Sky radiance at the horizon (and everywhere when `c1 = 0`).

@@ -37,7 +37,7 @@ fn the_crate_runs_its_sweep_with_plots_tests_and_claims() {
         claims.iter().find(|c| c["claim"].as_str().is_some_and(|t| t.contains(needle))).map(|c| c["held"].clone())
     };
     assert_eq!(held("converges like independent MC"), Some(serde_json::json!(true)), "{claims:?}");
-    assert_eq!(held("clamped_is0_cv0[clamp=1]"), Some(serde_json::json!(true)), "{claims:?}");
+    assert_eq!(held("clamped_uniform[clamp=1]"), Some(serde_json::json!(true)), "{claims:?}");
     assert!(held("4x as efficient").is_some(), "the speed-up claim is judged");
     let tests = summary["tests"].as_array().expect("tests");
     assert!(tests.iter().any(|t| t["estimator"] == "antithetic_cosine" && t["agrees"] == true));

@@ -13,7 +13,7 @@
 //!
 //! Both are *gated* by skewness before the outcome is seen: a t-test's tail at a tiny `alpha` is
 //! only right when the skewness of the tested mean is small (the first Edgeworth term,
-//! [`estimators::stats::t_test_skewness_limit`]), and the sample skewness of the cell itself is low exactly when its
+//! [`mcbench_core::stats::t_test_skewness_limit`]), and the sample skewness of the cell itself is low exactly when its
 //! repetitions missed a rare large value. So the gate takes the larger of the cell's skewness and
 //! that of an independent [`Gate`] (the same pair on a pilot seed, or at the previous budget), and
 //! the pooled test's variance is the mean of the cell's and the gate's: half of it cannot have
@@ -42,9 +42,9 @@ use super::pooled::{pooled, reps_needed};
 use super::spread::{Spread, ZeroChannels};
 use super::UNBIASEDNESS_ALPHA;
 use crate::cell::CellResult;
-use estimators::estimator::Bias;
-use estimators::stats::Moments;
-use estimators::testbed::Reference;
+use mcbench_core::estimator::Bias;
+use mcbench_core::stats::Moments;
+use mcbench_core::testbed::Reference;
 use serde::{Deserialize, Serialize};
 
 /// The relative bias a `pass` must be able to detect unless the sweep says otherwise.
@@ -70,7 +70,7 @@ pub struct Gate {
     pub integral_var: Vec<[f64; 3]>,
     /// How many consecutive integrals may share state: 1 when every integral's estimate is
     /// independent of the others', a test bed's sequence length when an estimator carries state
-    /// through a sequence ([`estimators::estimator::Estimator::integrals_independent`]). Known
+    /// through a sequence ([`mcbench_core::estimator::Estimator::integrals_independent`]). Known
     /// before any outcome; [`Gate::from_cell`] takes the whole cell as one group.
     pub group: usize,
 }
@@ -99,7 +99,10 @@ impl Gate {
 
     /// The group of `estimator` on `bed`: 1 if its integrals are independent, else the bed's
     /// sequence length.
-    pub fn group_of(estimator: &dyn estimators::estimator::Estimator, bed: &dyn estimators::testbed::TestBed) -> usize {
+    pub fn group_of(
+        estimator: &dyn mcbench_core::estimator::Estimator,
+        bed: &dyn mcbench_core::testbed::TestBed,
+    ) -> usize {
         if estimator.integrals_independent() {
             1
         } else {
@@ -226,7 +229,7 @@ fn agrees(claim: Bias, verdict: &str) -> bool {
 /// freedom (at least 1).
 pub(super) fn spread_upper(dof: f64) -> f64 {
     let dof = dof.max(1.0);
-    (dof / estimators::stats::hypothesis::chi_square_quantile(0.05, dof)).sqrt().max(1.0)
+    (dof / mcbench_core::stats::hypothesis::chi_square_quantile(0.05, dof)).sqrt().max(1.0)
 }
 
 /// The relative bias `b` of an estimator off by the factor `1 + b` that a test detecting the

@@ -3,10 +3,10 @@
 use super::*;
 use crate::analysis::reps_for;
 use crate::cell::{CellKey, TimeStats};
-use estimators::budget::Budget;
-use estimators::math::Rgb;
-use estimators::stats::NeumaierSum;
-use estimators::testbed::ReferenceKind;
+use mcbench_core::budget::Budget;
+use mcbench_core::math::Rgb;
+use mcbench_core::stats::NeumaierSum;
+use mcbench_core::testbed::ReferenceKind;
 use rand::{Rng, SeedableRng};
 
 /// A cell from per-repetition estimates of every integral (what the runner reduces).

@@ -16,8 +16,8 @@
 use super::bias::{RowBase, TestRow, POOLED_SHARE};
 use super::spread::ZeroChannels;
 use super::{POWER, UNBIASEDNESS_ALPHA};
-use estimators::stats::{detectable_shift_t, holm_bonferroni, t_test, TestOutcome};
-use estimators::testbed::{Reference, ReferenceKind};
+use mcbench_core::stats::{detectable_shift_t, holm_bonferroni, t_test, TestOutcome};
+use mcbench_core::testbed::{Reference, ReferenceKind};
 
 /// Degrees of freedom of a stored reference's standard error.
 fn reference_dof(samples: u64) -> f64 {

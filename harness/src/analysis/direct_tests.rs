@@ -4,9 +4,9 @@
 use super::super::bias::tests::{cell_from, decision, exact, normal_reps};
 use super::super::bias::{unbiasedness, Gate, DEFAULT_TOLERANCE};
 use crate::analysis::Spread;
-use estimators::estimator::Bias;
-use estimators::math::Rgb;
-use estimators::testbed::{Reference, ReferenceKind};
+use mcbench_core::estimator::Bias;
+use mcbench_core::math::Rgb;
+use mcbench_core::testbed::{Reference, ReferenceKind};
 use rand::{Rng, SeedableRng};
 
 /// `reps` repetitions of `values` (one per integral, every channel alike) each off by `1 + err`,

@@ -6,8 +6,8 @@ use super::bias::{multiplicative, spread_upper, Gate};
 use super::spread::{Spread, ZeroChannels};
 use super::POWER;
 use crate::cell::CellResult;
-use estimators::stats::{detectable_shift_t, holm_bonferroni, t_test, t_test_skewness_limit};
-use estimators::testbed::{Reference, ReferenceKind};
+use mcbench_core::stats::{detectable_shift_t, holm_bonferroni, t_test, t_test_skewness_limit};
+use mcbench_core::testbed::{Reference, ReferenceKind};
 
 /// The per-integral Holm test.
 pub(super) struct Holm {
@@ -44,7 +44,7 @@ impl Holm {
         }
         let scale = if upper { self.spread_upper } else { 1.0 };
         let scaled: Vec<f64> = self.strengths.iter().map(|q| q / scale).collect();
-        let shift = estimators::stats::detectable_shift_any(&scaled, alpha / tests as f64, POWER, self.dof);
+        let shift = mcbench_core::stats::detectable_shift_any(&scaled, alpha / tests as f64, POWER, self.dof);
         if shift.is_nan() {
             f64::NAN
         } else {
@@ -152,7 +152,7 @@ pub(super) fn holm(
                     continue;
                 }
                 None => t_test(mc.mean() - r_test, se, reps as f64 - 1.0),
-                Some(n) => estimators::stats::welch(mc.mean(), se, reps, r, rse, n),
+                Some(n) => mcbench_core::stats::welch(mc.mean(), se, reps, r, rse, n),
             };
             max_t = max_t.max(t.statistic.abs());
             ps.push(t.p_value);

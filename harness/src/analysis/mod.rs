@@ -13,7 +13,7 @@ pub use speedup::{speedups, SpeedUp, SpeedUpOutcome};
 pub use spread::Spread;
 
 use crate::metrics::SummaryRow;
-use estimators::stats::{log_log_fit, weighted_linear_fit, SlopeFit};
+use mcbench_core::stats::{log_log_fit, weighted_linear_fit, SlopeFit};
 use serde::{Deserialize, Serialize};
 
 /// Family-wise significance of the unbiasedness tests (book: statistics.md).
@@ -259,7 +259,7 @@ mod tests {
     use super::bias::tests::{cell_from, exact};
     use super::*;
     use crate::metrics::summarize;
-    use estimators::testbed::ReferenceKind;
+    use mcbench_core::testbed::ReferenceKind;
 
     #[test]
     fn metrics_follow_their_definitions() {
@@ -285,7 +285,7 @@ mod tests {
         let mut r = exact(&[[1.0, 1.0, 1.0]]);
         let exact_row = summarize(&cell_from(&per_rep, &r), &r);
         r.kind = ReferenceKind::Stored { command: "x".into(), samples: 100 };
-        r.std_err = vec![estimators::math::Rgb::splat(0.01)];
+        r.std_err = vec![mcbench_core::math::Rgb::splat(0.01)];
         let row = summarize(&cell_from(&per_rep, &r), &r);
         assert!((exact_row.mse - row.mse - 1e-4).abs() < 1e-12);
     }
@@ -302,7 +302,7 @@ mod tests {
         (1..=6)
             .map(|k| {
                 let n = 4f64.powi(k);
-                let mut m = estimators::stats::Moments::new();
+                let mut m = mcbench_core::stats::Moments::new();
                 for _ in 0..reps {
                     let chi2: f64 = (0..d).map(|_| normal(rng).powi(2)).sum();
                     m.push(chi2 / d as f64 / n);

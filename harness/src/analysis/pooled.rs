@@ -4,8 +4,8 @@
 use super::bias::{multiplicative, spread_upper, Gate};
 use super::POWER;
 use crate::cell::CellResult;
-use estimators::stats::{detectable_shift_t, t_test, t_test_skewness_limit, Moments};
-use estimators::testbed::{Reference, ReferenceKind};
+use mcbench_core::stats::{detectable_shift_t, t_test, t_test_skewness_limit, Moments};
+use mcbench_core::testbed::{Reference, ReferenceKind};
 
 /// The pooled test over repetitions.
 pub(super) struct Pooled {

@@ -8,7 +8,7 @@ use crate::cost_model::{CostModel, RayCostCurve, Regime};
 use crate::metrics::SummaryRow;
 use serde::{Deserialize, Serialize};
 
-use estimators::stats::hypothesis::t_quantile;
+use mcbench_core::stats::hypothesis::t_quantile;
 
 /// The normal quantile of a two-sided 95% interval (the slope's interval width to a standard
 /// error).

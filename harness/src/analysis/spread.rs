@@ -5,7 +5,7 @@
 
 use super::bias::Gate;
 use crate::cell::CellResult;
-use estimators::testbed::Reference;
+use mcbench_core::testbed::Reference;
 use serde::{Deserialize, Serialize};
 
 /// How the spread of a tested cell was judged (the `spread` of summary.json's `tests` rows).

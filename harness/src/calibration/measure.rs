@@ -17,8 +17,8 @@ use crate::guarded;
 use crate::plan::Plan;
 use crate::registry::Registry;
 use crate::runner::sequence_estimates;
-use estimators::budget::Budget;
-use estimators::estimator::Bias;
+use mcbench_core::budget::Budget;
+use mcbench_core::estimator::Bias;
 use rayon::prelude::*;
 
 /// The nominal level at which the false-flag rate is measured (resolvable in a few hundred seeds).

@@ -26,7 +26,7 @@ use crate::folder::OutputDir;
 use crate::output::RunReport;
 use crate::plan::Plan;
 use crate::registry::{Experiment, Registry, Sweeps};
-use estimators::estimator::Bias;
+use mcbench_core::estimator::Bias;
 use measure::Family;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -110,7 +110,7 @@ pub fn families_of_run(plan: &Plan, registry: &Registry) -> Vec<Family> {
         return families(registry, plan.sweep.mode);
     }
     let mut out = Vec::new();
-    for budget in s.budgets.iter().filter(|b| b.kind == estimators::budget::BudgetKind::Samples) {
+    for budget in s.budgets.iter().filter(|b| b.kind == mcbench_core::budget::BudgetKind::Samples) {
         for &(bi, ei) in &plan.pairs {
             out.push(Family {
                 bed: s.testbeds[bi].clone(),
@@ -181,10 +181,9 @@ mod tests {
     /// family somewhere, and each family carries its row's samples and repetitions.
     #[test]
     fn families_cover_the_controls_and_few_unbiased_estimators_per_case() {
-        let registry = Registry::builtin().with_references(crate::references::ReferenceDir::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../results/references"
-        )));
+        let registry = Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
+            crate::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+        );
         let all = families(&registry, Mode::Quick);
         let mut per_case = std::collections::HashMap::new();
         for f in all.iter().filter(|f| f.bias == Bias::Unbiased) {

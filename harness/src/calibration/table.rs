@@ -3,7 +3,7 @@
 
 use super::measure::{bias_grid, Family, Measured, NOMINAL};
 use crate::output::Claim;
-use estimators::estimator::Bias;
+use mcbench_core::estimator::Bias;
 use serde::{Deserialize, Serialize};
 
 /// One family's row of `calibration.csv`.

@@ -12,17 +12,17 @@
 //! estimates transformed by [`Scaled::apply`] / [`FireflyRejection::apply`]; the calibration applies
 //! those transforms to one set of estimates to measure every bias level on the same repetitions.
 
-use estimators::error::{ConfigError, EstimateError};
-use estimators::estimator::Estimator;
-use estimators::math::Rgb;
-use estimators::rng::StreamRng;
-use estimators::task::Task;
-use estimators::testbed::TestBed;
+use mcbench_core::error::{ConfigError, EstimateError};
+use mcbench_core::estimator::Estimator;
+use mcbench_core::math::Rgb;
+use mcbench_core::rng::StreamRng;
+use mcbench_core::task::Task;
+use mcbench_core::testbed::TestBed;
 
 /// An estimator whose estimates are `1 + b` times `inner`'s.
 ///
 /// ```
-/// use estimators::{estimator::Estimator, error::EstimateError, math::Rgb, rng::StreamRng, task::Task};
+/// use mcbench_core::{estimator::Estimator, error::EstimateError, math::Rgb, rng::StreamRng, task::Task};
 /// use mcbench::calibration::Scaled;
 ///
 /// struct Half;
@@ -133,23 +133,23 @@ pub fn quantile_threshold(estimates: &[Vec<[f64; 3]>], q: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::registry::Registry;
-    use estimators::budget::Budget;
-    use estimators::rng::StreamKey;
+    use mcbench_core::budget::Budget;
+    use mcbench_core::rng::StreamKey;
 
     /// On the same stream, the wrapped estimator gives exactly the transformed estimates of the
     /// inner one: what lets the calibration apply the transform instead of re-running.
     #[test]
     fn the_wrappers_equal_their_transform_on_the_same_stream() {
-        let registry = Registry::builtin();
+        let registry = Registry::new().with_catalog(mcbench_papers::catalog());
         let bed = registry.test_bed("gradient-plane").unwrap();
         let bed = (bed.build)(
             "default",
-            &estimators::params::Params::new().with("resolution", 2.0),
-            &estimators::references::NoReferences,
+            &mcbench_core::params::Params::new().with("resolution", 2.0),
+            &mcbench_core::references::NoReferences,
         )
         .unwrap();
         let entry = registry.estimator("is0_cv0").unwrap();
-        let build = || (entry.build)(&estimators::params::Params::new()).unwrap();
+        let build = || (entry.build)(&mcbench_core::params::Params::new()).unwrap();
         let budget = Budget::samples(8).unwrap();
         let key = StreamKey { seed: 3, testbed: "t", estimator: "e", budget: 8, rep: 0, integral: 1 };
         let task = Task::new(bed.as_ref(), 1, budget);

@@ -29,7 +29,7 @@
 use crate::cell::RepBlock;
 use crate::cost_model::{CostModel, Regime};
 use crate::metrics::RowBlocks;
-use estimators::stats::hypothesis::t_quantile;
+use mcbench_core::stats::hypothesis::t_quantile;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use statrs::distribution::{ContinuousCDF, Normal};
@@ -39,7 +39,7 @@ pub const RESAMPLES: usize = 2000;
 
 /// The seed of a claim's resamples: FNV-1a of a text naming the claim (metric, cells).
 pub fn seed_of(text: &str) -> u64 {
-    estimators::rng::fnv1a(text)
+    mcbench_core::rng::fnv1a(text)
 }
 
 /// Sums over a resample of one cell's blocks.

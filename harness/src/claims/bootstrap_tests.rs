@@ -1,7 +1,7 @@
 //! Unit tests of [`super`].
 
 use super::*;
-use estimators::task::Costs;
+use mcbench_core::task::Costs;
 
 /// A cell of `blocks` blocks of `per` repetitions each, each repetition's squared error from
 /// `draw`, and `seconds(k)` CPU seconds per estimate in block `k` (one integral).

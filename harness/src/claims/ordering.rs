@@ -81,7 +81,7 @@ fn repetitions_to_decide((value, reps): (f64, usize), (lo, hi): (f64, f64), thre
 /// `se = ln(hi / lo) / (2 z)` with `z` the level's normal quantile, and `d = exp(se (z + z_0.8))`.
 /// `None` for an empty or non-positive interval.
 pub fn detectable_ratio((lo, hi): (f64, f64), level: f64) -> Option<f64> {
-    let normal = |p: f64| estimators::stats::hypothesis::t_quantile(p, f64::INFINITY);
+    let normal = |p: f64| mcbench_core::stats::hypothesis::t_quantile(p, f64::INFINITY);
     let z = normal(1.0 - (1.0 - level) / 2.0);
     let se = (hi / lo).ln() / (2.0 * z);
     let d = (se * (z + normal(0.8))).exp();

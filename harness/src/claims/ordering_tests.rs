@@ -35,7 +35,7 @@ fn orderings_are_judged_on_bonferroni_intervals_of_every_pair() {
     // The binding pair is the one closest to 1: a vs b, at level 1 - 0.05 / 2.
     assert_eq!((held.pair.as_str(), held.our_value), ("a vs b", Some(0.5)), "{held:?}");
     let [lo, hi] = held.interval.expect("interval");
-    let q = estimators::stats::hypothesis::t_quantile(1.0 - 0.025 / 2.0, 15.0);
+    let q = mcbench_core::stats::hypothesis::t_quantile(1.0 - 0.025 / 2.0, 15.0);
     let w = (q * 2f64.sqrt() * 0.05).exp();
     assert!((lo - 0.5 / w).abs() < 1e-12 && (hi - 0.5 * w).abs() < 1e-12, "{lo} {hi}");
     assert!(held.reason.contains("Bonferroni over 2 pairs"), "{}", held.reason);
@@ -68,7 +68,7 @@ fn optima_compare_the_best_inside_with_the_best_outside_at_a_selection_level() {
     assert_eq!((held.verdict.as_str(), held.pair.as_str()), ("held", "p2 vs p3"), "{held:?}");
     assert!((held.our_value.expect("value") - 1.5).abs() < 1e-12, "{held:?}");
     let [lo, hi] = held.interval.expect("interval");
-    let q = estimators::stats::hypothesis::t_quantile(1.0 - 0.05 / 8.0, 15.0);
+    let q = mcbench_core::stats::hypothesis::t_quantile(1.0 - 0.05 / 8.0, 15.0);
     let w = (q * 2f64.sqrt() * 0.05).exp();
     assert!((lo - 1.5 / w).abs() < 1e-12 && (hi - 1.5 * w).abs() < 1e-12, "{lo} {hi}");
     assert!(held.reason.contains("Bonferroni over 2 inside x 2 outside"), "{}", held.reason);

@@ -30,7 +30,7 @@ use crate::output::{Claim, RunReport};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
-use estimators::stats::hypothesis::t_quantile;
+use mcbench_core::stats::hypothesis::t_quantile;
 
 /// The two-sided level of the intervals.
 pub const LEVEL: f64 = 0.95;

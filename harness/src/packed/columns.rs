@@ -16,8 +16,8 @@
 //! Format 1 (a `k` first, five plain columns of moments, blocks in the JSON part) is still read.
 
 use crate::cell::RepBlock;
-use estimators::stats::Moments;
-use estimators::task::Costs;
+use mcbench_core::stats::Moments;
+use mcbench_core::task::Costs;
 use std::collections::BTreeMap;
 
 /// The first word of a format-2 binary part. It is not a multiple of 3, so it is never a

@@ -17,9 +17,9 @@ pub mod columns;
 
 use crate::cell::CellResult;
 use crate::shard::BlockFile;
-use estimators::stats::Moments;
 use flate2::read::DeflateDecoder;
 use flate2::write::DeflateEncoder;
+use mcbench_core::stats::Moments;
 use std::io::{Read, Write};
 
 /// At most this many bytes are inflated from one record (a damaged record cannot make the reader
@@ -166,7 +166,7 @@ pub fn decode_block(payload: &[u8]) -> Result<BlockFile, String> {
 mod tests {
     use super::*;
     use crate::cell::{CellKey, TimeStats};
-    use estimators::budget::Budget;
+    use mcbench_core::budget::Budget;
 
     fn cell() -> CellResult {
         let mut moments = Vec::new();

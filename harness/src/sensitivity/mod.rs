@@ -31,7 +31,7 @@
 //! "#).unwrap();
 //! let part = &file.parts[0];
 //! let (sweep, claim) = part.setting(&file.name, 1, mcbench::config::Mode::Quick, &part.values[0]).unwrap();
-//! assert_eq!(sweep.testbeds[0].params.0["resolution"], mcbench::estimators::params::ParamValue::Number(4.0));
+//! assert_eq!(sweep.testbeds[0].params.0["resolution"], mcbench_core::params::ParamValue::Number(4.0));
 //! assert_eq!(claim.testbed(), Some("gradient-plane/diffuse"));
 //! ```
 
@@ -42,8 +42,8 @@ pub mod table;
 use crate::claim_spec::ClaimSpec;
 use crate::config::{EstimatorSpec, Mode, Sweep, SweepFile, TestBedSpec};
 use crate::error::Result;
-use estimators::error::ConfigError;
-use estimators::params::ParamValue;
+use mcbench_core::error::ConfigError;
+use mcbench_core::params::ParamValue;
 use serde::Deserialize;
 
 /// A sensitivity file.

@@ -96,7 +96,7 @@ impl Outcome {
 
 /// The outcome of `part` from its rows (one per setting, in setting order).
 pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
-    let find = |v: &estimators::params::ParamValue| rows.iter().find(|r| r.setting == setting_text(v)).copied();
+    let find = |v: &mcbench_core::params::ParamValue| rows.iter().find(|r| r.setting == setting_text(v)).copied();
     if let Some(r) = part.paper_like.as_ref().and_then(find).filter(|r| r.verdict == "held") {
         return Outcome::HeldAtPaperLike { setting: format!("{} = {}", part.vary, r.setting), value: value_text(r) };
     }

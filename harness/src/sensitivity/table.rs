@@ -8,7 +8,7 @@ use super::{setting_text, Part};
 use crate::error::Result;
 use crate::output::Claim;
 use crate::plot::claim_sweep::{write_claim_sweep, ClaimSweepFigure, SettingPoint};
-use estimators::params::ParamValue;
+use mcbench_core::params::ParamValue;
 use serde::Serialize;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};

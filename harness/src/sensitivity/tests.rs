@@ -58,7 +58,7 @@ fn settings_rewrite_the_sweep_and_the_names_the_claim_uses() {
     let (sweep, claim) = p.setting("s", 1, Mode::Full, &p.values[1]).unwrap();
     assert_eq!(sweep.testbeds[0].variant.as_deref(), Some("specular"));
     assert_eq!(claim.testbed(), Some("envmap-sequence/specular"));
-    assert!(p.setting("s", 1, Mode::Full, &estimators::params::ParamValue::Number(2.0)).is_err());
+    assert!(p.setting("s", 1, Mode::Full, &mcbench_core::params::ParamValue::Number(2.0)).is_err());
 }
 
 #[test]

@@ -2,14 +2,14 @@
 //! runs on, each cell tested by [`crate::analysis::unbiasedness`] (per-integral Holm t / Welch and
 //! the pooled per-repetition t-test, combined by Bonferroni) behind the gate of a pilot on its own
 //! seed, with the biased controls in the same run and required to be flagged (except where their
-//! registry entry exempts a test bed, [`estimators::registry::Checks`]). One table,
+//! registry entry exempts a test bed, [`mcbench_core::entry::Checks`]). One table,
 //! `unbiasedness.csv`: estimator x test bed -> p-value, verdict (`pass`, `inconclusive`,
 //! `biased`), the relative bias the row could detect with 80% power, the repetitions that would
 //! resolve the tolerance, and whether the registry calls the estimator unbiased.
 //!
 //! Nothing here names an estimator or a test bed: the experiment is derived from the registry it
 //! runs over ([`parts`]), so a plug-in registered from any crate is in it. Each test bed declares
-//! its cases ([`estimators::registry::BedCase`] with the role `Unbiasedness`: a variant, small
+//! its cases ([`mcbench_core::entry::BedCase`] with the role `Unbiasedness`: a variant, small
 //! parameters, samples per estimate and repetitions); cases of equal samples and repetitions form
 //! one part, an ordinary [`Sweep`] of those cases x every estimator whose needs they provide
 //! (with the estimator's check parameters, e.g. a control's coarse step). The first part is the
@@ -22,8 +22,8 @@ pub mod table;
 
 use crate::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
 use crate::registry::{Experiment, Registry, Sweeps};
-use estimators::budget::Budget;
-use estimators::registry::CaseRole;
+use mcbench_core::budget::Budget;
+use mcbench_core::entry::CaseRole;
 
 /// The experiment's name.
 pub const NAME: &str = "unbiasedness";
@@ -68,7 +68,7 @@ pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
     groups
         .into_iter()
         .map(|((samples, reps), testbeds)| {
-            let provided: Vec<estimators::testbed::Needs> =
+            let provided: Vec<mcbench_core::testbed::Needs> =
                 testbeds.iter().filter_map(|t| registry.test_bed(&t.id).ok().map(|e| e.provides)).collect();
             let estimators = registry
                 .estimators()
@@ -80,7 +80,7 @@ pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
                         .checks
                         .params
                         .iter()
-                        .fold(Default::default(), |p: estimators::params::Params, (k, v)| p.with(k, *v)),
+                        .fold(Default::default(), |p: mcbench_core::params::Params, (k, v)| p.with(k, *v)),
                 })
                 .collect();
             Part {
@@ -89,7 +89,7 @@ pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
                     experiment: NAME.into(),
                     testbeds,
                     estimators,
-                    budgets: vec![Budget { kind: estimators::budget::BudgetKind::Samples, amount: samples }],
+                    budgets: vec![Budget { kind: mcbench_core::budget::BudgetKind::Samples, amount: samples }],
                     reps: if mode == Mode::Quick { reps.0 } else { reps.1 },
                     seed: 1,
                     mode,
@@ -134,7 +134,7 @@ mod tests {
 
     #[test]
     fn parts_cover_every_case_and_every_estimator_that_can_run() {
-        let registry = Registry::builtin();
+        let registry = Registry::new().with_catalog(mcbench_papers::catalog());
         let parts = parts(&registry, Mode::Quick);
         let cases: usize = registry
             .test_beds()

@@ -35,7 +35,7 @@ fn rows_of(plan: &Plan, run: &RunResults, pilot: &RunResults, report: &mut RunRe
         let group = crate::analysis::Gate::group_of(plan.estimators[*ei].estimator.as_ref(), bed);
         let gate = crate::analysis::Gate::from_cell(pilot_cell, "pilot", 1.0).with_group(group);
         let mut tests = crate::analysis::unbiasedness(cell, bed.reference(), bias, Some(&gate), plan.sweep.tolerance());
-        if let estimators::testbed::ReferenceKind::Stored { command, .. } = &bed.reference().kind {
+        if let mcbench_core::testbed::ReferenceKind::Stored { command, .. } = &bed.reference().kind {
             if made_by(command, &plan.estimators[*ei].spec.id) {
                 judged_against_itself(&mut tests, command);
             }
@@ -83,7 +83,7 @@ pub fn exemption(registry: &Registry, id: &str, testbed: &str, variant: &str) ->
 }
 
 /// The plans of a part's sweep. A pair whose configuration is invalid on a test bed (the terminating
-/// single-particle model where `r > 2/(a+1)`: [`estimators::estimator::Estimator::validate`]) makes
+/// single-particle model where `r > 2/(a+1)`: [`mcbench_core::estimator::Estimator::validate`]) makes
 /// the whole sweep bad input; here it becomes a `not-run` row with the reason, and the rest runs:
 /// the sweep is split per test bed, and a failing test bed per estimator (streams do not depend on
 /// how a sweep is split, so the cells are the same).

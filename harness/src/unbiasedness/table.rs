@@ -8,7 +8,7 @@ use crate::cell::CellResult;
 use crate::error::Result;
 use crate::folder::OutputDir;
 use crate::output::Claim;
-use estimators::estimator::Bias;
+use mcbench_core::estimator::Bias;
 use serde::Serialize;
 
 /// One row of `unbiasedness.csv`.

@@ -44,7 +44,7 @@ fn exempt_controls_are_expected_to_pass() {
     r.estimator = "bidirectional_is_sn[candidates=5]".into();
     r.testbed = "envmap-sequence".into();
     r.variant = "mixed-lns".into();
-    let registry = crate::registry::Registry::builtin();
+    let registry = crate::registry::Registry::new().with_catalog(mcbench_papers::catalog());
     r.exempt = super::super::run::exemption(&registry, "bidirectional_is_sn", &r.testbed, &r.variant);
     judge(&mut r);
     assert_eq!(r.agrees, Some(true));
@@ -98,8 +98,8 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
     use crate::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
     use crate::plan::Plan;
     use crate::runner::{run, RunOptions, Silent};
-    use estimators::budget::Budget;
-    use estimators::params::Params;
+    use mcbench_core::budget::Budget;
+    use mcbench_core::params::Params;
     let sweep = Sweep {
         experiment: "unbiasedness-test".into(),
         testbeds: vec![TestBedSpec {
@@ -119,17 +119,16 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
     };
     let plan = Plan::prepare(
         sweep,
-        &crate::registry::Registry::builtin().with_references(crate::references::ReferenceDir::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../results/references"
-        ))),
+        &crate::registry::Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
+            crate::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+        ),
     )
     .unwrap();
     let opts = RunOptions { threads: Some(1), store: None, observer: &Silent };
     let results = run(&plan, &opts).unwrap();
     let pilot_plan = Plan::prepare(
         Sweep { seed: super::super::run::pilot_seed(plan.sweep.seed), ..plan.sweep.clone() },
-        &crate::registry::Registry::builtin(),
+        &crate::registry::Registry::new().with_catalog(mcbench_papers::catalog()),
     )
     .unwrap();
     let pilot = run(&pilot_plan, &opts).unwrap();
@@ -156,7 +155,7 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
 fn every_built_in_variant_is_in_a_part() {
     use crate::config::Mode;
     use crate::unbiasedness::parts;
-    let registry = crate::registry::Registry::builtin();
+    let registry = crate::registry::Registry::new().with_catalog(mcbench_papers::catalog());
     let all = parts(&registry, Mode::Quick);
     for t in registry.test_beds() {
         for v in t.variants {

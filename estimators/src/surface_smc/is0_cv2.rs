@@ -1,0 +1,25 @@
+//! `is0_cv2` (paper 001 Fig. 4): uniform hemisphere sampling, bilinear (order 1) cache control
+//! variate; one adaptive cache per estimate (see [`super`]).
+
+use super::params::CacheSmcParams;
+use super::{build_surface_or_medium, Sampling};
+use crate::cache::ControlVariate;
+use crate::media_smc::Sampling as MediaSampling;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::estimator::Bias;
+use mcbench_core::params::ParamSpec;
+use mcbench_core::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "is0_cv2",
+    paper: "001",
+    label: "is0_cv2",
+    bias: Bias::Unbiased,
+    needs: Needs::NONE,
+    samplers: &["uniform_hemisphere", "phase", "free_flight"],
+    summary: "SMC cache: uniform sampling, bilinear control variate (cv2); on a medium, the octree of spherical caches (paper 000)",
+    build: |p| build_surface_or_medium("is0_cv2", (Sampling::Uniform, MediaSampling::Uniform), ControlVariate::Bilinear, p),
+    params: ParamSpec::of::<CacheSmcParams>(),
+    checks: Checks::DEFAULT,
+};

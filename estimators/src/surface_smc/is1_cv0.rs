@@ -1,0 +1,25 @@
+//! `is1_cv0` (paper 001 Fig. 4): cache PDF importance sampling, no control variate; one adaptive
+//! cache per estimate (see [`super`]).
+
+use super::params::CacheSmcParams;
+use super::{build_surface_or_medium, Sampling};
+use crate::cache::ControlVariate;
+use crate::media_smc::Sampling as MediaSampling;
+use mcbench_core::entry::{Checks, EstimatorEntry};
+use mcbench_core::estimator::Bias;
+use mcbench_core::params::ParamSpec;
+use mcbench_core::testbed::Needs;
+
+/// Registry entry.
+pub static ENTRY: EstimatorEntry = EstimatorEntry {
+    id: "is1_cv0",
+    paper: "001",
+    label: "is1_cv0",
+    bias: Bias::Unbiased,
+    needs: Needs::NONE,
+    samplers: &["uniform_hemisphere", "phase", "free_flight"],
+    summary: "SMC cache: cache-PDF importance sampling, no control variate; on a medium, the octree of spherical caches (paper 000)",
+    build: |p| build_surface_or_medium("is1_cv0", (Sampling::Cache, MediaSampling::Cache), ControlVariate::None, p),
+    params: ParamSpec::of::<CacheSmcParams>(),
+    checks: Checks::DEFAULT,
+};
