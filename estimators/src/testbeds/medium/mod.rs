@@ -28,6 +28,7 @@ pub mod reference;
 pub mod scatter_reference;
 pub mod sphere;
 
+pub use params::DEFAULT_EXPONENT;
 pub use sphere::{clip_sphere, Field, CENTRE, LIGHT, MIN_LIGHT_DISTANCE, RADIUS, VARIANTS};
 
 use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
@@ -37,10 +38,6 @@ use mcbench_core::math::{Rgb, Vec3};
 use mcbench_core::params::{parse, ParamSpec, Params};
 use mcbench_core::references::{ReferenceKey, ReferenceSource};
 use mcbench_core::testbed::{MediumQuantity, MediumRay, MediumScene, Needs, Reference, TestBed};
-
-/// The default exponent `k` of Eq. 21's first factor (parameter `exponent` of `eq21-medium`; the
-/// book's paper-002 chapter gives the evidence for the reading).
-pub const DEFAULT_EXPONENT: i32 = 5;
 
 /// `eq21-medium` registry entry.
 pub static EQ21: TestBedEntry = TestBedEntry {

@@ -8,6 +8,10 @@ use mcbench_core::params::{check_count, check_range, ParamSet};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
+/// The default exponent `k` of Eq. 21's first factor (parameter `exponent` of `eq21-medium`; the
+/// book's paper-002 chapter gives the evidence for the reading).
+pub const DEFAULT_EXPONENT: i32 = 5;
+
 /// Parameters of the medium test beds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
@@ -30,7 +34,7 @@ pub struct MediumParams {
     /// Point light intensity (`single-scatter` only; 0 to 1e12, exclusive of 0; unset: 100).
     pub intensity: Option<f64>,
     /// The exponent k of Eq. 21's first factor, `((cos(1.5 (x + y + z)) + 1) / 2)^k`
-    /// (`eq21-medium` only; 1 to 16; unset: [`super::DEFAULT_EXPONENT`]).
+    /// (`eq21-medium` only; 1 to 16; unset: [`DEFAULT_EXPONENT`]).
     pub exponent: Option<usize>,
 }
 
@@ -106,9 +110,9 @@ impl MediumParams {
         Ok(())
     }
 
-    /// The exponent of Eq. 21 (unset: [`super::DEFAULT_EXPONENT`]).
+    /// The exponent of Eq. 21 (unset: [`DEFAULT_EXPONENT`]).
     pub fn exponent(&self) -> i32 {
-        self.exponent.map_or(super::DEFAULT_EXPONENT, |k| k as i32)
+        self.exponent.map_or(DEFAULT_EXPONENT, |k| k as i32)
     }
 
     /// The point light (defaults: intensity 100 at the sphere's centre).
