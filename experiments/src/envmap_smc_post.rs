@@ -11,6 +11,7 @@ use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::plot::{write_panels, Figure, Panels, Series};
 use mcbench::runner::RunResults;
+use mcbench::verdict::Verdict;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -126,7 +127,7 @@ fn bridges_halve(report: &RunReport, frames: usize, (one, five): (Option<f64>, O
     c.pair = "smc_path[bridges=5] vs smc[moves=5]".into();
     let n = sequences(report, "smc[moves=5]", frames).zip(sequences(report, "smc_path[bridges=5]", frames));
     let (Some((p1, p5)), Some((n1, n5))) = (one.zip(five), n) else {
-        c.verdict = "not measured".into();
+        c.verdict = Some(Verdict::NotMeasured);
         c.note = "smc[moves=5] or smc_path[bridges=5] did not run on the mixed variant".into();
         return c;
     };
@@ -134,14 +135,14 @@ fn bridges_halve(report: &RunReport, frames: usize, (one, five): (Option<f64>, O
     let d = p1 - p5;
     let (lo, hi) = (d - 1.96 * se, d + 1.96 * se);
     let (verdict, held) = if lo > 0.0 {
-        ("held", Some(true))
+        (Verdict::Held, Some(true))
     } else if hi < 0.0 {
-        ("not held", Some(false))
+        (Verdict::NotHeld, Some(false))
     } else {
-        ("inconclusive", None)
+        (Verdict::Inconclusive, None)
     };
     c.held = held;
-    c.verdict = verdict.into();
+    c.verdict = Some(verdict);
     let se5 = (p5 * (1.0 - p5) / n5).sqrt();
     c.interval = Some([p5 - 1.96 * se5, p5 + 1.96 * se5]);
     c.reason = format!(
@@ -363,10 +364,10 @@ pub fn post(
         (c.verdict, c.reason) = match (t.claim.as_str(), held) {
             ("unbiased", _) => {
                 let (_, v, why) = mcbench::claims::unbiased_verdict(t);
-                (v, why)
+                (Some(v), why)
             }
-            (_, None) => ("reported".into(), format!("test verdict {}: {}", t.verdict, t.reason)),
-            _ => (String::new(), t.reason.clone()),
+            (_, None) => (Some(Verdict::Reported), format!("test verdict {}: {}", t.verdict, t.reason)),
+            _ => (None, t.reason.clone()),
         };
         report.paper.push(c);
     }

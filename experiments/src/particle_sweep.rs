@@ -10,6 +10,7 @@
 use crate::ExperimentDef;
 use mcbench::claims::ratio::{self, Ratio, RatioMetric};
 use mcbench::output::{Claim, RunReport};
+use mcbench::verdict::Verdict;
 
 /// The sigma_samp values of the paper's sweeps (Fig. 6 and Fig. 7 together).
 pub const SIGMAS: [f64; 8] = [0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 2.0];
@@ -86,7 +87,7 @@ fn never_worse_claim(r: &RunReport, tb: &str, budget: u64) -> Claim {
         ..Default::default()
     };
     if pairs.is_empty() {
-        c.verdict = "not measured".into();
+        c.verdict = Some(Verdict::NotMeasured);
         c.note = format!("no pair ran at {budget} fetches");
         return c;
     }
@@ -95,11 +96,11 @@ fn never_worse_claim(r: &RunReport, tb: &str, budget: u64) -> Claim {
     let worst_lo = ends.iter().map(|e| e.0).fold(f64::INFINITY, f64::min);
     let worst_hi = ends.iter().map(|e| e.1).fold(f64::INFINITY, f64::min);
     let (verdict, held) = if worst_hi < NOT_WORSE {
-        ("not held", Some(false))
+        (Verdict::NotHeld, Some(false))
     } else if worst_lo >= NOT_WORSE && worst_lo.is_finite() {
-        ("held", Some(true))
+        (Verdict::Held, Some(true))
     } else {
-        ("inconclusive", None)
+        (Verdict::Inconclusive, None)
     };
     let listed: Vec<String> = pairs
         .iter()
@@ -110,7 +111,7 @@ fn never_worse_claim(r: &RunReport, tb: &str, budget: u64) -> Claim {
     c.our_value = Some(worst);
     c.interval = Some([worst_lo, worst_hi]);
     c.held = held;
-    c.verdict = verdict.into();
+    c.verdict = Some(verdict);
     c.reason = format!(
         "{} pairs at level {level:.4} (Bonferroni): held when every lower end is >= {NOT_WORSE}, not held when an upper end is below it; the adaptive model equals the non-terminating one at sigma_samp >= 1, so those pairs are left out",
         pairs.len()

@@ -41,7 +41,7 @@ fn unbiased_claim(r: &RunReport, variant: &str, estimator: &str) -> Claim {
         paper_value: None,
         our_value: ours,
         held: decisive.and_then(|t| mcbench::claims::unbiased_verdict(t).0),
-        verdict: decisive.map_or(String::new(), |t| mcbench::claims::unbiased_verdict(t).1),
+        verdict: decisive.map(|t| mcbench::claims::unbiased_verdict(t).1),
         reason: decisive.map_or(String::new(), |t| t.reason.clone()),
         note: format!(
             "{} (Holm-Welch per pixel and the pooled t-test over repetitions, Bonferroni); smallest Holm-adjusted p {} (pooled t {}); uniform_image on the same bed: Holm-Welch {}, pooled t {}; {} repetitions (see docs/src/paper-003.md: heavy-tailed pixel samples)",

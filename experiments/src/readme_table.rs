@@ -6,7 +6,7 @@
 //! `sensitivity`'s) into the snapshot; `... -- readme` rewrites the README's tables from it. The
 //! test `readme_table` fails when the README and the snapshot differ.
 
-use mcbench::output::Claim;
+use mcbench::output::{Claim, Verdict};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -126,7 +126,7 @@ fn cell(s: &str) -> String {
 /// One row of the generated table: a claim text with one verdict, over the test beds that share it.
 struct Row {
     claim: String,
-    verdict: String,
+    verdict: Verdict,
     beds: Vec<String>,
     values: Vec<String>,
     /// Whether the value divides by measured CPU time.
@@ -158,7 +158,7 @@ pub fn table(s: &Snapshot) -> String {
                 }
                 None => rows.push(Row {
                     claim: c.claim.clone(),
-                    verdict: c.verdict().to_string(),
+                    verdict: c.verdict(),
                     beds: vec![c.testbed.clone()],
                     values: vec![value(c)],
                     time,
@@ -221,13 +221,13 @@ pub fn current(readme: &str) -> Result<&str, TableError> {
 mod tests {
     use super::*;
 
-    fn claim(text: &str, bed: &str, v: f64, verdict: &str, regime: &str) -> Claim {
+    fn claim(text: &str, bed: &str, v: f64, verdict: Verdict, regime: &str) -> Claim {
         Claim {
             testbed: bed.into(),
             claim: text.into(),
             our_value: Some(v),
             interval: Some([v * 0.9, v * 1.1]),
-            verdict: verdict.into(),
+            verdict: Some(verdict),
             regime: regime.into(),
             note: "n | m".into(),
             ..Default::default()
@@ -248,17 +248,17 @@ mod tests {
                 e(
                     "x",
                     vec![
-                        claim("paper 002 Fig. 9: a", "eq21", 28.3, "held", ""),
-                        claim("paper 002 Fig. 9: a", "perlin", 6.8, "held", ""),
-                        claim("paper 002 Fig. 9: a", "other", 0.5, "not held", ""),
-                        claim("paper 004 §7: <b>", "env", 0.17, "not held", "measured"),
+                        claim("paper 002 Fig. 9: a", "eq21", 28.3, Verdict::Held, ""),
+                        claim("paper 002 Fig. 9: a", "perlin", 6.8, Verdict::Held, ""),
+                        claim("paper 002 Fig. 9: a", "other", 0.5, Verdict::NotHeld, ""),
+                        claim("paper 004 §7: <b>", "env", 0.17, Verdict::NotHeld, "measured"),
                     ],
                 ),
                 e(
                     "sensitivity",
                     vec![
-                        claim("paper 002: h (against v)", "eq21", 1.0, "inconclusive", ""),
-                        claim("paper 003: t (against d)", "checker", 1.4, "held", "measured"),
+                        claim("paper 002: h (against v)", "eq21", 1.0, Verdict::Inconclusive, ""),
+                        claim("paper 003: t (against d)", "checker", 1.4, Verdict::Held, "measured"),
                     ],
                 ),
             ],

@@ -2,6 +2,7 @@
 //! their unbiasedness verdicts, the paper's claims beside ours, and what was skipped.
 
 use crate::report::{markdown_table, sig};
+use crate::verdict::Verdict;
 
 /// Prints the summary of one experiment's run that took `seconds`.
 pub fn print_summary(r: &crate::output::RunReport, seconds: f64) {
@@ -58,8 +59,8 @@ pub fn print_summary(r: &crate::output::RunReport, seconds: f64) {
         .iter()
         .map(|c| {
             let held = match c.verdict() {
-                "not held" => "did NOT hold",
-                v => v,
+                Verdict::NotHeld => "did NOT hold",
+                v => v.as_str(),
             };
             vec![
                 c.claim.clone(),

@@ -105,6 +105,7 @@ pub mod sensitivity;
 pub mod shard;
 pub mod store;
 pub mod unbiasedness;
+pub mod verdict;
 
 /// The plug-in API (`mcbench-core`), for crates that depend on the harness alone.
 pub use mcbench_core;

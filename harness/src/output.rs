@@ -11,6 +11,8 @@ use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::Path;
 
+pub use crate::verdict::Verdict;
+
 /// Writes `bytes` to `path` atomically (a temp file in the same folder, then a rename). The temp
 /// file is created new: whatever is in its place (a symbolic link included) is removed first,
 /// never written through.
@@ -95,11 +97,11 @@ pub struct Claim {
     pub held: Option<bool>,
     /// How it was judged, or why it was not.
     pub note: String,
-    /// `held`, `not held`, `inconclusive` (the interval or test does not decide), `reported` (a
-    /// measurement shown beside the paper's number, with no verdict) or `not measured`; empty in
-    /// files written before it, where `held` is the verdict ([`Claim::verdict`]).
-    #[serde(default)]
-    pub verdict: String,
+    /// The verdict, when the claim states one (written `held`, `not held`, `inconclusive`,
+    /// `reported` or `not measured`); `None` (the empty word) where `held` is the verdict
+    /// ([`Claim::verdict`]), as in files written before it. Any other word is refused on reading.
+    #[serde(default, with = "crate::verdict::word")]
+    pub verdict: Option<Verdict>,
     /// 95% interval of `our_value`, for claims judged on an interval.
     #[serde(default)]
     pub interval: Option<[f64; 2]>,
@@ -119,15 +121,15 @@ pub struct Claim {
 impl Claim {
     /// The verdict: `verdict` when set, else read from `held` (with no `held`: `reported` when
     /// there is a value, `not measured` when there is none).
-    pub fn verdict(&self) -> &str {
-        if !self.verdict.is_empty() {
-            return &self.verdict;
+    pub fn verdict(&self) -> Verdict {
+        if let Some(v) = self.verdict {
+            return v;
         }
         match (self.held, self.our_value) {
-            (Some(true), _) => "held",
-            (Some(false), _) => "not held",
-            (None, Some(_)) => "reported",
-            (None, None) => "not measured",
+            (Some(true), _) => Verdict::Held,
+            (Some(false), _) => Verdict::NotHeld,
+            (None, Some(_)) => Verdict::Reported,
+            (None, None) => Verdict::NotMeasured,
         }
     }
 }
@@ -345,17 +347,17 @@ fn one_line(s: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::Claim;
+    use super::{Claim, Verdict};
 
     #[test]
     fn a_claim_without_a_verdict_reads_reported_when_it_has_a_value() {
         let c = |held, our_value| Claim { held, our_value, ..Default::default() };
-        assert_eq!(c(Some(true), Some(1.0)).verdict(), "held");
-        assert_eq!(c(Some(false), None).verdict(), "not held");
-        assert_eq!(c(None, Some(1.0)).verdict(), "reported");
-        assert_eq!(c(None, None).verdict(), "not measured");
-        let set = Claim { verdict: "inconclusive".into(), ..c(None, Some(1.0)) };
-        assert_eq!(set.verdict(), "inconclusive");
+        assert_eq!(c(Some(true), Some(1.0)).verdict(), Verdict::Held);
+        assert_eq!(c(Some(false), None).verdict(), Verdict::NotHeld);
+        assert_eq!(c(None, Some(1.0)).verdict(), Verdict::Reported);
+        assert_eq!(c(None, None).verdict(), Verdict::NotMeasured);
+        let set = Claim { verdict: Some(Verdict::Inconclusive), ..c(None, Some(1.0)) };
+        assert_eq!(set.verdict(), Verdict::Inconclusive);
     }
 
     use crate::analysis::TestRow;

@@ -2,6 +2,7 @@
 
 use crate::analysis::TestRow;
 use crate::output::{Claim, RunReport};
+use crate::verdict::Verdict;
 
 /// The test that decides unbiasedness for one (variant, estimator): its `combined` row (with
 /// `suffix` appended to the name), whose verdict is `pass`, `inconclusive` or `biased`.
@@ -11,13 +12,13 @@ pub fn decisive_test<'a>(tests: &'a [TestRow], variant: &str, estimator: &str, s
 
 /// The verdict of a claim that an estimator is unbiased, from its deciding test row: `held` on
 /// `pass`, `not held` on `biased`, `inconclusive` otherwise, with the row's reason.
-pub fn unbiased_verdict(t: &TestRow) -> (Option<bool>, String, String) {
-    let (held, verdict) = match t.verdict.as_str() {
-        "pass" => (Some(true), "held"),
-        "biased" => (Some(false), "not held"),
-        _ => (None, "inconclusive"),
+pub fn unbiased_verdict(t: &TestRow) -> (Option<bool>, Verdict, String) {
+    let verdict = match t.verdict.as_str() {
+        "pass" => Verdict::Held,
+        "biased" => Verdict::NotHeld,
+        _ => Verdict::Inconclusive,
     };
-    (held, verdict.into(), t.reason.clone())
+    (verdict.held(), verdict, t.reason.clone())
 }
 
 /// "The biased control is flagged by the unbiasedness test" on every variant it ran on: `held`
@@ -46,9 +47,9 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
     let used: Vec<String> =
         decisive.iter().map(|t| format!("{}/{}: {} p = {:.2e}", t.testbed, t.variant, t.verdict, t.p_value)).collect();
     let (verdict, reason) = if decisive.is_empty() {
-        ("not measured", "no unbiasedness row of the control".to_string())
+        (Verdict::NotMeasured, "no unbiasedness row of the control".to_string())
     } else if missed.is_empty() {
-        ("held", format!("flagged on all {} variants", decisive.len()))
+        (Verdict::Held, format!("flagged on all {} variants", decisive.len()))
     } else if missed.iter().any(|t| visible(t)) {
         let seen: Vec<String> = missed
             .iter()
@@ -64,7 +65,7 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
                 )
             })
             .collect();
-        ("not held", format!("missed where its row could see the bias: {}", seen.join(", ")))
+        (Verdict::NotHeld, format!("missed where its row could see the bias: {}", seen.join(", ")))
     } else {
         let under: Vec<String> = missed
             .iter()
@@ -92,7 +93,7 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
                 )
             })
             .collect();
-        ("inconclusive", under.join("; "))
+        (Verdict::Inconclusive, under.join("; "))
     };
     Claim {
         testbed: decisive.first().map(|t| t.testbed.clone()).unwrap_or_default(),
@@ -101,18 +102,14 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
         ),
         paper_value: None,
         our_value: (!decisive.is_empty()).then_some(max_p),
-        held: match verdict {
-            "held" => Some(true),
-            "not held" => Some(false),
-            _ => None,
-        },
+        held: verdict.held(),
         note: if missed.is_empty() {
             format!("flagged on all {} variants (largest p shown): {}", decisive.len(), used.join("; "))
         } else {
             let names: Vec<String> = missed.iter().map(|t| format!("{}/{}", t.testbed, t.variant)).collect();
             format!("NOT flagged on {}: {}", names.join(", "), used.join("; "))
         },
-        verdict: verdict.into(),
+        verdict: Some(verdict),
         reason,
         ..Default::default()
     }
@@ -121,6 +118,7 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
 #[cfg(test)]
 mod tests {
     use crate::analysis::TestRow;
+    use crate::verdict::Verdict;
 
     /// A control's combined rows on two variants: (variant, verdict, relative bias, its standard
     /// error, detectable bias).
@@ -157,20 +155,20 @@ mod tests {
             &report(&[("a", "biased", 0.05, 0.005, 0.02), ("b", "biased", 0.03, 0.005, 0.02)]),
             "ctl",
         );
-        assert_eq!((held.verdict.as_str(), held.held), ("held", Some(true)));
+        assert_eq!((held.verdict, held.held), (Some(Verdict::Held), Some(true)));
         // Missed on b, whose row detects 4% against a 1% bias: inconclusive, with the repetitions
         // (16 x 4^2 = 256) that would resolve it.
         let under = super::control_flagged(
             &report(&[("a", "biased", 0.05, 0.005, 0.02), ("b", "inconclusive", 0.01, 0.01, 0.04)]),
             "ctl",
         );
-        assert_eq!((under.verdict.as_str(), under.held), ("inconclusive", None), "{under:?}");
+        assert_eq!((under.verdict, under.held), (Some(Verdict::Inconclusive), None), "{under:?}");
         assert!(under.reason.contains("256 repetitions"), "{}", under.reason);
         // Missed on b although its row detects 2% and the bias is 5% ± 0.5%: not held.
         let blind = super::control_flagged(
             &report(&[("a", "biased", 0.05, 0.005, 0.02), ("b", "pass", 0.05, 0.005, 0.02)]),
             "ctl",
         );
-        assert_eq!((blind.verdict.as_str(), blind.held), ("not held", Some(false)), "{blind:?}");
+        assert_eq!((blind.verdict, blind.held), (Some(Verdict::NotHeld), Some(false)), "{blind:?}");
     }
 }

@@ -4,6 +4,7 @@
 
 use super::ratio::RatioMetric;
 use crate::metrics::SummaryRow;
+use crate::verdict::Verdict;
 
 /// A ratio `metric(a) / metric(b)` with an exact cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,17 +30,25 @@ impl ExactRatio {
     }
 
     /// The verdict of "the ratio lies above `threshold`" (`above`, else below), with the reason.
-    pub fn verdict(self, threshold: f64, above: bool) -> (&'static str, Option<bool>, String) {
+    pub fn verdict(self, threshold: f64, above: bool) -> (Verdict, Option<bool>, String) {
         let high = match self {
             ExactRatio::BothExact => {
-                return ("inconclusive", None, "both cells are exact (their errors are round-off): no ratio".into())
+                return (
+                    Verdict::Inconclusive,
+                    None,
+                    "both cells are exact (their errors are round-off): no ratio".into(),
+                )
             }
             ExactRatio::Zero => false,
             ExactRatio::Unbounded => true,
         };
         let held = high == above;
         let side = if high { "unbounded, above" } else { "zero, below" };
-        (if held { "held" } else { "not held" }, Some(held), format!("exact: the ratio is {side} {threshold}"))
+        (
+            if held { Verdict::Held } else { Verdict::NotHeld },
+            Some(held),
+            format!("exact: the ratio is {side} {threshold}"),
+        )
     }
 
     /// How notes give it.
@@ -74,10 +83,10 @@ mod tests {
         assert_eq!(ExactRatio::of(RatioMetric::Rmse, &noisy, &old), None);
         assert_eq!(ExactRatio::Unbounded.verdict(2.0, true).1, Some(true));
         assert_eq!(ExactRatio::Unbounded.verdict(2.0, false).1, Some(false));
-        assert_eq!(ExactRatio::Zero.verdict(1.0, false).0, "held");
+        assert_eq!(ExactRatio::Zero.verdict(1.0, false).0, Verdict::Held);
         assert_eq!(
             ExactRatio::BothExact.verdict(1.0, true),
-            ("inconclusive", None, ExactRatio::BothExact.verdict(1.0, true).2)
+            (Verdict::Inconclusive, None, ExactRatio::BothExact.verdict(1.0, true).2)
         );
     }
 }

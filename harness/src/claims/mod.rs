@@ -20,6 +20,7 @@ pub use slope::{
 use crate::analysis::{Fit, SpeedUp, SpeedUpOutcome};
 use crate::cost_model::Regime;
 use crate::output::{Claim, RunReport};
+use crate::verdict::Verdict;
 
 /// The fit of an estimator on a test bed, if the run has one.
 pub fn fit<'a>(report: &'a RunReport, testbed: &str, variant: &str, estimator: &str) -> Option<&'a Fit> {
@@ -82,7 +83,7 @@ pub fn speedup_claim(
                  CPU time, {:.3}x (renderer)",
                 s.baseline, s.budget, s.overhead, s.overhead_renderer
             ),
-            verdict: "held".into(),
+            verdict: Some(Verdict::Held),
             interval: None,
             pair: format!("{estimator} vs {}", s.baseline),
             regime: regime.name().into(),
@@ -134,7 +135,7 @@ pub fn speedup_claim(
         our_value: Some(value),
         held,
         note,
-        verdict: verdict.into(),
+        verdict: Some(verdict),
         interval: Some([lo, hi]),
         pair: format!("{estimator} vs {}", s.baseline),
         regime: regime.name().into(),

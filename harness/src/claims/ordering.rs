@@ -18,6 +18,7 @@ use super::ratio::{row, Ratio, RatioMetric, LEVEL};
 use crate::cost_model::Regime;
 use crate::metrics::SummaryRow;
 use crate::output::{Claim, RunReport};
+use crate::verdict::Verdict;
 
 /// Whether a smaller value of `metric` is better (errors) or a larger one (efficiencies).
 pub fn lower_is_better(metric: RatioMetric) -> bool {
@@ -95,13 +96,13 @@ pub fn repetitions_to_detect(detectable: f64, reps: usize, target: f64) -> f64 {
 }
 
 fn missing(base: Claim, why: String) -> Claim {
-    Claim { verdict: "inconclusive".into(), held: None, reason: why.clone(), note: why, ..base }
+    Claim { verdict: Some(Verdict::Inconclusive), held: None, reason: why.clone(), note: why, ..base }
 }
 
 /// A claim refused because it compares `name` with itself.
 pub fn refused(base: Claim, name: &str) -> Claim {
     let why = format!("refused: the claim compares {name} with itself");
-    Claim { verdict: "not measured".into(), held: None, reason: why.clone(), note: why, ..base }
+    Claim { verdict: Some(Verdict::NotMeasured), held: None, reason: why.clone(), note: why, ..base }
 }
 
 /// The rows of `names` on `tb` at `budget`, or the first name without one.
@@ -196,9 +197,9 @@ pub fn ordering_claim(
     let side = if lowest { "below" } else { "above" };
     let adj = format!("level {level:.4}, Bonferroni over {} pairs", pairs.len());
     let (verdict, held, reason) = match decide(&ends, lowest) {
-        Decision::Held => ("held", Some(true), format!("every interval lies {side} 1 ({adj})")),
+        Decision::Held => (Verdict::Held, Some(true), format!("every interval lies {side} 1 ({adj})")),
         Decision::NotHeld(i) => {
-            ("not held", Some(false), format!("{}: the interval lies on the other side of 1 ({adj})", pairs[i].0))
+            (Verdict::NotHeld, Some(false), format!("{}: the interval lies on the other side of 1 ({adj})", pairs[i].0))
         }
         Decision::Open(open) => {
             let need = open
@@ -211,7 +212,7 @@ pub fn ordering_claim(
             } else {
                 "no repetition count decides it (a ratio sits at 1)".into()
             };
-            ("inconclusive", None, format!("the intervals of {} straddle 1 ({adj}); {more}", names.join(", ")))
+            (Verdict::Inconclusive, None, format!("the intervals of {} straddle 1 ({adj}); {more}", names.join(", ")))
         }
     };
     let listed: Vec<String> =
@@ -226,7 +227,7 @@ pub fn ordering_claim(
             pairs[bind].1.reps,
             listed.join("; ")
         ),
-        verdict: verdict.into(),
+        verdict: Some(verdict),
         interval: Some([lo, hi]),
         pair: pairs[bind].0.clone(),
         reason,
@@ -284,16 +285,20 @@ pub fn optimum_claim(
     let (a, b) = (&ins[bi].estimator, &outs[bo].estimator);
     let (verdict, held, reason) = match (decide(&in_wins, lowest), decide(&out_wins, lowest)) {
         (Decision::Held, _) => {
-            ("held", Some(true), format!("the best inside, {a}, beats every outside candidate ({adj})"))
+            (Verdict::Held, Some(true), format!("the best inside, {a}, beats every outside candidate ({adj})"))
         }
         (_, Decision::Held) => {
-            ("not held", Some(false), format!("the best outside, {b}, beats every inside candidate ({adj})"))
+            (Verdict::NotHeld, Some(false), format!("the best outside, {b}, beats every inside candidate ({adj})"))
         }
         _ => {
             let (lo, hi) = r.interval_at(level);
             let need = repetitions_to_decide((r.value, r.reps), (lo, hi), 1.0)
                 .map_or("no repetition count decides it".into(), |n| format!("about {n} repetitions would decide it"));
-            ("inconclusive", None, format!("neither best beats every candidate on the other side ({adj}); {need}"))
+            (
+                Verdict::Inconclusive,
+                None,
+                format!("neither best beats every candidate on the other side ({adj}); {need}"),
+            )
         }
     };
     let listed: Vec<String> = ins
@@ -318,7 +323,7 @@ pub fn optimum_claim(
             r.value,
             listed.join(", ")
         ),
-        verdict: verdict.into(),
+        verdict: Some(verdict),
         interval: Some([lo, hi]),
         pair: format!("{a} vs {b}"),
         reason,
@@ -363,15 +368,15 @@ pub fn ratio_of_ratios_claim(
     let (yes, no) = if above { (lo > threshold, hi < threshold) } else { (hi < threshold, lo > threshold) };
     let side = if above { "above" } else { "below" };
     let (verdict, held, reason) = if !(lo.is_finite() && hi.is_finite()) {
-        ("inconclusive", None, "no interval: the cells carry no error spread".to_string())
+        (Verdict::Inconclusive, None, "no interval: the cells carry no error spread".to_string())
     } else if yes {
-        ("held", Some(true), format!("the 95% interval lies {side} {threshold}"))
+        (Verdict::Held, Some(true), format!("the 95% interval lies {side} {threshold}"))
     } else if no {
-        ("not held", Some(false), format!("the 95% interval lies on the other side of {threshold}"))
+        (Verdict::NotHeld, Some(false), format!("the 95% interval lies on the other side of {threshold}"))
     } else {
         let more = repetitions_to_decide((value, n.reps.min(d.reps)), (lo, hi), threshold)
             .map_or("no repetition count decides it".into(), |k| format!("about {k} repetitions would decide it"));
-        ("inconclusive", None, format!("the 95% interval straddles {threshold}; {more}"))
+        (Verdict::Inconclusive, None, format!("the 95% interval straddles {threshold}; {more}"))
     };
     Claim {
         our_value: Some(value),
@@ -387,7 +392,7 @@ pub fn ratio_of_ratios_claim(
             n.reps.min(d.reps),
             m = family.metric.name(),
         ),
-        verdict: verdict.into(),
+        verdict: Some(verdict),
         interval: Some([lo, hi]),
         reason,
         ..base

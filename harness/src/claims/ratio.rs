@@ -27,6 +27,7 @@ use super::exact_ratio::ExactRatio;
 use crate::cost_model::Regime;
 use crate::metrics::SummaryRow;
 use crate::output::{Claim, RunReport};
+use crate::verdict::Verdict;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -215,17 +216,17 @@ impl Ratio {
 
     /// `above`: whether the ratio lies above `threshold` (else below): `held`, `not held` or
     /// `inconclusive`, with the reason.
-    pub fn verdict(&self, threshold: f64, above: bool) -> (&'static str, Option<bool>, String) {
+    pub fn verdict(&self, threshold: f64, above: bool) -> (Verdict, Option<bool>, String) {
         let (lo, hi) = self.interval();
         let side = if above { "above" } else { "below" };
         if !(lo.is_finite() && hi.is_finite()) {
-            return ("inconclusive", None, "no interval: the cells carry no error spread (mse_se)".into());
+            return (Verdict::Inconclusive, None, "no interval: the cells carry no error spread (mse_se)".into());
         }
         let (yes, no) = if above { (lo > threshold, hi < threshold) } else { (hi < threshold, lo > threshold) };
         if yes {
-            ("held", Some(true), format!("the 95% interval lies {side} {threshold}"))
+            (Verdict::Held, Some(true), format!("the 95% interval lies {side} {threshold}"))
         } else if no {
-            ("not held", Some(false), format!("the 95% interval lies on the other side of {threshold}"))
+            (Verdict::NotHeld, Some(false), format!("the 95% interval lies on the other side of {threshold}"))
         } else {
             let z = t_quantile(0.5 + 0.5 * LEVEL, f64::INFINITY);
             let need = (self.reps as f64 * (z * self.log_se / (self.value / threshold).ln().abs()).powi(2)).ceil();
@@ -234,7 +235,7 @@ impl Ratio {
             } else {
                 "no repetition count decides it (the ratio sits at the threshold)".into()
             };
-            ("inconclusive", None, format!("the 95% interval straddles {threshold}; {more}"))
+            (Verdict::Inconclusive, None, format!("the 95% interval straddles {threshold}; {more}"))
         }
     }
 }
@@ -282,7 +283,7 @@ pub fn ratio_claim(report: &RunReport, spec: &RatioSpec<'_>, claim: &str, note: 
     };
     let (Some(a), Some(b)) = (row(report, tb, estimator, budget), row(report, tb, baseline, budget)) else {
         return Claim {
-            verdict: "not measured".into(),
+            verdict: Some(Verdict::NotMeasured),
             note: format!("no {} cell for {estimator} or {baseline} at {budget}", metric.name()),
             ..base
         };
@@ -297,14 +298,14 @@ pub fn ratio_claim(report: &RunReport, spec: &RatioSpec<'_>, claim: &str, note: 
                 a.budget_kind,
                 exact.describe()
             ),
-            verdict: verdict.into(),
+            verdict: Some(verdict),
             reason,
             ..base
         };
     }
     let Some(r) = Ratio::of(metric, a, b) else {
         return Claim {
-            verdict: "not measured".into(),
+            verdict: Some(Verdict::NotMeasured),
             note: format!("{} not defined for {estimator} or {baseline} at {budget}", metric.name()),
             ..base
         };
@@ -322,7 +323,7 @@ pub fn ratio_claim(report: &RunReport, spec: &RatioSpec<'_>, claim: &str, note: 
             r.reps,
             r.method()
         ),
-        verdict: verdict.into(),
+        verdict: Some(verdict),
         interval: Some([lo, hi]),
         reason,
         ..base
@@ -363,22 +364,22 @@ mod tests {
         // MSE 4 vs 1 with 5% relative errors: RMSE ratio 2, log SE 0.5 x sqrt(2) x 0.05.
         rows(&mut report, (4.0, 1.0), (0.2, 0.05));
         let c = ratio_claim(&report, &spec(RatioMetric::Rmse, true), "a has the larger error", "");
-        assert_eq!((c.verdict.as_str(), c.held, c.pair.as_str()), ("held", Some(true), "a vs b"), "{c:?}");
+        assert_eq!((c.verdict, c.held, c.pair.as_str()), (Some(Verdict::Held), Some(true), "a vs b"), "{c:?}");
         let [lo, hi] = c.interval.expect("interval");
         let w = (t_quantile(0.975, 15.0) * 0.5 * 2f64.sqrt() * 0.05).exp();
         assert!((lo - 2.0 / w).abs() < 1e-12 && (hi - 2.0 * w).abs() < 1e-12);
         // The FoM ratio is the inverse MSE ratio: 1/4, below 1.
         let f = ratio_claim(&report, &spec(RatioMetric::Fom, false), "a has the lower FoM", "");
-        assert_eq!((f.verdict.as_str(), f.our_value), ("held", Some(0.25)), "{f:?}");
-        assert_eq!(ratio_claim(&report, &spec(RatioMetric::Fom, true), "", "").verdict, "not held");
+        assert_eq!((f.verdict, f.our_value), (Some(Verdict::Held), Some(0.25)), "{f:?}");
+        assert_eq!(ratio_claim(&report, &spec(RatioMetric::Fom, true), "", "").verdict, Some(Verdict::NotHeld));
         // Noisy cells straddle 1: inconclusive, with the repetitions that would decide.
         rows(&mut report, (1.1, 1.0), (0.3, 0.3));
         let i = ratio_claim(&report, &spec(RatioMetric::Mse, true), "", "");
-        assert_eq!((i.verdict.as_str(), i.held), ("inconclusive", None), "{i:?}");
+        assert_eq!((i.verdict, i.held), (Some(Verdict::Inconclusive), None), "{i:?}");
         assert!(i.reason.contains("repetitions would decide"), "{}", i.reason);
         // A missing cell is not measured.
         let mut s = spec(RatioMetric::Mse, true);
         s.budget = 4;
-        assert_eq!(ratio_claim(&report, &s, "", "").verdict(), "not measured");
+        assert_eq!(ratio_claim(&report, &s, "", "").verdict(), Verdict::NotMeasured);
     }
 }

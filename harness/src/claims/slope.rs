@@ -4,6 +4,7 @@
 use super::{fit, not_measured};
 use crate::analysis::{SlopeOutcome, SlopeRange};
 use crate::output::{Claim, RunReport};
+use crate::verdict::Verdict;
 
 /// The log-log slope between the last two budgets of a series (the local order at the right end).
 pub fn last_segment_slope(report: &RunReport, testbed: &str, variant: &str, estimator: &str) -> Option<f64> {
@@ -42,7 +43,7 @@ fn slope_claim(
             our_value: None,
             held: None,
             note: format!("{estimator} is exact at every budget ({:?}): its RMSE is round-off", f.budgets),
-            verdict: "inconclusive".into(),
+            verdict: Some(Verdict::Inconclusive),
             reason: "exact at every budget: no slope to judge, an error of rounding alone has no order of \
                      convergence"
                 .into(),
@@ -78,9 +79,9 @@ fn slope_claim(
                 _ => String::new(),
             };
             let verdict = match held {
-                Some(true) => "held",
-                Some(false) => "not held",
-                None => "inconclusive",
+                Some(true) => Verdict::Held,
+                Some(false) => Verdict::NotHeld,
+                None => Verdict::Inconclusive,
             };
             Claim {
                 testbed: format!("{}/{}", tb.0, tb.1),
@@ -89,7 +90,7 @@ fn slope_claim(
                 our_value: Some(slope),
                 held,
                 note: format!("{over}{beside}"),
-                verdict: verdict.into(),
+                verdict: Some(verdict),
                 interval: Some([lo, hi]),
                 reason: note,
                 ..Default::default()

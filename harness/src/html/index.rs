@@ -5,7 +5,7 @@
 
 use super::markup::{badge, count_badges, esc, page, table, url, verdict_class, Cell};
 use crate::error::{HarnessError, Result};
-use crate::output::{Claim, RunReport};
+use crate::output::{Claim, RunReport, Verdict};
 use crate::report::{digest, interval, opt, sig};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -30,8 +30,8 @@ pub struct ClaimLine {
     pub our_value: Option<f64>,
     /// 95% interval of ours.
     pub interval: Option<[f64; 2]>,
-    /// The verdict word.
-    pub verdict: String,
+    /// The verdict.
+    pub verdict: Verdict,
 }
 
 impl From<&Claim> for ClaimLine {
@@ -42,7 +42,7 @@ impl From<&Claim> for ClaimLine {
             paper_value: c.paper_value,
             our_value: c.our_value,
             interval: c.interval,
-            verdict: c.verdict().to_string(),
+            verdict: c.verdict(),
         }
     }
 }
@@ -150,7 +150,7 @@ fn page_link(name: &str, dir: &Path) -> String {
 
 fn claims_table(o: &Overview) -> String {
     let all = o.claims.len() <= ROOT_CLAIMS;
-    let attention = |c: &&ClaimLine| matches!(c.verdict.as_str(), "not held" | "inconclusive");
+    let attention = |c: &&ClaimLine| c.verdict.needs_attention();
     let shown: Vec<&ClaimLine> =
         if all { o.claims.iter().collect() } else { o.claims.iter().filter(attention).take(ROOT_CLAIMS).collect() };
     let rows = shown
@@ -162,9 +162,9 @@ fn claims_table(o: &Overview) -> String {
                 Cell::text(&c.testbed),
                 Cell::num(&opt(c.paper_value)),
                 Cell::num(ours.trim()),
-                Cell::html(badge(&c.verdict)),
+                Cell::html(badge(c.verdict.as_str())),
             ];
-            (verdict_class(&c.verdict), cells)
+            (verdict_class(c.verdict.as_str()), cells)
         })
         .collect();
     let mut out = String::new();
@@ -265,7 +265,7 @@ mod tests {
         let root = dir.path();
         let mut report = synthetic_report();
         report.paper.push(Claim {
-            verdict: "inconclusive".into(),
+            verdict: Some(Verdict::Inconclusive),
             claim: "a <second> claim".into(),
             ..report.paper[0].clone()
         });

@@ -140,7 +140,7 @@ fn claims(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
                 Cell::num(&opt(c.paper_value)),
                 Cell::num(&opt(c.our_value)),
                 Cell::num(&interval(c.interval)),
-                Cell::html(badge(c.verdict())),
+                Cell::html(badge(c.verdict().as_str())),
                 Cell::text(
                     &[c.pair.as_str(), c.regime.as_str()]
                         .iter()
@@ -151,7 +151,7 @@ fn claims(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
                 ),
                 Cell::html(note_html(&note)),
             ];
-            (verdict_class(c.verdict()), cells)
+            (verdict_class(c.verdict().as_str()), cells)
         })
         .collect();
     let header = ["claim", "testbed", "paper", "ours", "95% interval", "verdict", "pair; cost regime", "note"];

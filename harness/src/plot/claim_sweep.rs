@@ -8,6 +8,7 @@
 
 use super::style::{self, named, text, FONT, LEGEND_ROW, MARGIN, TITLE_H};
 use crate::error::{HarnessError, Result};
+use crate::verdict::Verdict;
 use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
@@ -29,8 +30,8 @@ pub struct SettingPoint {
     pub value: Option<f64>,
     /// Its interval.
     pub interval: Option<[f64; 2]>,
-    /// The verdict (`held`, `not held`, `inconclusive`, ...).
-    pub verdict: String,
+    /// The verdict there.
+    pub verdict: Verdict,
     /// The scene's ceiling of the claim there, drawn as an orange triangle.
     pub ceiling: Option<f64>,
 }
@@ -199,9 +200,9 @@ where
             chart.draw_series(std::iter::once(TriangleMarker::new((x, c), 7, CEILING.filled())))?;
         }
         let Some(y) = p.value.filter(|v| v.is_finite()) else { continue };
-        match p.verdict.as_str() {
-            "held" => chart.draw_series(std::iter::once(Circle::new((x, y), 6, GREEN.filled())))?,
-            "not held" => chart.draw_series(std::iter::once(Cross::new((x, y), 7, RED.stroke_width(3))))?,
+        match p.verdict {
+            Verdict::Held => chart.draw_series(std::iter::once(Circle::new((x, y), 6, GREEN.filled())))?,
+            Verdict::NotHeld => chart.draw_series(std::iter::once(Cross::new((x, y), 7, RED.stroke_width(3))))?,
             _ => chart.draw_series(std::iter::once(Circle::new((x, y), 6, GREY.stroke_width(2))))?,
         };
     }
@@ -212,12 +213,12 @@ where
 mod tests {
     use super::*;
 
-    fn point(label: &str, value: f64, verdict: &str) -> SettingPoint {
+    fn point(label: &str, value: f64, verdict: Verdict) -> SettingPoint {
         SettingPoint {
             label: label.into(),
             value: Some(value),
             interval: Some([value * 0.9, value * 1.1]),
-            verdict: verdict.into(),
+            verdict,
             ceiling: Some(value * 2.0),
         }
     }
@@ -230,9 +231,9 @@ mod tests {
             x_desc: "sigma_t".into(),
             y_desc: "speed-up".into(),
             points: vec![
-                point("0.125", 9.0, "not held"),
-                point("2*", 0.75, "not held"),
-                point("0.5 (paper)", 3.0, "held"),
+                point("0.125", 9.0, Verdict::NotHeld),
+                point("2*", 0.75, Verdict::NotHeld),
+                point("0.5 (paper)", 3.0, Verdict::Held),
             ],
             paper: Some(15.3),
         };
@@ -240,7 +241,7 @@ mod tests {
         let files = write_claim_sweep(&dir, "log", &fig).unwrap();
         assert_eq!(files.len(), 2);
         assert!(std::fs::read_to_string(&files[0]).unwrap().contains("sigma_t"));
-        fig.points = vec![point("a", -0.6, "held"), point("b", -0.5, "inconclusive")];
+        fig.points = vec![point("a", -0.6, Verdict::Held), point("b", -0.5, Verdict::Inconclusive)];
         fig.paper = Some(-0.62);
         assert_eq!(fig.y_range().map(|r| r.2), Some(false));
         assert_eq!(write_claim_sweep(&dir, "linear", &fig).unwrap().len(), 2);

@@ -5,11 +5,17 @@
 
 use crate::analysis::TestRow;
 use crate::metrics::SummaryRow;
-use crate::output::Claim;
+use crate::output::{Claim, Verdict};
 use std::path::{Path, PathBuf};
 
 /// Claim verdicts in the order summaries list them (any other word follows, alphabetically).
-pub const CLAIM_VERDICTS: [&str; 5] = ["held", "not held", "inconclusive", "reported", "not measured"];
+pub const CLAIM_VERDICTS: [&str; 5] = [
+    Verdict::Held.as_str(),
+    Verdict::NotHeld.as_str(),
+    Verdict::Inconclusive.as_str(),
+    Verdict::Reported.as_str(),
+    Verdict::NotMeasured.as_str(),
+];
 
 /// Test verdicts in the order summaries list them (any other word follows, alphabetically).
 pub const TEST_VERDICTS: [&str; 3] = ["pass", "biased", "inconclusive"];
@@ -31,12 +37,12 @@ pub fn tally<'a>(words: impl IntoIterator<Item = &'a str>, known: &[&str]) -> Ve
 
 /// The claims' verdict counts.
 pub fn claim_counts(claims: &[Claim]) -> Vec<(String, usize)> {
-    tally(claims.iter().map(Claim::verdict), &CLAIM_VERDICTS)
+    tally(claims.iter().map(|c| c.verdict().as_str()), &CLAIM_VERDICTS)
 }
 
 /// Whether a claim needs a reader's attention first: it did not hold or the run could not decide.
 pub fn claim_needs_attention(c: &Claim) -> bool {
-    matches!(c.verdict(), "not held" | "inconclusive")
+    c.verdict().needs_attention()
 }
 
 /// The deciding rows of `tests`, in order: the `combined` row of a (test bed, variant, estimator,

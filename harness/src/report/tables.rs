@@ -38,7 +38,7 @@ impl<'a> From<&'a Claim> for ClaimRow<'a> {
             our_value: c.our_value,
             interval_low: c.interval.map(|i| i[0]),
             interval_high: c.interval.map(|i| i[1]),
-            verdict: c.verdict(),
+            verdict: c.verdict().as_str(),
             pair: &c.pair,
             regime: &c.regime,
             reason: &c.reason,

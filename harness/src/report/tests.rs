@@ -1,6 +1,7 @@
 use super::*;
 use crate::analysis::TestRow;
 use crate::plot::{plot_stem, tests::synthetic_report, write_plots, PlotKind};
+use crate::verdict::Verdict;
 
 #[test]
 fn report_summarises_every_table_and_shows_every_plot() {
@@ -56,8 +57,9 @@ fn long_tables_are_cut_to_the_rows_that_need_attention() {
     let claim = report.paper[0].clone();
     report.paper = (0..500)
         .map(|i| {
-            let (verdict, held) = if i % 50 == 7 { ("not held", Some(false)) } else { ("held", Some(true)) };
-            Claim { claim: format!("claim {i} {}", "x".repeat(400)), verdict: verdict.into(), held, ..claim.clone() }
+            let verdict = if i % 50 == 7 { Verdict::NotHeld } else { Verdict::Held };
+            let held = verdict.held();
+            Claim { claim: format!("claim {i} {}", "x".repeat(400)), verdict: Some(verdict), held, ..claim.clone() }
         })
         .collect();
     let test = report.tests[0].clone();

@@ -6,6 +6,7 @@
 
 use super::table::SettingRow;
 use super::{setting_text, Part};
+use crate::verdict::Verdict;
 
 /// The outcome of a part.
 #[derive(Clone, Debug, PartialEq)]
@@ -97,10 +98,10 @@ impl Outcome {
 /// The outcome of `part` from its rows (one per setting, in setting order).
 pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
     let find = |v: &mcbench_core::params::ParamValue| rows.iter().find(|r| r.setting == setting_text(v)).copied();
-    if let Some(r) = part.paper_like.as_ref().and_then(find).filter(|r| r.verdict == "held") {
+    if let Some(r) = part.paper_like.as_ref().and_then(find).filter(|r| r.verdict == Verdict::Held) {
         return Outcome::HeldAtPaperLike { setting: format!("{} = {}", part.vary, r.setting), value: value_text(r) };
     }
-    let mut held: Vec<String> = rows.iter().filter(|r| r.verdict == "held").map(|r| at(r, &part.vary)).collect();
+    let mut held: Vec<String> = rows.iter().filter(|r| r.verdict == Verdict::Held).map(|r| at(r, &part.vary)).collect();
     if held.len() == rows.len() && rows.len() > 1 {
         let values: Vec<f64> = rows.iter().filter_map(|r| r.value).collect();
         let (lo, hi) = values.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(*v), b.max(*v)));
@@ -139,7 +140,7 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
             d(a).total_cmp(&d(b))
         })
         .map_or_else(|| "no setting measured".to_string(), |r| at(r, &part.vary));
-    if rows.iter().any(|r| r.verdict == "not held") {
+    if rows.iter().any(|r| r.verdict == Verdict::NotHeld) {
         Outcome::NotHeldAnywhere { best }
     } else {
         Outcome::InconclusiveEverywhere { best }

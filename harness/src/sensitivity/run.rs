@@ -12,6 +12,7 @@ use crate::output::{Claim, Diagnostic, RunReport};
 use crate::plan::Plan;
 use crate::registry::{Experiment, Registry, Sweeps};
 use crate::runner::{self, RunResults};
+use crate::verdict::Verdict;
 use std::path::{Path, PathBuf};
 
 /// The sweep the experiment runs first (the first part at its default setting); the other
@@ -189,13 +190,9 @@ fn outcome_claim(part: &Part, rows: &[&SettingRow], outcome: &Outcome) -> Claim 
         claim: format!("paper {}: {} (against {})", part.paper, part.headline, part.vary),
         paper_value: row.and_then(|r| r.paper_value),
         our_value: row.and_then(|r| r.value),
-        held: row.and_then(|r| match r.verdict.as_str() {
-            "held" => Some(true),
-            "not held" => Some(false),
-            _ => None,
-        }),
+        held: row.and_then(|r| r.verdict.held()),
         note: outcome.sentence(),
-        verdict: row.map(|r| r.verdict.clone()).unwrap_or_else(|| "not measured".into()),
+        verdict: Some(row.map_or(Verdict::NotMeasured, |r| r.verdict)),
         interval: row.and_then(|r| Some([r.low?, r.high?])),
         pair: row.map(|r| r.pair.clone()).unwrap_or_default(),
         regime: row.map(|r| r.regime.clone()).unwrap_or_default(),

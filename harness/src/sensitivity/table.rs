@@ -8,6 +8,7 @@ use super::{setting_text, Part};
 use crate::error::Result;
 use crate::output::Claim;
 use crate::plot::claim_sweep::{write_claim_sweep, ClaimSweepFigure, SettingPoint};
+use crate::verdict::Verdict;
 use mcbench_core::params::ParamValue;
 use serde::Serialize;
 use std::fmt::Write;
@@ -39,7 +40,7 @@ pub struct SettingRow {
     /// Upper end.
     pub high: Option<f64>,
     /// The verdict there.
-    pub verdict: String,
+    pub verdict: Verdict,
     /// The ceiling there, where the part computes one.
     pub ceiling: Option<f64>,
     /// The compared pair, for ratio claims.
@@ -72,7 +73,7 @@ impl SettingRow {
             value: finite(c.our_value),
             low: finite(c.interval.map(|i| i[0])),
             high: finite(c.interval.map(|i| i[1])),
-            verdict: c.verdict().to_string(),
+            verdict: c.verdict(),
             ceiling: finite(ceiling),
             pair: c.pair.clone(),
             regime: c.regime.clone(),
@@ -127,7 +128,7 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
                 num(r.value),
                 interval,
                 num(r.paper_value),
-                md_text(&r.verdict),
+                md_text(r.verdict.as_str()),
                 num(r.ceiling),
                 md_text(&r.reason)
             );
@@ -149,7 +150,7 @@ pub fn plot(dir: &Path, part: &Part, rows: &[&SettingRow]) -> Result<Vec<PathBuf
             },
             value: r.value,
             interval: r.low.zip(r.high).map(|(a, b)| [a, b]),
-            verdict: r.verdict.clone(),
+            verdict: r.verdict,
             ceiling: r.ceiling,
         })
         .collect();

@@ -2,6 +2,7 @@ use super::outcome::{classify, Outcome};
 use super::table::SettingRow;
 use super::*;
 use crate::claim_spec::ClaimSpec;
+use crate::verdict::Verdict;
 
 const FILE: &str = r#"
 name = "s"
@@ -74,7 +75,7 @@ fn bad_files_are_refused_with_the_part_named() {
     assert!(SensitivityFile::parse(&twice).unwrap_err().contains("listed twice"));
 }
 
-fn row(setting: &str, role: &str, value: f64, verdict: &str, ceiling: Option<f64>) -> SettingRow {
+fn row(setting: &str, role: &str, value: f64, verdict: Verdict, ceiling: Option<f64>) -> SettingRow {
     SettingRow {
         part: "a".into(),
         paper: "p".into(),
@@ -87,7 +88,7 @@ fn row(setting: &str, role: &str, value: f64, verdict: &str, ceiling: Option<f64
         value: Some(value),
         low: Some(value * 0.9),
         high: Some(value * 1.1),
-        verdict: verdict.into(),
+        verdict,
         ceiling,
         pair: String::new(),
         regime: String::new(),
@@ -99,20 +100,32 @@ fn row(setting: &str, role: &str, value: f64, verdict: &str, ceiling: Option<f64
 fn the_outcome_is_decided_in_order() {
     let f = file_with(("", "")).unwrap();
     let p = &f.parts[0];
-    let (a, b) = (row("1", "paper-like", 16.0, "held", Some(20.0)), row("5", "default", 2.0, "not held", Some(3.0)));
+    let (a, b) = (
+        row("1", "paper-like", 16.0, Verdict::Held, Some(20.0)),
+        row("5", "default", 2.0, Verdict::NotHeld, Some(3.0)),
+    );
     assert!(matches!(classify(p, &[&a, &b]), Outcome::HeldAtPaperLike { .. }));
-    let (a, b) = (row("1", "paper-like", 4.0, "not held", Some(5.0)), row("5", "default", 16.0, "held", Some(30.0)));
+    let (a, b) = (
+        row("1", "paper-like", 4.0, Verdict::NotHeld, Some(5.0)),
+        row("5", "default", 16.0, Verdict::Held, Some(30.0)),
+    );
     let o = classify(p, &[&a, &b]);
     assert!(matches!(o, Outcome::HoldsWhere { .. }) && o.sentence().contains("estimator.smc.moves = 5"), "{o:?}");
-    let (a, b) = (row("1", "paper-like", 4.0, "held", None), row("5", "default", 16.0, "held", None));
+    let (a, b) = (row("1", "paper-like", 4.0, Verdict::Held, None), row("5", "default", 16.0, Verdict::Held, None));
     let mut q = p.clone();
     q.paper_like = None;
     let o = classify(&q, &[&a, &b]);
     assert!(o.sentence().contains("every setting tried") && o.sentence().contains("4.000 to 16.000"), "{o:?}");
-    let (a, b) = (row("1", "paper-like", 4.0, "not held", Some(5.0)), row("5", "default", 2.0, "not held", Some(3.0)));
+    let (a, b) = (
+        row("1", "paper-like", 4.0, Verdict::NotHeld, Some(5.0)),
+        row("5", "default", 2.0, Verdict::NotHeld, Some(3.0)),
+    );
     let o = classify(p, &[&a, &b]);
     assert!(matches!(o, Outcome::CannotHold { .. }) && o.sentence().contains("5.000"), "{o:?}");
-    let (a, b) = (row("1", "paper-like", 4.0, "not held", Some(50.0)), row("5", "default", 2.0, "inconclusive", None));
+    let (a, b) = (
+        row("1", "paper-like", 4.0, Verdict::NotHeld, Some(50.0)),
+        row("5", "default", 2.0, Verdict::Inconclusive, None),
+    );
     assert!(matches!(classify(p, &[&a, &b]), Outcome::NotHeldAnywhere { .. }), "a missing ceiling decides nothing");
     let mut q = p.clone();
     q.unsupportable = Some("the paper's own numbers give 3x".into());
@@ -124,19 +137,24 @@ fn not_held_anywhere_needs_a_not_held_setting_and_inconclusive_everywhere_says_s
     let f = file_with(("", "")).unwrap();
     let p = &f.parts[0];
     // Every setting inconclusive (no ceiling, no reason): nothing is decided either way.
-    let (a, b) = (row("1", "paper-like", 4.0, "inconclusive", None), row("5", "default", 2.0, "inconclusive", None));
+    let (a, b) = (
+        row("1", "paper-like", 4.0, Verdict::Inconclusive, None),
+        row("5", "default", 2.0, Verdict::Inconclusive, None),
+    );
     let o = classify(p, &[&a, &b]);
     assert!(matches!(o, Outcome::InconclusiveEverywhere { .. }), "{o:?}");
     assert_eq!(o.kind(), "inconclusive at every setting tried");
     assert!(o.sentence().starts_with("inconclusive at every setting tried; the closest: "), "{}", o.sentence());
     assert!(!o.sentence().contains("not held at any"), "{}", o.sentence());
     // One setting not held, the other inconclusive, none held: not held at any setting tried.
-    let (a, b) = (row("1", "paper-like", 4.0, "not held", None), row("5", "default", 2.0, "inconclusive", None));
+    let (a, b) =
+        (row("1", "paper-like", 4.0, Verdict::NotHeld, None), row("5", "default", 2.0, Verdict::Inconclusive, None));
     let o = classify(p, &[&a, &b]);
     assert!(matches!(o, Outcome::NotHeldAnywhere { .. }), "{o:?}");
     assert_eq!(o.kind(), "not held at any setting tried");
     // A held setting still wins over both.
-    let (a, b) = (row("1", "paper-like", 4.0, "inconclusive", None), row("5", "default", 2.0, "held", None));
+    let (a, b) =
+        (row("1", "paper-like", 4.0, Verdict::Inconclusive, None), row("5", "default", 2.0, Verdict::Held, None));
     assert!(matches!(classify(p, &[&a, &b]), Outcome::HoldsWhere { .. }));
 }
 
@@ -181,9 +199,9 @@ fn sensitivity_md_escapes_the_files_text_and_the_reasons() {
     let f = file_with(("open = \"o\"", "open = \"<script>alert(1)</script>\"")).unwrap();
     let mut p = f.parts[0].clone();
     p.headline = format!("h {tag}");
-    let mut a = row("1", "paper-like", 4.0, "not held", Some(5.0));
+    let mut a = row("1", "paper-like", 4.0, Verdict::NotHeld, Some(5.0));
     a.reason = format!("because {tag} | and\nmore");
-    let b = row("5", "default", 2.0, "not held", Some(3.0));
+    let b = row("5", "default", 2.0, Verdict::NotHeld, Some(3.0));
     let outcome = classify(&p, &[&a, &b]);
     let md = super::table::markdown(&[(&p, outcome)], &[a, b]);
     assert!(!md.contains('<') && !md.contains('>'), "{md}");
