@@ -1,15 +1,15 @@
-//! The README's claim tables from a committed snapshot of the quick suite's claims
-//! (`experiments::readme_table`).
+//! The claim tables of the book's claims-table page from a committed snapshot of the quick suite's
+//! claims (`experiments::readme_table`).
 //!
 //! - `cargo run --release -p experiments --example readme_table -- snapshot RESULTS [COMMAND]...`
 //!   reads `RESULTS/<experiment>/summary.json` of every suite experiment and of `sensitivity` into
 //!   `results/snapshots/quick/claims.json` (the commands that made the runs are stored with it);
-//! - `cargo run --release -p experiments --example readme_table -- readme` rewrites the README's
+//! - `cargo run --release -p experiments --example readme_table -- readme` rewrites that page's
 //!   generated part from the snapshot.
 //!
 //! Run from the repository root. Exit 2 with one line on bad input.
 
-use experiments::readme_table::{rewrite, snapshot, table, Snapshot, SNAPSHOT};
+use experiments::readme_table::{rewrite, snapshot, table, Snapshot, SNAPSHOT, TABLE_FILE};
 use std::path::Path;
 
 fn fail(msg: impl std::fmt::Display) -> ! {
@@ -44,9 +44,9 @@ fn main() {
         Some("readme") => {
             let text = std::fs::read_to_string(SNAPSHOT).unwrap_or_else(|e| fail(format!("{SNAPSHOT}: {e}")));
             let s: Snapshot = serde_json::from_str(&text).unwrap_or_else(|e| fail(format!("{SNAPSHOT}: {e}")));
-            let readme = std::fs::read_to_string("README.md").unwrap_or_else(|e| fail(format!("README.md: {e}")));
+            let readme = std::fs::read_to_string(TABLE_FILE).unwrap_or_else(|e| fail(format!("{TABLE_FILE}: {e}")));
             let new = rewrite(&readme, &table(&s)).unwrap_or_else(|e| fail(e));
-            write(Path::new("README.md"), &new);
+            write(Path::new(TABLE_FILE), &new);
             println!("README.md: claims table rewritten from {SNAPSHOT}");
         }
         _ => fail("usage: readme_table snapshot RESULTS [COMMAND]... | readme"),

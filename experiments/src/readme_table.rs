@@ -1,10 +1,11 @@
-//! The README's claim tables, generated from a committed snapshot of the quick suite's claims
-//! (`results/snapshots/quick/claims.json`) so that the README never shows a number no run printed.
+//! The claim tables of the book's claims-table page (which the README links), generated from a
+//! committed snapshot of the quick suite's claims (`results/snapshots/quick/claims.json`) so that
+//! they never show a number no run printed.
 //!
 //! `cargo run --release -p experiments --example readme_table -- snapshot results` reads every
 //! experiment's `summary.json` under a results root (the quick suite's and, when present,
-//! `sensitivity`'s) into the snapshot; `... -- readme` rewrites the README's tables from it. The
-//! test `readme_table` fails when the README and the snapshot differ.
+//! `sensitivity`'s) into the snapshot; `... -- readme` rewrites that page's tables from it. The
+//! test `readme_table` fails when the page and the snapshot differ.
 
 use mcbench::output::{Claim, Verdict};
 use serde::{Deserialize, Serialize};
@@ -12,6 +13,8 @@ use std::path::Path;
 
 /// Where the snapshot lives, relative to the repository root.
 pub const SNAPSHOT: &str = "results/snapshots/quick/claims.json";
+/// The book page that holds the generated tables (the README links it).
+pub const TABLE_FILE: &str = "docs/src/claims-table.md";
 /// The line that opens the generated part of the README.
 pub const BEGIN: &str = "<!-- claims table: generated from results/snapshots/quick/claims.json by `cargo run --release -p experiments --example readme_table -- readme`; do not edit -->";
 /// The line that closes it.
@@ -291,6 +294,6 @@ mod tests {
         assert_eq!(current(&new).unwrap(), "new table");
         assert!(matches!(rewrite("no markers", "t"), Err(TableError::NoMarkers)));
         assert_eq!(paper_of("paper 003 Table 1"), "003");
-        assert_eq!(paper_of("issue 12: every cell"), "-");
+        assert_eq!(paper_of("harness: every cell"), "-");
     }
 }
