@@ -6,10 +6,10 @@
 use crate::canonical_cells::{cell_rows, refused_terminating, z_crit, Agreement, CellRow};
 use crate::canonical_sweep::FAMILIES;
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
 use mcbench::output::RunReport;
 use mcbench::plan::Plan;
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
+use mcbench::store::folder::OutputDir;
 use mcbench_core::budget::BudgetKind;
 use mcbench_papers::testbeds::canonical_profiles::Profile;
 use serde::Serialize;

@@ -5,10 +5,10 @@
 //! largest budget must be at least 3x the reference's RMS standard error.
 
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
+use mcbench::store::folder::OutputDir;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -95,6 +95,6 @@ pub fn post(
             ..Default::default()
         });
     }
-    report.paper.extend(mcbench::claims::reference_precision(plan, report));
+    report.paper.extend(mcbench::analysis::claims::reference_precision(plan, report));
     Ok(Vec::new())
 }

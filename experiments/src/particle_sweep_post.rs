@@ -5,13 +5,13 @@
 //! majorant 1) as a flat reference series.
 
 use crate::particle_sweep::{IDS, SIGMAS};
+use mcbench::analysis::metrics::SummaryRow;
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::metrics::SummaryRow;
+use mcbench::output::plot::{write_panels, Figure, Line, Panels, Series};
 use mcbench::output::RunReport;
 use mcbench::plan::Plan;
-use mcbench::plot::{write_panels, Figure, Line, Panels, Series};
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
+use mcbench::store::folder::OutputDir;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

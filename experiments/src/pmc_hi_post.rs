@@ -6,11 +6,11 @@
 //! weight) and in `alpha_maps.csv`.
 
 use mcbench::error::{HarnessError, Result};
-use mcbench::folder::OutputDir;
+use mcbench::output::plot::maps::{write_maps, Map, Scale};
 use mcbench::output::RunReport;
 use mcbench::plan::Plan;
-use mcbench::plot::maps::{write_maps, Map, Scale};
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
+use mcbench::store::folder::OutputDir;
 use mcbench_core::budget::Budget;
 use mcbench_core::rng::StreamKey;
 use mcbench_core::task::Task;

@@ -8,11 +8,11 @@
 
 use crate::pmc_ip::{row, PMC_IP_4};
 use mcbench::error::{HarnessError, Result};
-use mcbench::folder::OutputDir;
+use mcbench::output::plot::maps::{write_maps, Map, Scale};
 use mcbench::output::RunReport;
 use mcbench::plan::{Plan, PreparedBed};
-use mcbench::plot::maps::{write_maps, Map, Scale};
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
+use mcbench::store::folder::OutputDir;
 use mcbench_core::budget::Budget;
 use mcbench_core::math::Rgb;
 use mcbench_core::rng::StreamKey;
@@ -186,7 +186,7 @@ pub fn post(
     _registry: &mcbench::registry::Registry,
 ) -> Result<Vec<PathBuf>> {
     results.write_csv("table1.csv", &table1(plan, report))?;
-    report.paper.extend(mcbench::claims::reference_precision(plan, report));
+    report.paper.extend(mcbench::analysis::claims::reference_precision(plan, report));
     let budget = 10;
     let Some(ip) = pmc_ip_of(plan, "pmc_ip") else { return Ok(Vec::new()) };
     let mut rows = Vec::new();

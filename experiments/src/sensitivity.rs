@@ -6,12 +6,12 @@
 //! file). Runs only when named: `mcbench run sensitivity`.
 
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
 use mcbench::output::RunReport;
 use mcbench::plan::Plan;
 use mcbench::registry::{Experiment, Registry};
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
 use mcbench::sensitivity::{run, SensitivityFile};
+use mcbench::store::folder::OutputDir;
 use std::path::{Path, PathBuf};
 
 /// The experiment's parts.

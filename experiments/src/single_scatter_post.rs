@@ -6,10 +6,10 @@
 
 use crate::single_scatter::{ranking, IDS, NOISE_FREE, PAPER_BUDGETS};
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
+use mcbench::store::folder::OutputDir;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

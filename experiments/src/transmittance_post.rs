@@ -8,11 +8,11 @@
 
 use crate::variance_claims::{build, central_ray, measure, Measured, CASES};
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
+use mcbench::output::plot::{write_panels, Figure, Key, Line, Panels, Series};
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
-use mcbench::plot::{write_panels, Figure, Key, Line, Panels, Series};
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
+use mcbench::store::folder::OutputDir;
 use mcbench_core::math::Vec3;
 use mcbench_papers::tracking::variance::predicted;
 use serde::Serialize;

@@ -19,12 +19,12 @@
 
 use crate::config::{Mode, Sweep};
 use crate::error::Result;
-use crate::folder::OutputDir;
+use crate::output::plot::DisplayNames;
 use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
-use crate::plot::DisplayNames;
-use crate::references::ReferenceDir;
-use crate::runner::RunResults;
+use crate::run::runner::RunResults;
+use crate::store::folder::OutputDir;
+use crate::store::references::ReferenceDir;
 use mcbench_core::entry::{EstimatorEntry, TestBedEntry};
 use mcbench_core::error::ConfigError;
 use mcbench_core::references::ReferenceSource;

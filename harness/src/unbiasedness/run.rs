@@ -11,11 +11,11 @@ use super::table;
 use super::{parts, Row};
 use crate::config::Sweep;
 use crate::error::Result;
-use crate::folder::OutputDir;
 use crate::output::RunReport;
 use crate::plan::Plan;
 use crate::registry::Registry;
-use crate::runner::{self, RunResults};
+use crate::run::runner::{self, RunResults};
+use crate::store::folder::OutputDir;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
