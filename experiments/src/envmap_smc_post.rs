@@ -9,11 +9,11 @@ use mcbench::error::{HarnessError, Result};
 use mcbench::output::plot::{write_panels, Figure, Panels, Series};
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
+use mcbench::registry::PostContext;
 use mcbench::run::runner::RunResults;
-use mcbench::store::folder::OutputDir;
 use mcbench::verdict::Verdict;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// RMSE per frame of one cell, with its time per estimate.
 struct FrameErrors {
@@ -176,14 +176,8 @@ const FIGURES: [(&str, &str, [&str; 2]); 2] = [
 ];
 
 /// The experiment's post-run analysis (see the module doc).
-pub fn post(
-    plan: &Plan,
-    run: &RunResults,
-    report: &mut RunReport,
-    results_dir: &OutputDir,
-    plots_dir: Option<&Path>,
-    registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, results: run, report, out: results_dir, plots: plots_dir, registry } = cx;
     let mode = plan.sweep.mode;
     let errors = frame_errors(plan, run);
     let rows: Vec<FrameRow<'_>> = errors

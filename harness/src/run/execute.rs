@@ -211,7 +211,14 @@ pub fn finish(
     report.paper.extend(declared);
     let mut extra_plots = Vec::new();
     if let Some(post) = def.and_then(|d| d.post) {
-        extra_plots = post(plan, run, &mut report, &results, opts.plots.then_some(plots_dir.as_path()), opts.registry)?;
+        extra_plots = post(crate::registry::PostContext {
+            plan,
+            results: run,
+            report: &mut report,
+            out: &results,
+            plots: opts.plots.then_some(plots_dir.as_path()),
+            registry: opts.registry,
+        })?;
     }
     report.meta.wall_seconds = started.elapsed().as_secs_f64();
     drop(analysis);

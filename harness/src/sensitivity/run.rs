@@ -9,9 +9,9 @@ use crate::config::{Mode, Sweep};
 use crate::error::{HarnessError, Result};
 use crate::output::{Claim, Diagnostic, RunReport};
 use crate::plan::Plan;
+use crate::registry::PostContext;
 use crate::registry::{Experiment, Registry, Sweeps};
 use crate::run::runner::{self, RunResults};
-use crate::store::folder::OutputDir;
 use crate::verdict::Verdict;
 use std::path::{Path, PathBuf};
 
@@ -135,15 +135,8 @@ pub(super) fn ceiling(
 /// Runs every setting of every part (the first part's default is the experiment's own run),
 /// judges each part's claim per setting, and writes `sensitivity.csv`, `sensitivity.md`, one
 /// plot per part and one claim per part (its outcome) into the report.
-pub fn post(
-    file: &SensitivityFile,
-    plan: &Plan,
-    run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    plots: Option<&Path>,
-    registry: &Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(file: &SensitivityFile, cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, results: run, report, out: results, plots, registry } = cx;
     let threads = report.meta.threads;
     let mut rows: Vec<SettingRow> = Vec::new();
     for (part, i, sweep, claim) in settings(file, &plan.sweep)? {
