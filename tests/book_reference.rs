@@ -264,21 +264,21 @@ fn table(fields: &[Field], all_optional: bool, defaults: Option<&serde_json::Val
 fn config_fields_page() -> String {
     let mut page = header(
         "Config file fields",
-        "the doc comments of `SweepFile`, `TestBedSpec` and `EstimatorSpec` (harness/src/config.rs), \
-         `ClaimSpec` (harness/src/claim_spec.rs) and `CostModel` (harness/src/cost_model.rs)",
+        "the doc comments of `SweepFile`, `TestBedSpec` and `EstimatorSpec` (harness/src/config/mod.rs), \
+         `ClaimSpec` (harness/src/config/claim_spec.rs) and `CostModel` (harness/src/plan/cost_model.rs)",
     );
     page += "Every field a config file may hold ([Config files](../config.md) shows one whole file). \
              Unknown fields are refused.\n\n";
 
-    let (doc, _, items) = parse("harness/src/config.rs", "SweepFile");
+    let (doc, _, items) = parse("harness/src/config/mod.rs", "SweepFile");
     page += &format!("## Top level\n\n{doc}\n\n{}", table(&items[0].fields, true, None));
 
     for (name, heading) in [("TestBedSpec", "[[testbeds]]"), ("EstimatorSpec", "[[estimators]]")] {
-        let (doc, _, items) = parse("harness/src/config.rs", name);
+        let (doc, _, items) = parse("harness/src/config/mod.rs", name);
         page += &format!("\n## `{heading}`\n\n{doc}\n\n{}", table(&items[0].fields, false, None));
     }
 
-    let (doc, attrs, variants) = parse("harness/src/claim_spec.rs", "ClaimSpec");
+    let (doc, attrs, variants) = parse("harness/src/config/claim_spec.rs", "ClaimSpec");
     assert!(attrs.contains("tag = \"kind\"") && attrs.contains("snake_case"), "claims are tagged by `kind`");
     page += &format!(
         "\n## `[[claims]]`\n\n{doc} The field `kind` names the kind; the other fields depend on it. \
@@ -289,7 +289,7 @@ fn config_fields_page() -> String {
             &format!("\n### `kind = \"{}\"`\n\n{}\n\n{}", snake_case(&v.name), v.doc, table(&v.fields, false, None));
     }
 
-    let (doc, attrs, items) = parse("harness/src/cost_model.rs", "CostModel");
+    let (doc, attrs, items) = parse("harness/src/plan/cost_model.rs", "CostModel");
     assert!(attrs.contains("default"), "unset [cost_model] fields keep their defaults");
     let defaults = serde_json::to_value(mcbench::config::CostModel::default()).unwrap();
     page += &format!(

@@ -3,11 +3,11 @@
 //! blocks apart and merging them (as shards do), give paired, reproducible intervals, and a cell
 //! stored without them falls back to the delta method.
 
-use mcbench::cell::{rep_block_count, CellResult};
-use mcbench::claims::{Ratio, RatioMetric};
+use mcbench::analysis::claims::{Ratio, RatioMetric};
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
 use mcbench::plan::Plan;
-use mcbench::runner::{self, RunOptions, Silent};
+use mcbench::run::cell::{rep_block_count, CellResult};
+use mcbench::run::runner::{self, RunOptions, Silent};
 use mcbench_core::budget::Budget;
 use mcbench_core::params::Params;
 
@@ -15,7 +15,9 @@ const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/refere
 
 fn registry() -> &'static mcbench::Registry {
     static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
-    REGISTRY.get_or_init(|| experiments::registry().with_references(mcbench::references::ReferenceDir::new(REFERENCES)))
+    REGISTRY.get_or_init(|| {
+        experiments::registry().with_references(mcbench::store::references::ReferenceDir::new(REFERENCES))
+    })
 }
 
 /// Two estimators on a small image at two budgets, 40 repetitions: blocks of 2 repetitions (20

@@ -93,7 +93,7 @@ fn a_false_independence_declaration_fails_the_suite() {
 fn registry() -> &'static mcbench::Registry {
     static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
     REGISTRY.get_or_init(|| {
-        experiments::registry().with_references(mcbench::references::ReferenceDir::new(concat!(
+        experiments::registry().with_references(mcbench::store::references::ReferenceDir::new(concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../results/references"
         )))

@@ -6,9 +6,9 @@
 //! - `summary.csv`, `tests.csv`, `claims.csv`: the header lines of a small run through the CLI;
 //!   `summary.csv` also against `mcbench::output::SUMMARY_HEADER` (the header written when a run
 //!   has no rows);
-//! - `integrals.csv`: `mcbench::integrals::COLUMNS`, and the run's header starts with them and ends
+//! - `integrals.csv`: `mcbench::output::integrals::COLUMNS`, and the run's header starts with them and ends
 //!   with `estimator_id`;
-//! - `timing columns`: `mcbench::metrics::TIMING_COLUMNS`;
+//! - `timing columns`: `mcbench::analysis::metrics::TIMING_COLUMNS`;
 //! - `summary.json` and `summary.json meta`: the run's top-level and `meta` field names;
 //! - `reference json`: the fields of a file `mcbench reference` wrote;
 //! - `subcommands`: the `Commands:` of `mcbench --help`;
@@ -94,14 +94,14 @@ fn the_files_a_run_writes_have_the_columns_and_fields_the_chapter_lists() {
     let summary = listed(&doc, "summary.csv");
     assert_eq!(header(&res.join("summary.csv")), summary, "summary.csv's header");
     assert_eq!(strs(mcbench::output::SUMMARY_HEADER), summary, "the header of a summary.csv without rows");
-    assert_eq!(listed(&doc, "timing columns"), strs(mcbench::metrics::TIMING_COLUMNS));
+    assert_eq!(listed(&doc, "timing columns"), strs(mcbench::analysis::metrics::TIMING_COLUMNS));
     assert!(
-        mcbench::metrics::TIMING_COLUMNS.iter().all(|c| summary.iter().any(|s| s == c)),
+        mcbench::analysis::metrics::TIMING_COLUMNS.iter().all(|c| summary.iter().any(|s| s == c)),
         "every timing column is a summary.csv column"
     );
 
     let integrals = listed(&doc, "integrals.csv");
-    assert_eq!(integrals, strs(&mcbench::integrals::COLUMNS));
+    assert_eq!(integrals, strs(&mcbench::output::integrals::COLUMNS));
     let got = header(&res.join("integrals.csv"));
     assert_eq!(got[..integrals.len()], integrals[..], "integrals.csv's first columns");
     assert_eq!(got.last().map(String::as_str), Some("estimator_id"), "integrals.csv ends with estimator_id");

@@ -5,7 +5,7 @@
 
 mod common;
 use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::runner::{self, RunOptions, Silent};
+use mcbench::run::runner::{self, RunOptions, Silent};
 use mcbench::{Bias, Checks, EstimateError, Estimator, EstimatorEntry, Needs, Registry, Rgb, StreamRng, Task};
 use mcbench_core::budget::{Budget, BudgetKind};
 use mcbench_core::params::{ParamSpec, Params};
@@ -73,7 +73,10 @@ fn registry() -> &'static Registry {
     static REGISTRY: std::sync::OnceLock<Registry> = std::sync::OnceLock::new();
     REGISTRY.get_or_init(|| {
         experiments::registry().with_estimator(&SLEEPER).with_estimator(&SPINNER).with_references(
-            mcbench::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+            mcbench::store::references::ReferenceDir::new(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../results/references"
+            )),
         )
     })
 }
@@ -102,7 +105,7 @@ fn samples(amounts: &[u64]) -> Vec<Budget> {
     amounts.iter().map(|&amount| Budget { kind: BudgetKind::Samples, amount }).collect()
 }
 
-fn summaries(plan: &mcbench::plan::Plan, run: &runner::RunResults) -> Vec<mcbench::metrics::SummaryRow> {
+fn summaries(plan: &mcbench::plan::Plan, run: &runner::RunResults) -> Vec<mcbench::analysis::metrics::SummaryRow> {
     run.cells.iter().map(|(bi, ei, cell)| plan.summary_row(*bi, *ei, cell)).collect()
 }
 
@@ -136,7 +139,7 @@ fn cpu_seconds_count_work_and_not_sleep() {
 /// a partial second repetition block included.
 #[test]
 fn interleaved_cells_equal_cells_run_alone() {
-    let strip = |mut c: mcbench::cell::CellResult| {
+    let strip = |mut c: mcbench::run::cell::CellResult| {
         c.time = Default::default();
         c.cpu_time = None;
         for b in &mut c.blocks {

@@ -2,8 +2,8 @@
 //! turns it into a fixed sample count samples the whole image, not one column.
 
 use mcbench::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::execute::{execute, ExecOptions};
-use mcbench::runner::Silent;
+use mcbench::run::execute::{execute, ExecOptions};
+use mcbench::run::runner::Silent;
 use mcbench_core::budget::{Budget, BudgetKind};
 use mcbench_core::params::Params;
 use mcbench_core::testbed::MediumScene;

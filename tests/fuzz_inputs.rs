@@ -6,9 +6,9 @@
 
 use mcbench::config::{Mode, SweepFile};
 use mcbench::error::HarnessError;
-use mcbench::execute::{execute, ExecOptions};
 use mcbench::output::{read_results, read_results_unverified};
-use mcbench::runner::Silent;
+use mcbench::run::execute::{execute, ExecOptions};
+use mcbench::run::runner::Silent;
 use mcbench::store::Store;
 use proptest::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -229,23 +229,26 @@ fn edited_result_files_never_panic_and_fail_in_one_line() {
 }
 
 /// Random edits of a stored cell's JSON (inside its record, checksums made good): the resume's
-/// check ([`mcbench::runner::preload`]) never panics, and refuses in one line naming the cell.
+/// check ([`mcbench::run::runner::preload`]) never panics, and refuses in one line naming the cell.
 #[test]
 fn edited_cells_never_panic_and_fail_in_one_line() {
     let (dir, plan) = tiny_run();
     let path = dir.path().join("results/tiny/cells.store");
     let records = Store::open(&path).expect("store").records().to_vec();
     let name = records[0].name.clone();
-    let original = mcbench::packed::split(&records[0].payload).expect("a record");
+    let original = mcbench::store::packed::split(&records[0].payload).expect("a record");
     runner(300)
         .run(&edits(), |edits| {
             let mut parts = original.clone();
             parts.meta = mutate(&original.meta, &edits);
             let mut edited = records.clone();
-            edited[0].payload = mcbench::packed::join(&parts);
+            edited[0].payload = mcbench::store::packed::join(&parts);
             mcbench::store::write_records(&path, &edited).expect("write");
-            prop_assert_eq!(file_rejected_well("cells.store", || mcbench::runner::preload(&plan, Some(&path))), Ok(()));
-            if let Err(e) = mcbench::runner::preload(&plan, Some(&path)) {
+            prop_assert_eq!(
+                file_rejected_well("cells.store", || mcbench::run::runner::preload(&plan, Some(&path))),
+                Ok(())
+            );
+            if let Err(e) = mcbench::run::runner::preload(&plan, Some(&path)) {
                 prop_assert!(e.to_string().contains(&name), "the refusal names the cell: {}", e);
             }
             Ok(())
@@ -275,7 +278,10 @@ fn edited_stores_never_panic_and_fail_in_one_line() {
                 }
             }
             std::fs::write(&path, &b).expect("write");
-            prop_assert_eq!(file_rejected_well("cells.store", || mcbench::runner::preload(&plan, Some(&path))), Ok(()));
+            prop_assert_eq!(
+                file_rejected_well("cells.store", || mcbench::run::runner::preload(&plan, Some(&path))),
+                Ok(())
+            );
             Ok(())
         })
         .expect("no edit makes the store's reader panic or fail in more than one line");
@@ -288,8 +294,8 @@ fn edited_manifests_never_panic_and_fail_in_one_line() {
     let (dir, plan) = tiny_run();
     let root = dir.path().join("results");
     let shard = "1/1".parse().expect("spec");
-    let pre = mcbench::shard::preflight(&plan, shard, &root).expect("preflight");
-    mcbench::shard::run_shard(&plan, None, pre, Some(1), false, &Silent).expect("shard");
+    let pre = mcbench::run::shard::preflight(&plan, shard, &root).expect("preflight");
+    mcbench::run::shard::run_shard(&plan, None, pre, Some(1), false, &Silent).expect("shard");
     let folder = root.join("tiny/shard-1-of-1");
     let manifest = folder.join("manifest.json");
     let original = std::fs::read_to_string(&manifest).expect("manifest");
@@ -298,7 +304,7 @@ fn edited_manifests_never_panic_and_fail_in_one_line() {
         .run(&edits(), |edits| {
             std::fs::write(&manifest, mutate(&original, &edits)).expect("write");
             let opts = options(&out);
-            let merged = mcbench::merge::merge(std::slice::from_ref(&folder), &opts);
+            let merged = mcbench::run::merge::merge(std::slice::from_ref(&folder), &opts);
             prop_assert_eq!(file_rejected_well("manifest.json", || merged), Ok(()));
             Ok(())
         })
@@ -344,7 +350,9 @@ const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/refere
 /// repository's stored references.
 fn registry() -> &'static mcbench::Registry {
     static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
-    REGISTRY.get_or_init(|| experiments::registry().with_references(mcbench::references::ReferenceDir::new(REFERENCES)))
+    REGISTRY.get_or_init(|| {
+        experiments::registry().with_references(mcbench::store::references::ReferenceDir::new(REFERENCES))
+    })
 }
 
 /// Plans a sweep against [`registry`].

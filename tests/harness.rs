@@ -3,9 +3,9 @@
 //! test's teeth.
 
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::execute::{execute, ExecOptions};
-use mcbench::integrals::IntegralsFormat;
-use mcbench::runner::Silent;
+use mcbench::output::integrals::IntegralsFormat;
+use mcbench::run::execute::{execute, ExecOptions};
+use mcbench::run::runner::Silent;
 use mcbench_core::params::Params;
 use std::path::Path;
 
@@ -32,7 +32,7 @@ fn sweep(ids: &[&str], reps: usize) -> Sweep {
     }
 }
 
-fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> mcbench::execute::Outcome {
+fn run_into(dir: &Path, sweep: Sweep, threads: usize, plots: bool) -> mcbench::run::execute::Outcome {
     run_with(dir, sweep, threads, plots, IntegralsFormat::default())
 }
 
@@ -42,7 +42,7 @@ fn run_with(
     threads: usize,
     plots: bool,
     integrals: IntegralsFormat,
-) -> mcbench::execute::Outcome {
+) -> mcbench::run::execute::Outcome {
     let plan = plan_of(sweep).expect("valid sweep");
     let opts = ExecOptions {
         results_root: dir.join("results"),
@@ -287,7 +287,9 @@ const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/refere
 /// repository's stored references.
 fn registry() -> &'static mcbench::Registry {
     static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();
-    REGISTRY.get_or_init(|| experiments::registry().with_references(mcbench::references::ReferenceDir::new(REFERENCES)))
+    REGISTRY.get_or_init(|| {
+        experiments::registry().with_references(mcbench::store::references::ReferenceDir::new(REFERENCES))
+    })
 }
 
 /// Plans a sweep against [`registry`].

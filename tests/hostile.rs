@@ -5,7 +5,7 @@
 //! whose numbers would break a metric is refused naming its file and field.
 #![cfg(unix)]
 
-use mcbench::folder::FolderLock;
+use mcbench::store::folder::FolderLock;
 use std::collections::BTreeMap;
 use std::os::unix::fs::symlink;
 use std::path::{Path, PathBuf};

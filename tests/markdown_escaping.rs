@@ -4,7 +4,7 @@
 //! (`&lt;script&gt;`), and no `.md` file of the run holds a raw tag a markdown viewer would render.
 
 use mcbench::config::{Mode, SweepFile};
-use mcbench::execute::{execute, prepare, ExecOptions};
+use mcbench::run::execute::{execute, prepare, ExecOptions};
 use mcbench::{EstimatorEntry, Registry};
 use std::path::{Path, PathBuf};
 
@@ -58,7 +58,7 @@ fn text_from_configs_labels_and_stored_files_is_escaped_in_every_markdown_file()
     let registry = Registry::new()
         .with_catalog(mcbench_papers::catalog())
         .with_estimator(&HOSTILE)
-        .with_references(mcbench::references::ReferenceDir::new(planted_references(dir.path())));
+        .with_references(mcbench::store::references::ReferenceDir::new(planted_references(dir.path())));
     let config = format!(
         "name = 'escaping'\nreps = 2\nbudgets = [1, 2, 4]\n\
          [[testbeds]]\nid = 'gradient-box'\nvariant = 'albedo-0.8'\n\
@@ -73,7 +73,7 @@ fn text_from_configs_labels_and_stored_files_is_escaped_in_every_markdown_file()
         results_root: dir.path().join("results"),
         plots_root: dir.path().join("plots"),
         threads: Some(1),
-        observer: &mcbench::runner::Silent,
+        observer: &mcbench::run::runner::Silent,
         plots: true,
         wait: false,
         registry: &registry,

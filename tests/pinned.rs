@@ -34,7 +34,7 @@ fn first_estimates() -> BTreeMap<String, String> {
         .into_iter()
         .map(|(id, v, p)| {
             let entry = builtins::testbed(id).expect("registered test bed");
-            let refs = mcbench::references::ReferenceDir::new(REFERENCES);
+            let refs = mcbench::store::references::ReferenceDir::new(REFERENCES);
             (format!("{id}/{v}"), (entry.build)(v, &p, &refs).expect("builds"))
         })
         .collect();

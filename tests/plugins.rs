@@ -66,7 +66,7 @@ static THROW_AWAY: EstimatorEntry = EstimatorEntry {
 
 fn registry() -> Registry {
     Registry::new().with_catalog(mcbench_papers::catalog()).with_estimator(&THROW_AWAY).with_references(
-        mcbench::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+        mcbench::store::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
     )
 }
 
@@ -94,8 +94,9 @@ fn one_file_and_one_registration_are_enough() {
     let plan = mcbench::plan::Plan::prepare(sweep(Params::new().with("tilt", 0.5)), &registry).expect("plans");
     let bad = mcbench::plan::Plan::prepare(sweep(Params::new().with("tlit", 0.5)), &registry);
     assert!(bad.err().map(|e| e.to_string()).unwrap_or_default().contains("throw_away.tlit"));
-    let opts = mcbench::runner::RunOptions { threads: Some(1), store: None, observer: &mcbench::runner::Silent };
-    let run = mcbench::runner::run(&plan, &opts).expect("runs");
+    let opts =
+        mcbench::run::runner::RunOptions { threads: Some(1), store: None, observer: &mcbench::run::runner::Silent };
+    let run = mcbench::run::runner::run(&plan, &opts).expect("runs");
     assert_eq!(run.cells.len(), 3);
     // In the unbiasedness experiment wherever a case provides a surface, with nothing listing it.
     let parts = mcbench::unbiasedness::parts(&registry, Mode::Quick);
@@ -110,6 +111,6 @@ fn one_file_and_one_registration_are_enough() {
     let failures = suite.check(&THROW_AWAY);
     assert!(failures.is_empty(), "{failures:?}");
     // Listed with its parameter.
-    let text = mcbench::listing::list(Some(mcbench::listing::What::Estimators), true, &registry);
+    let text = mcbench::output::listing::list(Some(mcbench::output::listing::What::Estimators), true, &registry);
     assert!(text.contains("throw_away") && text.contains("Strength of the polar tilt"), "{text}");
 }

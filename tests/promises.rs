@@ -80,7 +80,7 @@ fn recommit(folder: &Path, name: &str) {
     for f in c["files"].as_array_mut().expect("files") {
         if f["name"] == name {
             f["bytes"] = serde_json::json!(bytes.len());
-            f["digest"] = serde_json::json!(mcbench::folder::digest(&bytes));
+            f["digest"] = serde_json::json!(mcbench::store::folder::digest(&bytes));
         }
     }
     std::fs::write(&path, serde_json::to_string(&c).expect("json")).expect("write");
@@ -144,11 +144,11 @@ fn numbers_are_bounded_on_every_input_path() {
     ok(d, &["run", "--config", "tiny.toml", "--shard", "1/1"]);
     let shard = d.join("results/tiny/shard-1-of-1");
     let path = shard.join("manifest.json");
-    let mut m: mcbench::shard::Manifest =
+    let mut m: mcbench::run::shard::Manifest =
         serde_json::from_str(&std::fs::read_to_string(&path).expect("manifest")).expect("parses");
     m.sweep.reps = 1_000_000_000_000;
     m.reps = m.sweep.reps;
-    m.sweep_digest = mcbench::shard::sweep_digest(&m.sweep);
+    m.sweep_digest = mcbench::run::shard::sweep_digest(&m.sweep);
     std::fs::write(&path, serde_json::to_string(&m).expect("json")).expect("write");
     refused(d, &["merge", "results/tiny/shard-1-of-1"], 2, "reps");
 }
@@ -185,7 +185,8 @@ fn outputs_and_stored_cells_are_checked_first() {
     let mut records = Store::open(&store).expect("store").records().to_vec();
     records.sort_by(|a, b| a.name.cmp(&b.name));
     records.drain(..3);
-    let corrupt = mcbench::packed::join(&mcbench::packed::Parts { meta: "{\"key\":".into(), columns: Vec::new() });
+    let corrupt =
+        mcbench::store::packed::join(&mcbench::store::packed::Parts { meta: "{\"key\":".into(), columns: Vec::new() });
     records[2].payload = corrupt;
     let name = records[2].name.clone();
     mcbench::store::write_records(&store, &records).expect("rewrite");

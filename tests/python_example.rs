@@ -4,8 +4,8 @@
 //! passes, unless `MCBENCH_REQUIRE_PYTHON=1` (CI sets it) makes that a failure.
 
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::execute::{execute, ExecOptions};
-use mcbench::runner::Silent;
+use mcbench::run::execute::{execute, ExecOptions};
+use mcbench::run::runner::Silent;
 use mcbench_core::params::Params;
 use std::path::Path;
 use std::process::Command;

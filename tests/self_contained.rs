@@ -110,7 +110,7 @@ fn readable(path: &Path) -> Option<String> {
             text.push('\n');
             text += &String::from_utf8_lossy(&r.payload);
             text.push('\n');
-            if let Ok(cell) = mcbench::packed::decode_cell(&r.payload) {
+            if let Ok(cell) = mcbench::store::packed::decode_cell(&r.payload) {
                 text += &serde_json::to_string(&cell).expect("a cell serialises");
                 text.push('\n');
             }
@@ -120,7 +120,7 @@ fn readable(path: &Path) -> Option<String> {
     if name.ends_with(".gz") {
         assert_eq!(name, "integrals.csv.gz", "a compressed file this test cannot read: {}", path.display());
         let folder = path.parent().expect("a results folder");
-        return mcbench::integrals::read_text(folder).expect("integrals.csv.gz decodes");
+        return mcbench::output::integrals::read_text(folder).expect("integrals.csv.gz decodes");
     }
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     Some(String::from_utf8_lossy(&bytes).into_owned())

@@ -7,7 +7,7 @@ use std::process::{Command, Output};
 
 mod common;
 use common::deterministic_csv;
-use mcbench::metrics::TIMING_COLUMNS;
+use mcbench::analysis::metrics::TIMING_COLUMNS;
 use mcbench::store::{Record, Store};
 
 /// The transmittance experiment (its claims and post hook included) shrunk to seconds: two small

@@ -7,8 +7,8 @@
 
 use mcbench::analysis::{SlopeOutcome, SpeedUpOutcome, Spread};
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::execute::{execute, ExecOptions};
-use mcbench::runner::Silent;
+use mcbench::run::execute::{execute, ExecOptions};
+use mcbench::run::runner::Silent;
 use mcbench::{
     Bias, Checks, EstimateError, Estimator, EstimatorEntry, Needs, Reference, Registry, Rgb, StreamRng, Task, TestBed,
     TestBedEntry,

@@ -6,10 +6,10 @@
 //! not run keep their reason.
 
 use crate::canonical_sweep::{family_of, spec, terminating_min_ratio, FAMILIES, RATIOS};
-use mcbench::claims::decisive_test;
+use mcbench::analysis::claims::decisive_test;
 use mcbench::output::RunReport;
 use mcbench::plan::{Plan, Skipped};
-use mcbench::runner::RunResults;
+use mcbench::run::runner::RunResults;
 use mcbench_core::estimator::Bias;
 use mcbench_core::estimator::EstimateMoments;
 use mcbench_core::stats::detectable_shift;

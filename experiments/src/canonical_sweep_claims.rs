@@ -8,8 +8,8 @@ use crate::canonical_cells::{Agreement, CellRow, AGREEMENT_ALPHA, RESOLVED_REL_S
 use crate::canonical_sweep::FAMILIES;
 use crate::canonical_sweep_post::{short, Analysis};
 use mcbench::analysis::UNBIASEDNESS_ALPHA;
+use mcbench::output::report::sig;
 use mcbench::output::Claim;
-use mcbench::report::sig;
 use mcbench_core::estimator::Bias;
 use mcbench_core::stats::holm_bonferroni;
 use mcbench_papers::testbeds::canonical_1d::{REFERENCE_REL_BOUND, TARGETS};

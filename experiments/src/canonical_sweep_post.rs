@@ -6,14 +6,11 @@
 use crate::canonical_cells::{cell_rows, refused_terminating, z_crit, Agreement, CellRow};
 use crate::canonical_sweep::FAMILIES;
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::output::RunReport;
-use mcbench::plan::Plan;
-use mcbench::runner::RunResults;
+use mcbench::registry::PostContext;
 use mcbench_core::budget::BudgetKind;
 use mcbench_papers::testbeds::canonical_profiles::Profile;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The finished cells with the sweep's critical value for the variance checks.
 pub struct Analysis {
@@ -142,14 +139,8 @@ fn cells_rows(a: &Analysis) -> Vec<CellsRow<'_>> {
 }
 
 /// The experiment's post-run analysis (see the module doc).
-pub fn post(
-    plan: &Plan,
-    run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    plots: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, results: run, report, out: results, plots, .. } = cx;
     report.skipped.extend(refused_terminating(plan));
     let equal_cost = plan.sweep.budgets.iter().any(|b| b.kind == BudgetKind::Fetches);
     let analysis = Analysis::new(cell_rows(plan, run, report), equal_cost);

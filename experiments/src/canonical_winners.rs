@@ -9,7 +9,7 @@
 use crate::canonical_cells::{Agreement, CellRow};
 use crate::canonical_sweep::{FAMILIES, RATIOS};
 use crate::canonical_sweep_post::{short, Analysis};
-use mcbench::report::{markdown_table, md_text, sig};
+use mcbench::output::report::{markdown_table, md_text, sig};
 use mcbench_core::estimator::Bias;
 use mcbench_papers::testbeds::canonical_1d::TARGETS;
 use mcbench_papers::testbeds::canonical_profiles::Profile;

@@ -43,7 +43,7 @@ pub fn m_values(mode: Mode) -> &'static [u32] {
 }
 
 fn verdict(r: &RunReport, variant: &str, estimator: &str, claim: &str, expect_pass: Option<bool>) -> Claim {
-    let t = mcbench::claims::decisive_test(&r.tests, variant, estimator, "");
+    let t = mcbench::analysis::claims::decisive_test(&r.tests, variant, estimator, "");
     match t {
         None => Claim { testbed: format!("envmap-sequence/{variant}"), claim: claim.into(), paper_value: None, our_value: None, held: None, note: format!("{estimator} did not run") , ..Default::default() },
         Some(t) => Claim {

@@ -6,14 +6,14 @@
 
 use crate::envmap_smc::{m_values, p_values};
 use mcbench::error::{HarnessError, Result};
-use mcbench::folder::OutputDir;
+use mcbench::output::plot::{write_panels, Figure, Panels, Series};
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
-use mcbench::plot::{write_panels, Figure, Panels, Series};
-use mcbench::runner::RunResults;
+use mcbench::registry::PostContext;
+use mcbench::run::runner::RunResults;
 use mcbench::verdict::Verdict;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// RMSE per frame of one cell, with its time per estimate.
 struct FrameErrors {
@@ -176,14 +176,8 @@ const FIGURES: [(&str, &str, [&str; 2]); 2] = [
 ];
 
 /// The experiment's post-run analysis (see the module doc).
-pub fn post(
-    plan: &Plan,
-    run: &RunResults,
-    report: &mut RunReport,
-    results_dir: &OutputDir,
-    plots_dir: Option<&Path>,
-    registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, results: run, report, out: results_dir, plots: plots_dir, registry } = cx;
     let mode = plan.sweep.mode;
     let errors = frame_errors(plan, run);
     let rows: Vec<FrameRow<'_>> = errors
@@ -329,7 +323,8 @@ pub fn post(
     let dedicated = crate::envmap_unbiasedness::check(mode, plan.sweep.seed, registry)?;
     for t in dedicated.iter().filter(|t| t.test.starts_with("holm")) {
         // One claim per (variant, estimator): its combined row decides.
-        let Some(t) = mcbench::claims::decisive_test(&dedicated, &t.variant, &t.estimator, "_dedicated") else {
+        let Some(t) = mcbench::analysis::claims::decisive_test(&dedicated, &t.variant, &t.estimator, "_dedicated")
+        else {
             continue;
         };
         let theory = match t.claim.as_str() {
@@ -363,7 +358,7 @@ pub fn post(
         // on L_ns, where it is unbiased.
         (c.verdict, c.reason) = match (t.claim.as_str(), held) {
             ("unbiased", _) => {
-                let (_, v, why) = mcbench::claims::unbiased_verdict(t);
+                let (_, v, why) = mcbench::analysis::claims::unbiased_verdict(t);
                 (Some(v), why)
             }
             (_, None) => (Some(Verdict::Reported), format!("test verdict {}: {}", t.verdict, t.reason)),

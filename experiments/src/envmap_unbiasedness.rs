@@ -82,9 +82,9 @@ pub fn check(mode: Mode, seed: u64, registry: &Registry) -> Result<Vec<TestRow>>
             };
             let reference = bed.reference();
             let budget = Budget::samples(n)?;
-            let cell = mcbench::guarded::cell_of(bed.as_ref(), id, budget, seed, &per_rep_of(seed));
+            let cell = mcbench::run::guarded::cell_of(bed.as_ref(), id, budget, seed, &per_rep_of(seed));
             let pilot_seed = mcbench::unbiasedness::run::pilot_seed(seed);
-            let pilot = mcbench::guarded::cell_of(bed.as_ref(), id, budget, pilot_seed, &per_rep_of(pilot_seed));
+            let pilot = mcbench::run::guarded::cell_of(bed.as_ref(), id, budget, pilot_seed, &per_rep_of(pilot_seed));
             let gate = mcbench::analysis::Gate::from_cell(&pilot, "pilot", 1.0)
                 .with_group(mcbench::analysis::Gate::group_of(est.as_ref(), bed.as_ref()));
             for mut row in unbiasedness(&cell, reference, entry.bias, Some(&gate), DEDICATED_TOLERANCE) {

@@ -41,7 +41,7 @@ use mcbench::output::{Claim, RunReport};
 use mcbench::registry::{Experiment, PostFn, Registry};
 
 /// A named experiment of the suite: its sweep as data (a TOML experiment file beside the code,
-/// [`mcbench::declare`]), its claims and, for real figures and tables, its own analysis.
+/// [`mcbench::config::declare`]), its claims and, for real figures and tables, its own analysis.
 pub struct ExperimentDef {
     /// The experiment file.
     pub toml: &'static str,
@@ -56,7 +56,7 @@ pub struct ExperimentDef {
 impl ExperimentDef {
     /// The harness's experiment (the embedded file is checked by a test of this crate).
     pub fn experiment(&self) -> Experiment {
-        mcbench::declare::experiment(self.toml, self.claims, self.post)
+        mcbench::config::declare::experiment(self.toml, self.claims, self.post)
             .unwrap_or_else(|e| panic!("an experiment file of the suite does not parse: {e}"))
     }
 
@@ -124,7 +124,7 @@ pub fn registry() -> Registry {
 /// references.
 #[cfg(test)]
 pub(crate) fn test_registry() -> Registry {
-    registry().with_references(mcbench::references::ReferenceDir::new(concat!(
+    registry().with_references(mcbench::store::references::ReferenceDir::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../results/references"
     )))
@@ -136,7 +136,7 @@ mod tests {
     #[test]
     fn every_experiment_file_parses() {
         for d in super::experiment_files() {
-            let e = mcbench::declare::experiment(d.toml, d.claims, d.post).expect("parses");
+            let e = mcbench::config::declare::experiment(d.toml, d.claims, d.post).expect("parses");
             assert!(!e.name.is_empty());
         }
     }
@@ -153,7 +153,7 @@ mod tests {
         let registry = super::test_registry();
         let mut judged = 0;
         for d in super::experiment_files() {
-            let file = mcbench::declare::ExperimentFile::parse(d.toml).expect("parses");
+            let file = mcbench::config::declare::ExperimentFile::parse(d.toml).expect("parses");
             let quick = file.sweep(Mode::Quick).expect("quick sweep");
             for mode in [Mode::Quick, Mode::Full] {
                 let mut sweep = file.sweep(mode).expect("sweep");

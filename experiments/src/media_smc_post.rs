@@ -5,12 +5,10 @@
 //! largest budget must be at least 3x the reference's RMS standard error.
 
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
 use mcbench::output::{Claim, RunReport};
-use mcbench::plan::Plan;
-use mcbench::runner::RunResults;
+use mcbench::registry::PostContext;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The refinement criterion the ids run with (their default).
 const CRITERION: f64 = 32.0;
@@ -47,14 +45,8 @@ fn diag(r: &RunReport, variant: &str, estimator: &str, budget: u64, name: &str) 
 }
 
 /// Writes `structure.csv`, adds the Table 1 and reference-precision entries to the `paper` block.
-pub fn post(
-    plan: &Plan,
-    _run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    _plots: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, report, out: results, .. } = cx;
     let last = plan.sweep.budgets.last().map_or(0, |b| b.amount);
     let mut rows = Vec::new();
     for d in &report.diagnostics {
@@ -95,6 +87,6 @@ pub fn post(
             ..Default::default()
         });
     }
-    report.paper.extend(mcbench::claims::reference_precision(plan, report));
+    report.paper.extend(mcbench::analysis::claims::reference_precision(plan, report));
     Ok(Vec::new())
 }

@@ -4,7 +4,7 @@
 //! ([`DISPLAY`], registered by [`crate::registry`]). An id or parameter not listed here is left to
 //! the harness's fallback (the registered label, or the id).
 
-use mcbench::plot::DisplayNames;
+use mcbench::output::plot::DisplayNames;
 
 /// The hook the suite's registry carries.
 pub const DISPLAY: DisplayNames = DisplayNames { estimator: Some(estimator), testbed: Some(testbed) };

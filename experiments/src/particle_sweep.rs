@@ -8,7 +8,7 @@
 //! claim is here.
 
 use crate::ExperimentDef;
-use mcbench::claims::ratio::{self, Ratio, RatioMetric};
+use mcbench::analysis::claims::ratio::{self, Ratio, RatioMetric};
 use mcbench::output::{Claim, RunReport};
 use mcbench::verdict::Verdict;
 
@@ -29,7 +29,7 @@ fn name(id: &str, s: f64) -> String {
     format!("{id}[sigma_samp={s}]")
 }
 
-fn row<'a>(r: &'a RunReport, tb: &str, est: &str, budget: u64) -> Option<&'a mcbench::metrics::SummaryRow> {
+fn row<'a>(r: &'a RunReport, tb: &str, est: &str, budget: u64) -> Option<&'a mcbench::analysis::metrics::SummaryRow> {
     r.rows.iter().find(|x| x.testbed == tb && x.estimator == est && x.budget == budget)
 }
 

@@ -5,15 +5,12 @@
 //! majorant 1) as a flat reference series.
 
 use crate::particle_sweep::{IDS, SIGMAS};
+use mcbench::analysis::metrics::SummaryRow;
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::metrics::SummaryRow;
-use mcbench::output::RunReport;
-use mcbench::plan::Plan;
-use mcbench::plot::{write_panels, Figure, Line, Panels, Series};
-use mcbench::runner::RunResults;
+use mcbench::output::plot::{write_panels, Figure, Line, Panels, Series};
+use mcbench::registry::PostContext;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// One row of `fom.csv`: one cell of the summary.
 #[derive(Serialize)]
@@ -46,14 +43,8 @@ fn model_of(name: &str) -> &str {
 }
 
 /// Writes `fom.csv` and one FoM-vs-sigma_samp plot per medium.
-pub fn post(
-    _: &Plan,
-    _: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    plots: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { report, out: results, plots, .. } = cx;
     let rows: Vec<FomRow<'_>> = report
         .rows
         .iter()

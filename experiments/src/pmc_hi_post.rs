@@ -6,16 +6,14 @@
 //! weight) and in `alpha_maps.csv`.
 
 use mcbench::error::{HarnessError, Result};
-use mcbench::folder::OutputDir;
+use mcbench::output::plot::maps::{write_maps, Map, Scale};
 use mcbench::output::RunReport;
-use mcbench::plan::Plan;
-use mcbench::plot::maps::{write_maps, Map, Scale};
-use mcbench::runner::RunResults;
+use mcbench::registry::PostContext;
 use mcbench_core::budget::Budget;
 use mcbench_core::rng::StreamKey;
 use mcbench_core::task::Task;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Samples per estimate of the Fig. 7 maps.
 pub const FIG7_SPP: u64 = 16;
@@ -124,14 +122,8 @@ fn table2(report: &RunReport) -> Vec<Table2Row<'_>> {
 }
 
 /// Writes `table2.csv`, `alpha_maps.csv` and the Fig. 7 maps.
-pub fn post(
-    plan: &Plan,
-    _run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    plots: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, report, out: results, plots, .. } = cx;
     results.write_csv("table2.csv", &table2(report))?;
     let Some(est) = plan.estimators.iter().find(|e| e.name == "pmc_hi") else { return Ok(Vec::new()) };
     let budget = Budget::samples(FIG7_SPP).map_err(|e| HarnessError::write("fig7", e))?;

@@ -5,7 +5,7 @@
 //! and the threshold-stopping control of paper 003 §2 that the unbiasedness test must flag.
 
 use crate::{pmc_ip_post, ExperimentDef};
-use mcbench::metrics::SummaryRow;
+use mcbench::analysis::metrics::SummaryRow;
 use mcbench::output::{Claim, RunReport};
 
 /// The name of PMC-IP 4+6+6 (the initial image takes 4 spp).
@@ -33,15 +33,15 @@ fn unbiased_claim(r: &RunReport, variant: &str, estimator: &str) -> Claim {
         r.tests.iter().find(|t| t.variant == variant && t.estimator == e && t.test == name).map(|t| t.p_value)
     };
     let p = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2e}"));
-    let decisive = mcbench::claims::decisive_test(&r.tests, variant, estimator, "");
+    let decisive = mcbench::analysis::claims::decisive_test(&r.tests, variant, estimator, "");
     let ours = decisive.map(|t| t.p_value);
     Claim {
         testbed: format!("checker-image/{variant}"),
         claim: format!("paper 003 §4.2: PMC-IP ({estimator}) is unbiased (against the stored reference)"),
         paper_value: None,
         our_value: ours,
-        held: decisive.and_then(|t| mcbench::claims::unbiased_verdict(t).0),
-        verdict: decisive.map(|t| mcbench::claims::unbiased_verdict(t).1),
+        held: decisive.and_then(|t| mcbench::analysis::claims::unbiased_verdict(t).0),
+        verdict: decisive.map(|t| mcbench::analysis::claims::unbiased_verdict(t).1),
         reason: decisive.map_or(String::new(), |t| t.reason.clone()),
         note: format!(
             "{} (Holm-Welch per pixel and the pooled t-test over repetitions, Bonferroni); smallest Holm-adjusted p {} (pooled t {}); uniform_image on the same bed: Holm-Welch {}, pooled t {}; {} repetitions (see docs/src/paper-003.md: heavy-tailed pixel samples)",

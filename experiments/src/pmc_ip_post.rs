@@ -8,18 +8,18 @@
 
 use crate::pmc_ip::{row, PMC_IP_4};
 use mcbench::error::{HarnessError, Result};
-use mcbench::folder::OutputDir;
+use mcbench::output::plot::maps::{write_maps, Map, Scale};
 use mcbench::output::RunReport;
 use mcbench::plan::{Plan, PreparedBed};
-use mcbench::plot::maps::{write_maps, Map, Scale};
-use mcbench::runner::RunResults;
+use mcbench::registry::PostContext;
+use mcbench::run::runner::RunResults;
 use mcbench_core::budget::Budget;
 use mcbench_core::math::Rgb;
 use mcbench_core::rng::StreamKey;
 use mcbench_core::task::Task;
 use mcbench_papers::pmc::ip::{image_probes, PmcIp, Trace};
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The paper's Table 1: (image, method, spp schedule, T seconds, Err, P-Eff).
 const PAPER: [(&str, &str, &str, f64, f64, f64); 5] = [
@@ -177,16 +177,10 @@ fn one_run(plan: &Plan, bed: &PreparedBed, ip: &PmcIp, budget: u64) -> Result<(T
 }
 
 /// Writes `table1.csv`, `pixels.csv` and the Fig. 4 maps; adds the reference-precision claims.
-pub fn post(
-    plan: &Plan,
-    run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    plots: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, results: run, report, out: results, plots, .. } = cx;
     results.write_csv("table1.csv", &table1(plan, report))?;
-    report.paper.extend(mcbench::claims::reference_precision(plan, report));
+    report.paper.extend(mcbench::analysis::claims::reference_precision(plan, report));
     let budget = 10;
     let Some(ip) = pmc_ip_of(plan, "pmc_ip") else { return Ok(Vec::new()) };
     let mut rows = Vec::new();

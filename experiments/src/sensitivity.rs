@@ -6,11 +6,8 @@
 //! file). Runs only when named: `mcbench run sensitivity`.
 
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::output::RunReport;
-use mcbench::plan::Plan;
+use mcbench::registry::PostContext;
 use mcbench::registry::{Experiment, Registry};
-use mcbench::runner::RunResults;
 use mcbench::sensitivity::{run, SensitivityFile};
 use std::path::{Path, PathBuf};
 
@@ -22,15 +19,8 @@ pub fn file() -> SensitivityFile {
     SensitivityFile::parse(TOML).unwrap_or_else(|e| panic!("the sensitivity file of the suite does not parse: {e}"))
 }
 
-fn post(
-    plan: &Plan,
-    results: &RunResults,
-    report: &mut RunReport,
-    out: &OutputDir,
-    plots: Option<&Path>,
-    registry: &Registry,
-) -> Result<Vec<PathBuf>> {
-    run::post(&file(), plan, results, report, out, plots, registry)
+fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    run::post(&file(), cx)
 }
 
 fn preflight(registry: &Registry, first: &mcbench::config::Sweep, cells: &Path) -> Result<()> {

@@ -6,12 +6,10 @@
 
 use crate::single_scatter::{ranking, IDS, NOISE_FREE, PAPER_BUDGETS};
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::output::{Claim, RunReport};
-use mcbench::plan::Plan;
-use mcbench::runner::RunResults;
+use mcbench::output::Claim;
+use mcbench::registry::PostContext;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Primary rays per pixel at ~300 fetches in paper 002 Fig. 12 (upper row; MIS's label is lost in
 /// the text extraction, and the lower row's labels are too garbled to attribute).
@@ -52,14 +50,8 @@ struct EqualFetchRow<'a> {
 }
 
 /// Writes `equal_fetch.csv` and adds the ray counts and unbiasedness summaries to the `paper` block.
-pub fn post(
-    plan: &Plan,
-    _run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    _plots: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, report, out: results, .. } = cx;
     let mut rows = Vec::new();
     let mut claims = Vec::new();
     for bed in &plan.beds {

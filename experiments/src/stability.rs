@@ -12,14 +12,12 @@ use crate::stability_cases::{self as sc, CaseFile, Expect, Outcome};
 use crate::stability_numeric::{self as num, Sequence};
 use crate::ExperimentDef;
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::guarded::one_line;
-use mcbench::output::{Claim, RunReport};
-use mcbench::plan::Plan;
-use mcbench::runner::RunResults;
+use mcbench::output::Claim;
+use mcbench::registry::PostContext;
+use mcbench::run::guarded::one_line;
 use mcbench_core::params::Params;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Definition.
 pub static DEF: ExperimentDef = ExperimentDef { toml: include_str!("stability.toml"), claims: None, post: Some(post) };
@@ -98,14 +96,8 @@ fn nan_to_none(x: f64) -> Option<f64> {
 }
 
 /// Runs every case, writes `stability.csv` and `pdf_zero.csv`, adds one claim per case.
-pub fn post(
-    plan: &Plan,
-    _run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    _plots: Option<&Path>,
-    registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, report, out: results, registry, .. } = cx;
     let file = CaseFile::load()?;
     let seed = plan.sweep.seed;
     let mut rows = Vec::new();

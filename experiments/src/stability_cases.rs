@@ -3,7 +3,7 @@
 //! in one of three outcomes:
 //! - `correct`: every estimate finite, and the harness's own unbiasedness test
 //!   ([`mcbench::analysis::unbiasedness`], the deciding Holm or pooled test of
-//!   [`mcbench::claims::decisive_test`]) agrees with the estimator's registered bias claim;
+//!   [`mcbench::analysis::claims::decisive_test`]) agrees with the estimator's registered bias claim;
 //! - `refused`: the test bed, the estimator, its validation or an estimate refused with a typed
 //!   error (its one-line text is recorded);
 //! - `FAILED`: a panic, a non-finite estimate, or a mean off the reference beyond its error bars.
@@ -14,12 +14,12 @@
 //! The cases themselves, and the table of places where a pdf can be zero, are data:
 //! `stability_cases.toml` beside this file, embedded and read by [`CaseFile::load`].
 
+use mcbench::analysis::claims::decisive_test;
 use mcbench::analysis::unbiasedness;
-use mcbench::claims::decisive_test;
 use mcbench::config::Mode;
 use mcbench::error::HarnessError;
-use mcbench::guarded::{self, one_line, Stopped};
 use mcbench::registry::Registry;
+use mcbench::run::guarded::{self, one_line, Stopped};
 use mcbench_core::budget::Budget;
 use mcbench_core::error::EstimateError;
 use mcbench_core::params::Params;

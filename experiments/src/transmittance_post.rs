@@ -8,15 +8,13 @@
 
 use crate::variance_claims::{build, central_ray, measure, Measured, CASES};
 use mcbench::error::Result;
-use mcbench::folder::OutputDir;
-use mcbench::output::{Claim, RunReport};
-use mcbench::plan::Plan;
-use mcbench::plot::{write_panels, Figure, Key, Line, Panels, Series};
-use mcbench::runner::RunResults;
+use mcbench::output::plot::{write_panels, Figure, Key, Line, Panels, Series};
+use mcbench::output::Claim;
+use mcbench::registry::PostContext;
 use mcbench_core::math::Vec3;
 use mcbench_papers::tracking::variance::predicted;
 use serde::Serialize;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Points along the central ray (s = 20 k / POINTS).
 const POINTS: usize = 20;
@@ -45,14 +43,8 @@ struct BandRow {
 }
 
 /// Writes `fig8_bands.csv` and the band plot, and adds the band agreement to the `paper` block.
-pub fn post(
-    _: &Plan,
-    _: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    plots: Option<&Path>,
-    _registry: &mcbench::registry::Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { report, out: results, plots, .. } = cx;
     let Some((bed, grid)) = central_ray(POINTS) else { return Ok(Vec::new()) };
     let sigma = |t: f64| bed.extinction(Vec3::new(0.0, 0.0, t));
     let mut rows = Vec::new();

@@ -12,12 +12,12 @@
 //! `resolution` pixels (default 8); `case` is `default`, `stiff` or `all` (default). Seeds are
 //! `first seed` (default 1) and the `seeds - 1` (default 199) after it; everything is deterministic.
 
+use mcbench::analysis::metrics::SummaryRow;
 use mcbench::analysis::{fits, RIGHT_END_BUDGETS};
 use mcbench::config::{powers_of_four, EstimatorSpec, Mode, Sweep, TestBedSpec};
-use mcbench::metrics::SummaryRow;
 use mcbench::plan::Plan;
 use mcbench::registry::Registry;
-use mcbench::runner::{run, RunOptions, Silent};
+use mcbench::run::runner::{run, RunOptions, Silent};
 use mcbench_core::params::Params;
 use mcbench_core::stats::log_log_fit;
 

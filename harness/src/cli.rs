@@ -5,11 +5,11 @@
 
 use crate::config::{Mode, SweepFile};
 use crate::error::{HarnessError, Result};
-use crate::execute::{self, ExecOptions};
-use crate::integrals::IntegralsFormat;
-use crate::progress::Progress;
+use crate::output::integrals::IntegralsFormat;
 use crate::registry::Registry;
-use crate::shard::ShardSpec;
+use crate::run::execute::{self, ExecOptions};
+use crate::run::progress::Progress;
+use crate::run::shard::ShardSpec;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use mcbench_core::params::Params;
 use std::ffi::OsString;
@@ -146,10 +146,10 @@ struct RunArgs {
     #[arg(long, value_name = "N", allow_negative_numbers = true)]
     seed: Option<u64>,
     /// Repetitions per integral (2 to 1000000).
-    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(2..=crate::limits::MAX_REPS as u64))]
+    #[arg(long, value_name = "R", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(2..=crate::config::limits::MAX_REPS as u64))]
     reps: Option<u64>,
     /// Worker threads (default: all cores).
-    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=crate::limits::MAX_THREADS))]
+    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=crate::config::limits::MAX_THREADS))]
     threads: Option<u64>,
     /// Results root.
     #[arg(long, value_name = "DIR", default_value = "results")]
@@ -256,11 +256,11 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
         }
         Some(Command::List { what, params }) => {
             let what = what.map(|w| match w {
-                ListWhat::Testbeds => crate::listing::What::TestBeds,
-                ListWhat::Estimators => crate::listing::What::Estimators,
-                ListWhat::Experiments => crate::listing::What::Experiments,
+                ListWhat::Testbeds => crate::output::listing::What::TestBeds,
+                ListWhat::Estimators => crate::output::listing::What::Estimators,
+                ListWhat::Experiments => crate::output::listing::What::Experiments,
             });
-            print!("{}", crate::listing::list(what, params, registry));
+            print!("{}", crate::output::listing::list(what, params, registry));
             Ok(())
         }
         Some(Command::Reference(args)) => reference(args, registry),
@@ -278,8 +278,8 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
                 integrals,
             };
             let t0 = Instant::now();
-            let out = crate::merge::merge(&dirs, &opts)?;
-            crate::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
+            let out = crate::run::merge::merge(&dirs, &opts)?;
+            crate::output::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
             println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             Ok(())
         }
@@ -292,7 +292,7 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
 
 fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     let mode = args.mode();
-    crate::phases::track();
+    crate::run::phases::track();
     let file = args.config.as_deref().map(SweepFile::read).transpose()?;
     // A config's claims replace the experiment's: an error in one of them names the file too.
     let file_claims = file.as_ref().is_some_and(|f| f.claims.is_some());
@@ -334,7 +334,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
             execute::prepare(sweep, registry).map_err(|e| in_config(e, args, file_claims))?
         };
         prepared.push((def, plan));
-        times.push(crate::phases::take());
+        times.push(crate::run::phases::take());
     }
     let progress = Progress::new(args.progress);
     let opts = ExecOptions {
@@ -351,17 +351,17 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     let mut checked = Vec::new();
     for ((def, plan), t) in prepared.iter().zip(&mut times) {
         checked.push(match args.shard {
-            Some(shard) => Checked::Shard(crate::shard::preflight(plan, shard, &args.results)?),
+            Some(shard) => Checked::Shard(crate::run::shard::preflight(plan, shard, &args.results)?),
             None => Checked::Run(execute::preflight(plan, *def, &opts)?),
         });
-        t.add(&crate::phases::take());
+        t.add(&crate::run::phases::take());
     }
     let started = Instant::now();
     for (((def, plan), checked), t) in prepared.iter().zip(checked).zip(&mut times) {
         let t0 = Instant::now();
         if let Checked::Shard(pre) = checked {
             let threads = args.threads.map(|t| t as usize);
-            let out = crate::shard::run_shard(plan, *def, pre, threads, args.wait, &progress)?;
+            let out = crate::run::shard::run_shard(plan, *def, pre, threads, args.wait, &progress)?;
             progress.finish();
             println!(
                 "{} shard {}: {} of {} units ({} resumed) in {:.1} s, written to {}",
@@ -378,15 +378,15 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         let Checked::Run(pre) = checked else { continue };
         let out = execute::execute_checked(plan, *def, &opts, pre)?;
         progress.finish();
-        t.add(&crate::phases::take());
-        crate::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
+        t.add(&crate::run::phases::take());
+        crate::output::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
         println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
         println!("time: {}", t.line());
     }
     println!("\ntotal wall time {:.1} s", started.elapsed().as_secs_f64());
     if args.shard.is_none() {
         let names: Vec<&str> = prepared.iter().map(|(_, p)| p.sweep.experiment.as_str()).collect();
-        print!("{}", crate::phases::table(&names, &times));
+        print!("{}", crate::run::phases::table(&names, &times));
         if !args.no_plots {
             println!("HTML report (open in a browser): {}", args.plots.join("index.html").display());
         }
@@ -437,13 +437,13 @@ fn conformance(ids: &[String], registry: &Registry) -> Result<()> {
 /// `registry` reading stored references from `references`, or `<results>/references`.
 fn with_references(registry: &Registry, results: &std::path::Path, references: &Option<PathBuf>) -> Registry {
     let dir = references.clone().unwrap_or_else(|| results.join("references"));
-    registry.clone().with_references(crate::references::ReferenceDir::new(dir))
+    registry.clone().with_references(crate::store::references::ReferenceDir::new(dir))
 }
 
 /// What was checked for one experiment of a `run` before anything was written.
 enum Checked {
     Run(execute::Preflight),
-    Shard(crate::shard::ShardPreflight),
+    Shard(crate::run::shard::ShardPreflight),
 }
 
 /// `mcbench plot`: redraws a finished run's plots into `<plots>/<results folder's name>` (the
@@ -453,11 +453,11 @@ fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, regi
         .ok()
         .and_then(|p| p.file_name().and_then(|n| n.to_str()).map(String::from))
         .ok_or_else(|| HarnessError::bad_file(results_dir, "not a results folder"))?;
-    let _read = crate::folder::read_lock(results_dir, wait)?;
+    let _read = crate::store::folder::read_lock(results_dir, wait)?;
     let report = crate::output::read_results(results_dir)?;
     let dir = plots.join(&name);
-    crate::folder::check_own_dir("--plots", &dir)?;
-    let _lock = crate::folder::FolderLock::acquire(&dir, wait, &[])?;
+    crate::store::folder::check_own_dir("--plots", &dir)?;
+    let _lock = crate::store::folder::FolderLock::acquire(&dir, wait, &[])?;
     execute::draw(&report, &dir, results_dir, registry.display_names())?;
     println!("plots, report.md and index.html written to {}", dir.display());
     Ok(())
@@ -475,17 +475,17 @@ fn reference(args: ReferenceArgs, registry: &Registry) -> Result<()> {
     // of its own, not a symbolic link.
     let folder = match args.references {
         Some(dir) => {
-            crate::folder::check_output_dir("--references", &dir)?;
-            crate::references::ReferenceDir::new(dir)
+            crate::store::folder::check_output_dir("--references", &dir)?;
+            crate::store::references::ReferenceDir::new(dir)
         }
         None => {
             let dir = args.results.join("references");
-            crate::folder::check_own_dir("--results", &dir)?;
-            crate::references::ReferenceDir::new(dir)
+            crate::store::folder::check_own_dir("--results", &dir)?;
+            crate::store::references::ReferenceDir::new(dir)
         }
     };
     let t0 = Instant::now();
-    let made = crate::references::make(entry, &variant, &params, args.samples, &folder, args.wait)?;
+    let made = crate::store::references::make(entry, &variant, &params, args.samples, &folder, args.wait)?;
     let r = &made.stored.reference;
     let kind = match &r.kind {
         mcbench_core::testbed::ReferenceKind::Exact { method, bound } => {

@@ -23,11 +23,11 @@
 //!    longer than one integral, the sequence estimated at once equals its tasks estimated one by
 //!    one from the same stream (no state carried from task to task).
 
+use crate::analysis::claims::decisive_test;
 use crate::analysis::{unbiasedness, Gate, TestRow};
-use crate::cell::CellResult;
-use crate::claims::decisive_test;
-use crate::guarded::{self, Stopped};
 use crate::registry::Registry;
+use crate::run::cell::CellResult;
+use crate::run::guarded::{self, Stopped};
 use mcbench_core::budget::Budget;
 use mcbench_core::entry::{CaseRole, EstimatorEntry};
 use mcbench_core::error::ConfigError;

@@ -7,11 +7,22 @@
 //! the result files of the book's contract chapter, log-log plots and a report, and a command line with config files,
 //! resume, shards and merge.
 //!
-//! Pipeline: [`config`] -> [`plan`] -> [`runner`] -> [`metrics`] / [`analysis`] -> [`output`] /
-//! [`plot`] / [`report`] / [`html`]; [`execute`] ties them together, [`cli`] is the command line,
-//! [`shard`] and [`merge`] split a sweep over machines and join it again, [`conformance`] is the
-//! check every plug-in goes through. Names are looked up in a [`Registry`], a value you build in
-//! `main`.
+//! Pipeline: [`config`] (a sweep from a config file or an experiment) -> [`plan`] (built test beds
+//! and estimators, every bad name refused before anything is written) -> [`run`] (the cells of the
+//! sweep, filled in parallel; [`run::execute`] ties the stages together) -> [`store`] (the cell
+//! store and the results folder) -> [`analysis`] (metrics, fits, unbiasedness tests, claims) ->
+//! [`output`] (result files, report, plots, HTML pages). [`cli`] is the command line; names are
+//! looked up in a [`Registry`], a value you build in `main`.
+//!
+//! | folder | stage |
+//! |---|---|
+//! | [`config`] | sweeps, config files, experiments declared as TOML, claim specs, input bounds |
+//! | [`plan`] | the plan of a sweep, the cost model, the budget pilot |
+//! | [`run`] | runner, cells, interleaving, progress, CPU time and phases, resume, shards and merge |
+//! | [`store`] | the cell store, packed cells, results folders and their lock, stored references |
+//! | [`analysis`] | metrics, slope fits, unbiasedness tests, speed-ups, claim checks, RMSE bands |
+//! | [`output`] | `summary.csv`/`summary.json`, `integrals.csv`, report, console, plots, HTML, listings |
+//! | [`unbiasedness`], [`calibration`], [`sensitivity`], [`conformance`] | the built-in experiments and the plug-in check |
 //!
 //! ## Quick start: your own estimator, from your own crate
 //!
@@ -62,47 +73,16 @@
 #![warn(missing_docs)]
 
 pub mod analysis;
-mod budget_pilot;
 pub mod calibration;
-pub mod cell;
-pub mod claim_check;
-pub mod claim_spec;
-pub mod claims;
 pub mod cli;
 pub mod config;
 pub mod conformance;
-pub mod console;
-pub mod cost_model;
-pub mod cputime;
-pub mod declare;
 pub mod error;
-pub mod execute;
-pub mod folder;
-mod folder_lock;
-pub mod guarded;
-pub mod html;
-pub mod integrals;
-pub mod interleave;
-pub mod limits;
-pub mod listing;
-mod made_dirs;
-pub mod merge;
-pub mod metrics;
 pub mod output;
-pub mod packed;
-pub mod phases;
 pub mod plan;
-pub mod plot;
-pub mod progress;
-pub mod references;
 pub mod registry;
-pub mod report;
-pub mod resume;
-pub mod rmse_band;
-pub mod roundoff;
-pub mod runner;
+pub mod run;
 pub mod sensitivity;
-pub mod shard;
 pub mod store;
 pub mod unbiasedness;
 pub mod verdict;

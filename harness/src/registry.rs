@@ -19,12 +19,12 @@
 
 use crate::config::{Mode, Sweep};
 use crate::error::Result;
-use crate::folder::OutputDir;
+use crate::output::plot::DisplayNames;
 use crate::output::{Claim, RunReport};
 use crate::plan::Plan;
-use crate::plot::DisplayNames;
-use crate::references::ReferenceDir;
-use crate::runner::RunResults;
+use crate::run::runner::RunResults;
+use crate::store::folder::OutputDir;
+use crate::store::references::ReferenceDir;
 use mcbench_core::entry::{EstimatorEntry, TestBedEntry};
 use mcbench_core::error::ConfigError;
 use mcbench_core::references::ReferenceSource;
@@ -32,11 +32,25 @@ use mcbench_core::Catalog;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-/// An experiment's own analysis after the run: (plan, finished cells, report to extend, results
-/// folder (its files are written through it and committed with the run's), plots folder when plots
-/// are drawn, the registry) -> extra plot files. For real figures and tables beyond what every run
-/// writes.
-pub type PostFn = fn(&Plan, &RunResults, &mut RunReport, &OutputDir, Option<&Path>, &Registry) -> Result<Vec<PathBuf>>;
+/// What an experiment's own analysis after the run gets ([`PostFn`]).
+pub struct PostContext<'a> {
+    /// The plan that ran.
+    pub plan: &'a Plan,
+    /// The finished cells.
+    pub results: &'a RunResults,
+    /// The report to extend (claims, skipped pairs, diagnostics).
+    pub report: &'a mut RunReport,
+    /// The results folder: its files are written through it and committed with the run's.
+    pub out: &'a OutputDir,
+    /// The plots folder, when plots are drawn.
+    pub plots: Option<&'a Path>,
+    /// The registry the run looked its names up in.
+    pub registry: &'a Registry,
+}
+
+/// An experiment's own analysis after the run: its [`PostContext`] -> extra plot files. For real
+/// figures and tables beyond what every run writes.
+pub type PostFn = fn(PostContext<'_>) -> Result<Vec<PathBuf>>;
 
 /// The claims of an experiment, judged on a finished run.
 pub type ClaimsFn = fn(&RunReport) -> Vec<Claim>;

@@ -5,7 +5,7 @@ experiment by experiment, time-derived values aside:
   experiments' own tables; a gzip-compressed table is compared by its text with the plain one of
   the same name, and over the columns both sides have: the columns only one side has, such as the
   `params` columns older integrals.csv files repeated per row, are listed, not compared),
-  with the columns named in harness/src/metrics.rs TIMING_COLUMNS (and the other time-derived
+  with the columns named in harness/src/analysis/metrics.rs TIMING_COLUMNS (and the other time-derived
   names below) removed, cell by cell; tests.csv and claims.csv are left to the next point (they
   are summary.json's `tests` and `paper` as tables, and a time-derived claim's value may move);
 - every claim's verdict and value in summary.json (`paper`), and the tests' verdicts and p-values.
@@ -18,7 +18,7 @@ import json
 import pathlib
 import sys
 
-# TIMING_COLUMNS of harness/src/metrics.rs, and the summary.json fields and table columns that are
+# TIMING_COLUMNS of harness/src/analysis/metrics.rs, and the summary.json fields and table columns that are
 # derived from measured time (as scripts/slurm/smoke_test.sh strips them).
 TIMING = {"seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff", "cpu_seconds", "efficiency_wall",
           "efficiency_renderer", "wall_seconds", "overhead", "speedup", "run_id", "overhead_wall", "speedup_wall",

@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use mcbench::metrics::TIMING_COLUMNS;
+use mcbench::analysis::metrics::TIMING_COLUMNS;
 use std::path::Path;
 
 /// summary.csv with the wall-clock columns removed.
@@ -24,7 +24,7 @@ pub fn stored_cells(store: &Path) -> Vec<(String, serde_json::Value)> {
     s.records()
         .iter()
         .map(|r| {
-            let cell = mcbench::packed::decode_cell(&r.payload).expect("cell decodes");
+            let cell = mcbench::store::packed::decode_cell(&r.payload).expect("cell decodes");
             (r.name.clone(), serde_json::to_value(&cell).expect("json"))
         })
         .collect()
@@ -37,8 +37,8 @@ pub fn edit_cells(store: &Path, mut edit: impl FnMut(&str, &mut serde_json::Valu
         .into_iter()
         .map(|(name, mut v)| {
             edit(&name, &mut v);
-            let cell: mcbench::cell::CellResult = serde_json::from_value(v).expect("still a cell");
-            mcbench::store::Record { payload: mcbench::packed::encode_cell(&cell), name }
+            let cell: mcbench::run::cell::CellResult = serde_json::from_value(v).expect("still a cell");
+            mcbench::store::Record { payload: mcbench::store::packed::encode_cell(&cell), name }
         })
         .collect();
     mcbench::store::write_records(store, &records).expect("rewrites");
@@ -46,5 +46,5 @@ pub fn edit_cells(store: &Path, mut edit: impl FnMut(&str, &mut serde_json::Valu
 
 /// The text of a results folder's integrals.csv (plain or gzip-compressed).
 pub fn integrals_text(results_dir: &Path) -> String {
-    mcbench::integrals::read_text(results_dir).expect("readable").expect("an integrals file")
+    mcbench::output::integrals::read_text(results_dir).expect("readable").expect("an integrals file")
 }

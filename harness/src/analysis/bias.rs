@@ -31,7 +31,7 @@
 //! an estimator carries state: [`Gate::group`]) each count as a chance.
 //!
 //! Zero and round-off variance are a case of their own ([`super::spread`]): a cell whose every
-//! repetition, and its gate's, agree to within round-off ([`crate::roundoff`]) is compared with
+//! repetition, and its gate's, agree to within round-off ([`crate::analysis::roundoff`]) is compared with
 //! the reference directly (the private `direct` module); in a gated cell where only some
 //! integrals are so, those are not t-tested on their rounding errors (agreements within an exact
 //! reference's bound join the per-integral family, the rest are left untested) and the others are
@@ -41,7 +41,7 @@ use super::holm::holm;
 use super::pooled::{pooled, reps_needed};
 use super::spread::{Spread, ZeroChannels};
 use super::UNBIASEDNESS_ALPHA;
-use crate::cell::CellResult;
+use crate::run::cell::CellResult;
 use mcbench_core::estimator::Bias;
 use mcbench_core::stats::Moments;
 use mcbench_core::testbed::Reference;

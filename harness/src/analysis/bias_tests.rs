@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::analysis::reps_for;
-use crate::cell::{CellKey, TimeStats};
+use crate::run::cell::{CellKey, TimeStats};
 use mcbench_core::budget::Budget;
 use mcbench_core::math::Rgb;
 use mcbench_core::stats::NeumaierSum;

@@ -5,7 +5,7 @@
 use super::bias::{multiplicative, spread_upper, Gate};
 use super::spread::{Spread, ZeroChannels};
 use super::POWER;
-use crate::cell::CellResult;
+use crate::run::cell::CellResult;
 use mcbench_core::stats::{detectable_shift_t, holm_bonferroni, t_test, t_test_skewness_limit};
 use mcbench_core::testbed::{Reference, ReferenceKind};
 

@@ -2,9 +2,14 @@
 //! papers' speed-up computation (paper 000/001).
 
 pub mod bias;
+pub mod claim_check;
+pub mod claims;
 mod direct;
 mod holm;
+pub mod metrics;
 mod pooled;
+pub mod rmse_band;
+pub mod roundoff;
 pub mod speedup;
 pub mod spread;
 
@@ -12,7 +17,7 @@ pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE, POOLED_SHARE};
 pub use speedup::{speedups, SpeedUp, SpeedUpOutcome};
 pub use spread::Spread;
 
-use crate::metrics::SummaryRow;
+use crate::analysis::metrics::SummaryRow;
 use mcbench_core::stats::{log_log_fit, weighted_linear_fit, SlopeFit};
 use serde::{Deserialize, Serialize};
 
@@ -258,7 +263,7 @@ pub fn reps_for(d: f64, reps: usize, est_share: f64, tolerance: f64) -> Option<f
 mod tests {
     use super::bias::tests::{cell_from, exact};
     use super::*;
-    use crate::metrics::summarize;
+    use crate::analysis::metrics::summarize;
     use mcbench_core::testbed::ReferenceKind;
 
     #[test]
@@ -307,7 +312,7 @@ mod tests {
                     let chi2: f64 = (0..d).map(|_| normal(rng).powi(2)).sum();
                     m.push(chi2 / d as f64 / n);
                 }
-                let mut r = crate::plot::tests::row("x", n as u64, m.mean().sqrt(), 1.0);
+                let mut r = crate::output::plot::tests::row("x", n as u64, m.mean().sqrt(), 1.0);
                 r.reps = reps;
                 r.mse = m.mean();
                 r.mse_se = (m.variance() / reps as f64).sqrt();
@@ -324,7 +329,7 @@ mod tests {
         let series = |rmse: [f64; 4], bound: f64| -> Vec<SummaryRow> {
             (0..4u32)
                 .map(|k| {
-                    let mut r = crate::plot::tests::row("x", 4u64.pow(k + 1), rmse[k as usize], 1.0);
+                    let mut r = crate::output::plot::tests::row("x", 4u64.pow(k + 1), rmse[k as usize], 1.0);
                     (r.rmse_roundoff, r.mse_se) = (bound, 0.1 * r.mse);
                     r
                 })

@@ -3,7 +3,7 @@
 
 use super::bias::{multiplicative, spread_upper, Gate};
 use super::POWER;
-use crate::cell::CellResult;
+use crate::run::cell::CellResult;
 use mcbench_core::stats::{detectable_shift_t, t_test, t_test_skewness_limit, Moments};
 use mcbench_core::testbed::{Reference, ReferenceKind};
 

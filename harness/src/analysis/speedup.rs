@@ -1,11 +1,11 @@
 //! The papers' speed-up (paper 000 §5, 001 §5) with its 95% interval, in both cost regimes
-//! ([`crate::cost_model`]), and as a function of the cost of a ray.
+//! ([`crate::plan::cost_model`]), and as a function of the cost of a ray.
 
 use super::{group, Fit, SlopeOutcome};
-use crate::claims::bootstrap::{self, Bootstrap};
-use crate::claims::Ratio;
-use crate::cost_model::{CostModel, RayCostCurve, Regime};
-use crate::metrics::SummaryRow;
+use crate::analysis::claims::bootstrap::{self, Bootstrap};
+use crate::analysis::claims::Ratio;
+use crate::analysis::metrics::SummaryRow;
+use crate::plan::cost_model::{CostModel, RayCostCurve, Regime};
 use serde::{Deserialize, Serialize};
 
 use mcbench_core::stats::hypothesis::t_quantile;
@@ -25,7 +25,7 @@ fn quantile(reps: usize) -> f64 {
 /// overhead (its seconds per estimate over the baseline's at that budget).
 ///
 /// Its interval, in each cost regime, is a bootstrap over blocks of repetitions
-/// ([`crate::claims::bootstrap`]) when both cells at that budget carry them: each resample
+/// ([`crate::analysis::claims::bootstrap`]) when both cells at that budget carry them: each resample
 /// recomputes the method's error and CPU seconds and costs per estimate and the baseline's (paired
 /// when the two were cut into the same blocks), moves the baseline's fitted error at this budget by
 /// its own cell's resampled error (its point's noise, an upper bound for the fit's there), and
@@ -158,7 +158,7 @@ impl SpeedUp {
     pub fn describe(&self, regime: Regime) -> String {
         match self.outcome {
             SpeedUpOutcome::Unbounded => "unbounded (exact)".into(),
-            SpeedUpOutcome::Measured => crate::report::sig(self.in_regime(regime), 4),
+            SpeedUpOutcome::Measured => crate::output::report::sig(self.in_regime(regime), 4),
         }
     }
 

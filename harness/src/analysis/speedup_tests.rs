@@ -75,8 +75,8 @@ fn speedup_uses_the_baseline_fit() {
 fn a_speedup_over_round_off_is_unbounded() {
     let mut rows = Vec::new();
     for b in [4u64, 16, 64] {
-        let mut base = crate::plot::tests::row("base", b, 1.0 / (b as f64).sqrt(), 1e-6 * b as f64);
-        let mut exact = crate::plot::tests::row("exact", b, 3e-17 * b as f64, 2e-6 * b as f64);
+        let mut base = crate::output::plot::tests::row("base", b, 1.0 / (b as f64).sqrt(), 1e-6 * b as f64);
+        let mut exact = crate::output::plot::tests::row("exact", b, 3e-17 * b as f64, 2e-6 * b as f64);
         base.rmse_roundoff = 1e-15;
         exact.rmse_roundoff = 1e-15 * b as f64;
         rows.extend([base, exact]);

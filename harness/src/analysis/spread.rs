@@ -1,10 +1,10 @@
 //! Which integrals and channels of a cell have a spread at all: those whose repetitions (and the
-//! gate's) agree to within round-off ([`crate::roundoff`]) are compared with the reference
+//! gate's) agree to within round-off ([`crate::analysis::roundoff`]) are compared with the reference
 //! directly, since a t-test on a spread made of rounding errors measures the arithmetic, not the
 //! estimator.
 
 use super::bias::Gate;
-use crate::cell::CellResult;
+use crate::run::cell::CellResult;
 use mcbench_core::testbed::Reference;
 use serde::{Deserialize, Serialize};
 
@@ -57,7 +57,7 @@ impl ZeroChannels {
     /// zero-variance when its sample standard deviation, and the gate's (scaled to the cell; when
     /// the gate has one), are at most its round-off bound.
     pub(super) fn of(cell: &CellResult, reference: &Reference, gate: Option<&Gate>) -> ZeroChannels {
-        let bounds = crate::roundoff::bounds(cell, reference);
+        let bounds = crate::analysis::roundoff::bounds(cell, reference);
         let mut largest_sd = 0.0f64;
         let zero: Vec<[Option<f64>; 3]> = cell
             .moments
@@ -125,7 +125,7 @@ mod tests {
         let gate = Gate::from_cell(&cell_from(&noisy, &r), "pilot", 1.0);
         let z = ZeroChannels::of(&cell, &r, Some(&gate));
         assert_eq!((z.count, z.spread(true)), (3, Spread::Mixed));
-        assert_eq!(z.direct(Spread::Mixed, 0, 2), Some(crate::roundoff::bound(0.5, 4.0)));
+        assert_eq!(z.direct(Spread::Mixed, 0, 2), Some(crate::analysis::roundoff::bound(0.5, 4.0)));
         assert_eq!(z.direct(Spread::Mixed, 1, 0), None);
         // Without a gate a partly quiet cell is sampled: its quiet integral may have missed a tail.
         let z = ZeroChannels::of(&cell_from(&noisy, &r), &r, None);

@@ -22,13 +22,12 @@ pub use wrap::{FireflyRejection, Scaled};
 
 use crate::config::{Mode, Sweep};
 use crate::error::Result;
-use crate::folder::OutputDir;
-use crate::output::RunReport;
 use crate::plan::Plan;
+use crate::registry::PostContext;
 use crate::registry::{Experiment, Registry, Sweeps};
 use mcbench_core::estimator::Bias;
 use measure::Family;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// The experiment's name.
@@ -134,14 +133,8 @@ fn first_sweep(registry: &Registry, mode: Mode) -> Sweep {
 }
 
 /// Measures every family and writes `calibration.csv` and `calibration.md`, and the claims.
-pub fn post(
-    plan: &Plan,
-    _run: &crate::runner::RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    _plots: Option<&Path>,
-    registry: &Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, report, out: results, registry, .. } = cx;
     let t0 = Instant::now();
     let mode = plan.sweep.mode;
     let n = seeds(mode);
@@ -182,7 +175,7 @@ mod tests {
     #[test]
     fn families_cover_the_controls_and_few_unbiased_estimators_per_case() {
         let registry = Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
-            crate::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+            crate::store::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
         );
         let all = families(&registry, Mode::Quick);
         let mut per_case = std::collections::HashMap::new();

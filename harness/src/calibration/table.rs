@@ -227,9 +227,9 @@ fn mark(x: Option<bool>) -> &'static str {
     }
 }
 
-/// `calibration.md`: the table with the checks (names escaped, [`md_text`](crate::report::md_text)).
+/// `calibration.md`: the table with the checks (names escaped, [`md_text`](crate::output::report::md_text)).
 pub fn markdown(rows: &[Row], header: &str) -> String {
-    use crate::report::md_text;
+    use crate::output::report::md_text;
     let mut s = format!("# calibration\n\n{}\n\n", md_text(header));
     s.push_str("| test bed | estimator | claim | reps | seeds | tested % | false flags % at 5% [95% CI] | flagged % | pass % | power 1% | power 1% on pass | power 3% | detectable % | measured 80% point % | firefly bias % / flagged % | checks |\n");
     s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");

@@ -39,7 +39,7 @@ pub mod outcome;
 pub mod run;
 pub mod table;
 
-use crate::claim_spec::ClaimSpec;
+use crate::config::claim_spec::ClaimSpec;
 use crate::config::{EstimatorSpec, Mode, Sweep, SweepFile, TestBedSpec};
 use crate::error::Result;
 use mcbench_core::error::ConfigError;

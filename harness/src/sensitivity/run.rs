@@ -7,11 +7,11 @@ use super::{setting_text, Ceiling, Part, SensitivityFile};
 use crate::analysis;
 use crate::config::{Mode, Sweep};
 use crate::error::{HarnessError, Result};
-use crate::folder::OutputDir;
 use crate::output::{Claim, Diagnostic, RunReport};
 use crate::plan::Plan;
+use crate::registry::PostContext;
 use crate::registry::{Experiment, Registry, Sweeps};
-use crate::runner::{self, RunResults};
+use crate::run::runner::{self, RunResults};
 use crate::verdict::Verdict;
 use std::path::{Path, PathBuf};
 
@@ -47,7 +47,7 @@ pub fn experiment(
 fn settings<'a>(
     file: &'a SensitivityFile,
     first: &Sweep,
-) -> Result<Vec<(&'a Part, usize, Sweep, crate::claim_spec::ClaimSpec)>> {
+) -> Result<Vec<(&'a Part, usize, Sweep, crate::config::claim_spec::ClaimSpec)>> {
     let mut out = Vec::new();
     for part in &file.parts {
         for (i, v) in part.values.iter().enumerate() {
@@ -93,18 +93,18 @@ pub fn setting_report(plan: &Plan, run: &RunResults, like: &RunReport) -> RunRep
 }
 
 /// The error a work ratio multiplies by rays, read from a summary row.
-type ErrorOf = fn(&crate::metrics::SummaryRow) -> f64;
+type ErrorOf = fn(&crate::analysis::metrics::SummaryRow) -> f64;
 
 /// The ceiling of `claim` on one setting's report.
 pub(super) fn ceiling(
     kind: Ceiling,
-    claim: &crate::claim_spec::ClaimSpec,
+    claim: &crate::config::claim_spec::ClaimSpec,
     sweep_baseline: Option<&str>,
     report: &RunReport,
 ) -> Option<f64> {
-    use crate::claim_spec::ClaimSpec;
-    use crate::claims::RatioMetric;
-    use crate::metrics::SummaryRow;
+    use crate::analysis::claims::RatioMetric;
+    use crate::analysis::metrics::SummaryRow;
+    use crate::config::claim_spec::ClaimSpec;
     match kind {
         Ceiling::WorkRatio => {
             // The error measure the claim's efficiency divides by, and the budget it is read at.
@@ -135,15 +135,8 @@ pub(super) fn ceiling(
 /// Runs every setting of every part (the first part's default is the experiment's own run),
 /// judges each part's claim per setting, and writes `sensitivity.csv`, `sensitivity.md`, one
 /// plot per part and one claim per part (its outcome) into the report.
-pub fn post(
-    file: &SensitivityFile,
-    plan: &Plan,
-    run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    plots: Option<&Path>,
-    registry: &Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(file: &SensitivityFile, cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, results: run, report, out: results, plots, registry } = cx;
     let threads = report.meta.threads;
     let mut rows: Vec<SettingRow> = Vec::new();
     for (part, i, sweep, claim) in settings(file, &plan.sweep)? {

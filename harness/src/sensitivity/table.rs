@@ -6,8 +6,8 @@
 use super::outcome::Outcome;
 use super::{setting_text, Part};
 use crate::error::Result;
+use crate::output::plot::claim_sweep::{write_claim_sweep, ClaimSweepFigure, SettingPoint};
 use crate::output::Claim;
-use crate::plot::claim_sweep::{write_claim_sweep, ClaimSweepFigure, SettingPoint};
 use crate::verdict::Verdict;
 use mcbench_core::params::ParamValue;
 use serde::Serialize;
@@ -87,9 +87,9 @@ fn num(x: Option<f64>) -> String {
 }
 
 /// `sensitivity.md`: the outcome table, then per part its settings (every text of the file and of
-/// the verdicts escaped, [`md_text`](crate::report::md_text)).
+/// the verdicts escaped, [`md_text`](crate::output::report::md_text)).
 pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
-    use crate::report::md_text;
+    use crate::output::report::md_text;
     let mut s = String::from(
         "# Where each claim holds\n\n| paper | claim | against | at our default | at the paper-like setting | outcome |\n|---|---|---|---|---|---|\n",
     );
@@ -161,5 +161,5 @@ pub fn plot(dir: &Path, part: &Part, rows: &[&SettingRow]) -> Result<Vec<PathBuf
         points,
         paper: rows.iter().find_map(|r| r.paper_value),
     };
-    write_claim_sweep(dir, &format!("sensitivity_{}", crate::plot::sanitize(&part.id)), &fig)
+    write_claim_sweep(dir, &format!("sensitivity_{}", crate::output::plot::sanitize(&part.id)), &fig)
 }

@@ -1,7 +1,7 @@
 use super::outcome::{classify, Outcome};
 use super::table::SettingRow;
 use super::*;
-use crate::claim_spec::ClaimSpec;
+use crate::config::claim_spec::ClaimSpec;
 use crate::verdict::Verdict;
 
 const FILE: &str = r#"
@@ -161,7 +161,7 @@ fn not_held_anywhere_needs_a_not_held_setting_and_inconclusive_everywhere_says_s
 #[test]
 fn the_work_ratio_ceiling_divides_error_times_rays_by_the_claims_own_error() {
     use super::run::ceiling;
-    let mut report = crate::plot::tests::synthetic_report();
+    let mut report = crate::output::plot::tests::synthetic_report();
     let template = report.rows[0].clone();
     report.rows.clear();
     // (name, budget, variance, MSE, Err, rays)

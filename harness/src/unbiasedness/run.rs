@@ -11,11 +11,11 @@ use super::table;
 use super::{parts, Row};
 use crate::config::Sweep;
 use crate::error::Result;
-use crate::folder::OutputDir;
 use crate::output::RunReport;
 use crate::plan::Plan;
+use crate::registry::PostContext;
 use crate::registry::Registry;
-use crate::runner::{self, RunResults};
+use crate::run::runner::{self, RunResults};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -152,14 +152,8 @@ pub fn preflight(registry: &Registry, first: &Sweep, cells: &Path) -> Result<()>
 }
 
 /// Runs the pilots, the other parts and writes the table (see the module docs).
-pub fn post(
-    plan: &Plan,
-    run: &RunResults,
-    report: &mut RunReport,
-    results: &OutputDir,
-    _plots: Option<&Path>,
-    registry: &Registry,
-) -> Result<Vec<PathBuf>> {
+pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    let PostContext { plan, results: run, report, out: results, registry, .. } = cx;
     let threads = report.meta.threads;
     let first_pilot = runner::run_stored(
         &Plan::prepare(pilot_of(&plan.sweep), registry)?,

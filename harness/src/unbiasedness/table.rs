@@ -4,10 +4,10 @@
 
 pub use super::stats::{reps_for_target, TARGET_REL_BIAS};
 use crate::analysis::TestRow;
-use crate::cell::CellResult;
 use crate::error::Result;
-use crate::folder::OutputDir;
 use crate::output::Claim;
+use crate::run::cell::CellResult;
+use crate::store::folder::OutputDir;
 use mcbench_core::estimator::Bias;
 use serde::Serialize;
 
@@ -96,7 +96,7 @@ pub fn row_from_tests(cell: &CellResult, bias: Bias, tests: &[TestRow], exempt: 
 }
 
 fn pct(x: f64) -> String {
-    format!("{}%", crate::report::sig(100.0 * x, 2))
+    format!("{}%", crate::output::report::sig(100.0 * x, 2))
 }
 
 /// Fills `agrees` and `note`: unbiased ids must `pass` (an inconclusive row neither agrees nor
@@ -262,7 +262,7 @@ pub fn markdown(rows: &[Row]) -> String {
     let body: Vec<Vec<String>> = rows
         .iter()
         .map(|r| {
-            let num = |x: f64| if x.is_nan() { "-".to_string() } else { crate::report::sig(x, 2) };
+            let num = |x: f64| if x.is_nan() { "-".to_string() } else { crate::output::report::sig(x, 2) };
             vec![
                 r.estimator.clone(),
                 format!("{}/{}", r.testbed, r.variant),
@@ -295,7 +295,7 @@ pub fn markdown(rows: &[Row]) -> String {
         "agrees",
         "note",
     ];
-    crate::report::markdown_table(&header, &body)
+    crate::output::report::markdown_table(&header, &body)
 }
 
 #[cfg(test)]

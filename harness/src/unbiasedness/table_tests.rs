@@ -97,7 +97,7 @@ fn repetitions_for_a_tenth_of_a_percent() {
 fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
     use crate::config::{EstimatorSpec, Mode, Sweep, TestBedSpec};
     use crate::plan::Plan;
-    use crate::runner::{run, RunOptions, Silent};
+    use crate::run::runner::{run, RunOptions, Silent};
     use mcbench_core::budget::Budget;
     use mcbench_core::params::Params;
     let sweep = Sweep {
@@ -120,7 +120,7 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
     let plan = Plan::prepare(
         sweep,
         &crate::registry::Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
-            crate::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+            crate::store::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
         ),
     )
     .unwrap();
