@@ -32,6 +32,22 @@ fn the_small_budget_check_flags_the_biased_control() {
     assert!(row.p_value < UNBIASEDNESS_ALPHA, "the biased control was not flagged: {} p = {}", row.test, row.p_value);
 }
 
+/// Teeth on the generic integrands: the same check flags their biased control
+/// (`integrand_clamped_mc`) on every variant of both built-in integrand beds.
+#[test]
+fn the_small_budget_check_flags_the_integrand_control_on_every_integrand_bed() {
+    let entry = builtins::estimator("integrand_clamped_mc").expect("registered");
+    let est = (entry.build)(&Default::default()).expect("builds");
+    for id in ["product-peak", "cosine-power"] {
+        let bed_entry = builtins::testbed(id).expect("registered");
+        for variant in bed_entry.variants {
+            let bed = bed_entry.build_exact(variant, &Default::default()).expect("builds");
+            let row = small_budget_unbiasedness(entry, est.as_ref(), bed.as_ref()).expect("the control runs");
+            assert!(row.p_value < UNBIASEDNESS_ALPHA, "{id}/{variant}: not flagged, {} p = {}", row.test, row.p_value);
+        }
+    }
+}
+
 /// A registry entry that names a sampler the sampler registry does not have fails the suite: the
 /// sampler check cannot pass vacuously.
 #[test]

@@ -192,6 +192,15 @@ impl<'a> Task<'a> {
     pub fn image_plane(&self) -> Option<ImageProbe<'_>> {
         Some(ImageProbe { scene: self.bed.image_plane()?, task: self })
     }
+    /// The counted probe of this integral's generic integrand ([`crate::integrand`]), when the
+    /// scene has one.
+    pub fn integrand(&self) -> Option<crate::integrand::IntegrandProbe<'_>> {
+        Some(crate::integrand::IntegrandProbe { f: self.bed.integrand()?, task: self })
+    }
+    /// Counts one sample (an integrand evaluation).
+    pub(crate) fn count_sample(&self) {
+        self.count(|c| c.samples += 1);
+    }
     /// Counts `n` evaluations of an adaptive sampler's target density ([`Costs::target_evals`])
     /// that no probe counts: the estimator calls it where it evaluates its target.
     pub fn count_target_evals(&self, n: u64) {
