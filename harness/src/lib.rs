@@ -108,6 +108,7 @@ pub mod shard;
 pub mod store;
 pub mod unbiasedness;
 pub mod verdict;
+pub mod wording;
 
 /// The plug-in API (`mcbench-core`), for crates that depend on the harness alone.
 pub use mcbench_core;
