@@ -117,13 +117,3 @@ pub use mcbench_core::{
     Needs, ParamSpec, Reference, Rgb, StreamRng, Task, TestBed, TestBedEntry,
 };
 pub use registry::{Experiment, Registry};
-
-/// The README's code blocks, compiled and run as doc tests.
-#[cfg(doctest)]
-#[doc = include_str!("../../README.md")]
-pub struct ReadmeDoctests;
-
-/// The Rust blocks of the book's plug-in chapter, compiled and run as doc tests.
-#[cfg(doctest)]
-#[doc = include_str!("../../docs/src/extending.md")]
-pub struct BookPluginDoctests;
