@@ -1,7 +1,7 @@
 //! Generic integrands (book: extending.md): one function on a named [`Domain`], with its exact
 //! value when it has one. [`crate::integrand_bed`] turns an integrand into a test bed that
 //! provides [`crate::Needs::INTEGRAND`]; estimators reach it through the counted
-//! [`IntegrandProbe`] of [`crate::Task::integrand`] (one sample per evaluation).
+//! [`crate::task::IntegrandProbe`] of [`crate::Task::integrand`] (one sample per evaluation).
 //!
 //! ```
 //! use mcbench_core::integrand::{Domain, Integrand};
@@ -25,7 +25,6 @@
 
 use crate::error::ConfigError;
 use crate::samplers::{cosine_hemisphere, uniform_hemisphere};
-use crate::task::Task;
 use rand::Rng;
 use std::f64::consts::PI;
 
@@ -131,24 +130,6 @@ pub trait Integrand: Send + Sync {
     /// computes and stores it (`mcbench reference <bed>`).
     fn exact(&self) -> Option<f64> {
         None
-    }
-}
-
-/// Counted access to the integrand of a task: every evaluation is one sample.
-pub struct IntegrandProbe<'a> {
-    pub(crate) f: &'a dyn Integrand,
-    pub(crate) task: &'a Task<'a>,
-}
-
-impl IntegrandProbe<'_> {
-    /// The domain (free).
-    pub fn domain(&self) -> Domain {
-        self.f.domain()
-    }
-    /// `f(x)`: one sample.
-    pub fn eval(&self, x: &[f64]) -> f64 {
-        self.task.count_sample();
-        self.f.eval(x)
     }
 }
 

@@ -15,11 +15,10 @@
 use mcbench_core::entry::{Checks, EstimatorEntry};
 use mcbench_core::error::{ConfigError, EstimateError};
 use mcbench_core::estimator::{Bias, Estimator};
-use mcbench_core::integrand::IntegrandProbe;
 use mcbench_core::math::Rgb;
 use mcbench_core::params::{check_range, parse, NoParams, ParamSet, ParamSpec};
 use mcbench_core::rng::StreamRng;
-use mcbench_core::task::Task;
+use mcbench_core::task::{IntegrandProbe, Task};
 use mcbench_core::testbed::Needs;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
