@@ -38,6 +38,11 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
     assert_bad_input(d, &["run", "surface-smc", "--reps", "0"], "--reps");
     assert_bad_input(d, &["run", "surface-smc", "--seed", "abc"], "--seed");
     assert_bad_input(d, &["run", "surface-smc", "--threads", "0"], "--threads");
+    // A pattern of --estimators or --testbeds that matches nothing is named, with the valid ids.
+    assert_bad_input(d, &["run", "unbiasedness", "--estimators", "integrand_mc,nope*"], "--estimators = nope*");
+    assert_bad_input(d, &["run", "unbiasedness", "--testbeds", "peak"], "product-peak");
+    assert_bad_input(d, &["conformance", "--testbeds", "no-such-bed"], "--testbeds = no-such-bed");
+    assert_bad_input(d, &["conformance", "no_such_estimator"], "integrand_mc");
     assert_bad_input(d, &["run"], "experiment");
     assert_bad_input(d, &["frobnicate"], "frobnicate");
     assert_bad_input(d, &["reference", "gradient-plane", "--variant", "shiny"], "gradient-plane/shiny");

@@ -32,6 +32,22 @@ fn the_small_budget_check_flags_the_biased_control() {
     assert!(row.p_value < UNBIASEDNESS_ALPHA, "the biased control was not flagged: {} p = {}", row.test, row.p_value);
 }
 
+/// Teeth on the generic integrands: the same check flags their biased control
+/// (`integrand_clamped_mc`) on every variant of both built-in integrand beds.
+#[test]
+fn the_small_budget_check_flags_the_integrand_control_on_every_integrand_bed() {
+    let entry = builtins::estimator("integrand_clamped_mc").expect("registered");
+    let est = (entry.build)(&Default::default()).expect("builds");
+    for id in ["product-peak", "cosine-power"] {
+        let bed_entry = builtins::testbed(id).expect("registered");
+        for variant in bed_entry.variants {
+            let bed = bed_entry.build_exact(variant, &Default::default()).expect("builds");
+            let row = small_budget_unbiasedness(entry, est.as_ref(), bed.as_ref()).expect("the control runs");
+            assert!(row.p_value < UNBIASEDNESS_ALPHA, "{id}/{variant}: not flagged, {} p = {}", row.test, row.p_value);
+        }
+    }
+}
+
 /// A registry entry that names a sampler the sampler registry does not have fails the suite: the
 /// sampler check cannot pass vacuously.
 #[test]
@@ -98,4 +114,30 @@ fn registry() -> &'static mcbench::Registry {
             "/../results/references"
         )))
     })
+}
+
+/// A sampler registered from a user's crate (`Registry::with_sampler`) is what the suite tests for
+/// an estimator that names it: its failing chi-square check fails the estimator, its passing one
+/// does not, and without the registration the name is unknown.
+#[test]
+fn a_users_sampler_gets_the_chi_square_check() {
+    use mcbench_core::samplers::registry::SamplerEntry;
+    use mcbench_core::stats::ChiSquare;
+    fn outcome(p_value: f64) -> Vec<(String, ChiSquare)> {
+        let c = ChiSquare { statistic: 1.0, dof: 9, p_value, cells: 10, merged_from: 10 };
+        vec![("grid".to_string(), c)]
+    }
+    static BAD: SamplerEntry = SamplerEntry { id: "my_sampler", summary: "a wrong density", check: || outcome(1e-9) };
+    static GOOD: SamplerEntry = SamplerEntry { id: "my_sampler", summary: "a right density", check: || outcome(0.4) };
+    let real = builtins::estimator("is0_cv0").expect("registered");
+    let entry = EstimatorEntry { samplers: &["my_sampler"], ..*real };
+    let failures = |r: mcbench::Registry| -> Vec<String> {
+        let suite = Conformance::new(&r).expect("builds");
+        suite.check(&entry).into_iter().filter(|f| f.check == "samplers").map(|f| f.detail).collect()
+    };
+    let bad = failures(registry().clone().with_sampler(&BAD));
+    assert!(bad.len() == 1 && bad[0].contains("my_sampler: grid"), "{bad:?}");
+    assert!(failures(registry().clone().with_sampler(&GOOD)).is_empty());
+    let unknown = failures(registry().clone());
+    assert!(unknown.len() == 1 && unknown[0].contains("Registry::with_sampler"), "{unknown:?}");
 }

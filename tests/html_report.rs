@@ -72,7 +72,7 @@ fn a_run_writes_pages_whose_links_resolve_and_the_root_keeps_every_experiment() 
     }
     let html = read(&page);
     for needle in [
-        "Paper claims",
+        "<h2 id=\"claims\">Claims</h2>",
         "class=\"badge v-inconclusive\"",
         "Per-pixel z-scores and relative errors",
         "src=\"data:image/png;base64,",

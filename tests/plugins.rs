@@ -114,3 +114,104 @@ fn one_file_and_one_registration_are_enough() {
     let text = mcbench::output::listing::list(Some(mcbench::output::listing::What::Estimators), true, &registry);
     assert!(text.contains("throw_away") && text.contains("Strength of the polar tilt"), "{text}");
 }
+
+/// A diffuse point (albedo 0.8) under a white sky: `f / p = 1.6 cos(theta)` under uniform
+/// hemisphere sampling never reaches the clamp 2 of the built-in control `clamped_is0_cv0`, which
+/// is therefore unbiased here. Exact reference 0.8.
+struct WhiteSky(mcbench::Reference);
+
+impl mcbench_core::testbed::HemisphereScene for WhiteSky {
+    fn shading(&self, _i: usize) -> mcbench_core::testbed::ShadingPoint {
+        let brdf = mcbench_core::brdf::Phong { kd: Rgb([0.8; 3]), ks: Rgb::ZERO, n: 1.0 };
+        mcbench_core::testbed::ShadingPoint { position: Vec3::default(), normal: Vec3::Z, wo: Vec3::Z, brdf }
+    }
+    fn incident(&self, _i: usize, _wi: Vec3) -> Rgb {
+        Rgb([1.0; 3])
+    }
+}
+
+impl mcbench::TestBed for WhiteSky {
+    fn id(&self) -> &'static str {
+        "white-sky"
+    }
+    fn variant(&self) -> &str {
+        "default"
+    }
+    fn provides(&self) -> Needs {
+        Needs::SURFACE
+    }
+    fn resolution(&self) -> (usize, usize) {
+        (1, 1)
+    }
+    fn reference(&self) -> &mcbench::Reference {
+        &self.0
+    }
+    fn hemisphere(&self) -> Option<&dyn mcbench_core::testbed::HemisphereScene> {
+        Some(self)
+    }
+}
+
+static WHITE_SKY: mcbench::TestBedEntry = mcbench::TestBedEntry {
+    id: "white-sky",
+    variants: &["default"],
+    provides: Needs::SURFACE,
+    summary: "a diffuse point under a white sky, exact",
+    build: |_, _, _| {
+        let exact = mcbench_core::testbed::ReferenceKind::Exact { method: "closed form".into(), bound: 1e-15 };
+        Ok(Box::new(WhiteSky(mcbench::Reference { kind: exact, value: vec![Rgb([0.8; 3])], std_err: vec![Rgb::ZERO] })))
+    },
+    compute_reference: None,
+    params: ParamSpec::NONE,
+    cases: &[mcbench_core::entry::BedCase {
+        variant: "default",
+        params: &[],
+        role: mcbench_core::entry::CaseRole::Unbiasedness { samples: 16, reps: (256, 2048) },
+    }],
+};
+
+/// The control claim of a run of the built-in control on the built-in `gradient-plane` (where it is
+/// biased) and a user's bed on which it is not: red without an exemption, held with one, whose
+/// reason the table and the report show.
+#[test]
+fn an_exemption_from_the_users_crate_keeps_the_control_claim_honest() {
+    const REASON: &str = "f/p never reaches the clamp under a white sky";
+    let claim = |registry: Registry| {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let root = dir.path();
+        let (results, plots) = (root.join("results"), root.join("plots"));
+        let args = [
+            "mcbench",
+            "run",
+            "unbiasedness",
+            "--estimators",
+            "clamped_is0_cv0",
+            "--testbeds",
+            "white-sky,gradient-plane",
+            "--threads",
+            "2",
+            "--results",
+            results.to_str().expect("utf8"),
+            "--plots",
+            plots.to_str().expect("utf8"),
+        ];
+        assert_eq!(mcbench::cli::main_with_args(registry, args), 0);
+        let csv = std::fs::read_to_string(results.join("unbiasedness/unbiasedness.csv")).expect("table");
+        let report = std::fs::read_to_string(plots.join("unbiasedness/report.md")).expect("report");
+        let line =
+            report.lines().find(|l| l.contains("the biased control clamped_is0_cv0")).expect("claim").to_string();
+        (csv, report, line)
+    };
+    let (csv, _, line) = claim(Registry::new().with_catalog(mcbench_papers::catalog()).with_test_bed(&WHITE_SKY));
+    assert!(line.contains("not held") && line.contains("white-sky/default"), "{line}\n{csv}");
+    let exempted = Registry::new().with_catalog(mcbench_papers::catalog()).with_test_bed(&WHITE_SKY).with_exemption(
+        "clamped_is0_cv0",
+        "white-sky",
+        &["*"],
+        REASON,
+    );
+    let (csv, report, line) = claim(exempted);
+    assert!(line.contains(" held ") && !line.contains("not held"), "{line}\n{csv}");
+    let row = csv.lines().find(|l| l.contains("white-sky")).expect("row");
+    assert!(row.contains(REASON), "{row}");
+    assert!(report.contains(REASON), "{report}");
+}

@@ -1,7 +1,9 @@
 //! Stored references as data, through the binary: a copy of the binary run from anywhere finds
-//! every stored reference through `--references` (and nothing through a path compiled into it), a
+//! every stored reference of the built-in test beds without any folder (they are compiled into
+//! the papers' crate, not read through a path compiled into it) and through `--references`, a
 //! reference made with parameters is found by a run that uses them, and a stored reference that
-//! is malformed is refused before anything is written.
+//! is malformed in the folder a run names is refused (the folder is asked before the built-in
+//! ones) before anything is written.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -56,19 +58,32 @@ const EVERY_STORED: &str = "name = 'stored'\nreps = 2\nbudgets = [1]\n\
 fn a_copied_binary_finds_every_stored_reference_through_references() {
     let (_dir, bin, work) = copied_binary();
     std::fs::write(work.join("stored.toml"), EVERY_STORED).expect("config");
-    // Without a references folder it finds none (no path is compiled in) and says how to make one.
-    let o = run(&bin, &work, &["run", "--config", "stored.toml", "--no-plots"]);
-    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("mcbench reference gradient-box --variant albedo-0.8"), "{}", stderr(&o));
-    assert!(!work.join("results/stored").exists(), "nothing written");
-    let o = run(&bin, &work, &["run", "--config", "stored.toml", "--no-plots", "--references", REFERENCES]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let csv = std::fs::read_to_string(work.join("results/stored/summary.csv")).expect("summary");
-    for bed in
-        ["albedo-0.8", "albedo-1", "albedo-0.5", "hg-0.1", "thick", "default", "occluded", "soft-shadow", "multiple"]
-    {
-        assert!(csv.contains(&format!(",{bed},")), "{bed} missing from {csv}");
+    // Without a references folder it finds the built-in ones; the same through --references.
+    for (args, folder) in [(vec![], "results"), (vec!["--references", REFERENCES, "--results", "named"], "named")] {
+        let o = run(&bin, &work, &[&["run", "--config", "stored.toml", "--no-plots"][..], &args].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        let csv = std::fs::read_to_string(work.join(folder).join("stored/summary.csv")).expect("summary");
+        for bed in [
+            "albedo-0.8",
+            "albedo-1",
+            "albedo-0.5",
+            "hg-0.1",
+            "thick",
+            "default",
+            "occluded",
+            "soft-shadow",
+            "multiple",
+        ] {
+            assert!(csv.contains(&format!(",{bed},")), "{bed} missing from {csv}");
+        }
     }
+    // A reference of other parameters is in neither: refused, saying how to make it.
+    let other = EVERY_STORED.replace("variant = 'albedo-1'\n", "variant = 'albedo-1'\nparams = { sigma_t = 0.7 }\n");
+    std::fs::write(work.join("other.toml"), other).expect("config");
+    let o = run(&bin, &work, &["run", "--config", "other.toml", "--no-plots"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("mcbench reference gradient-box --variant albedo-1"), "{}", stderr(&o));
+    assert!(!work.join("results/other").exists(), "nothing written");
     // The same through --results: the references folder below a results root.
     let root = work.join("elsewhere");
     std::fs::create_dir_all(root.join("references")).expect("mkdir");

@@ -18,20 +18,32 @@
 
 use crate::entry::{EstimatorEntry, TestBedEntry};
 use crate::error::ConfigError;
+use crate::references::ReferenceSource;
 
-/// Estimators and test beds, in the order they are listed.
+/// Estimators and test beds, in the order they are listed, and the stored references the crate
+/// ships for its test beds.
 #[derive(Clone, Default)]
 pub struct Catalog {
     /// The estimators.
     pub estimators: Vec<&'static EstimatorEntry>,
     /// The test beds.
     pub testbeds: Vec<&'static TestBedEntry>,
+    /// Stored references built into the crate, looked up after the folder a run names
+    /// ([`crate::references::Chain`]).
+    pub references: Vec<&'static dyn ReferenceSource>,
 }
 
 impl Catalog {
     /// The estimators and test beds of two lists.
     pub fn new(estimators: &[&'static EstimatorEntry], testbeds: &[&'static TestBedEntry]) -> Self {
-        Catalog { estimators: estimators.to_vec(), testbeds: testbeds.to_vec() }
+        Catalog { estimators: estimators.to_vec(), testbeds: testbeds.to_vec(), references: Vec::new() }
+    }
+
+    /// The same with `source`, the stored references the crate ships (for example compiled in
+    /// with `include_str!`), looked up after the folder a run names.
+    pub fn with_references(mut self, source: &'static dyn ReferenceSource) -> Self {
+        self.references.push(source);
+        self
     }
 
     /// Looks an estimator up by id.

@@ -30,6 +30,8 @@ pub mod entry;
 pub mod envmap;
 pub mod error;
 pub mod estimator;
+pub mod integrand;
+pub mod integrand_bed;
 pub mod lighting;
 pub mod math;
 pub mod memo;
@@ -52,6 +54,8 @@ pub use entry::{
 };
 pub use error::{ConfigError, EstimateError};
 pub use estimator::{Bias, EstimateMoments, Estimator};
+pub use integrand::{Domain, Integrand};
+pub use integrand_bed::IntegrandBed;
 pub use math::{Frame, Rgb, Vec3};
 pub use params::{NoParams, ParamSet, ParamSpec, Params};
 pub use references::{ReferenceKey, ReferenceSource, StoredReference};

@@ -162,6 +162,32 @@ impl ReferenceSource for InMemory {
     }
 }
 
+/// Several sources asked in order, the first that holds a key winning: the harness puts the
+/// folder `--references` names first and the references built into the plug-in crates
+/// ([`crate::Catalog::with_references`]) after it, so a reference of your own overrides a built-in
+/// one and a built-in bed needs no folder at all.
+#[derive(Clone, Default)]
+pub struct Chain(pub Vec<std::sync::Arc<dyn ReferenceSource>>);
+
+impl ReferenceSource for Chain {
+    fn stored(&self, key: &ReferenceKey) -> Result<Option<StoredReference>, ConfigError> {
+        for source in &self.0 {
+            if let Some(s) = source.stored(key)? {
+                return Ok(Some(s));
+            }
+        }
+        Ok(None)
+    }
+    fn location(&self) -> String {
+        let places: Vec<String> = self.0.iter().map(|s| s.location()).collect();
+        if places.is_empty() {
+            "no reference folder".into()
+        } else {
+            places.join(", then ")
+        }
+    }
+}
+
 /// The reference of `key` from `source`, checked against the `integrals` and `resolution` of the
 /// test bed ([`StoredReference::check`]): absent is an error that says how to make it.
 pub fn load(
@@ -228,6 +254,20 @@ mod tests {
                 std_err: vec![Rgb([std_err; 3]); 4],
             },
         }
+    }
+
+    /// The first source that holds a key wins; the location names every source in order.
+    #[test]
+    fn a_chain_asks_its_sources_in_order() {
+        use std::sync::Arc;
+        let key = ReferenceKey::new("bed", "default", &[], true);
+        let (mine, builtin) = (stored(1.0, 0.0), stored(2.0, 0.0));
+        let chain = Chain(vec![Arc::new(InMemory(vec![mine])), Arc::new(InMemory(vec![builtin.clone()]))]);
+        assert_eq!(chain.stored(&key).unwrap().unwrap().reference.value[0][0], 1.0);
+        let fallback = Chain(vec![Arc::new(NoReferences), Arc::new(InMemory(vec![builtin]))]);
+        assert_eq!(fallback.stored(&key).unwrap().unwrap().reference.value[0][0], 2.0);
+        assert_eq!(fallback.location(), "no reference folder, then references in memory");
+        assert!(Chain::default().stored(&key).unwrap().is_none());
     }
 
     #[test]

@@ -192,6 +192,11 @@ impl<'a> Task<'a> {
     pub fn image_plane(&self) -> Option<ImageProbe<'_>> {
         Some(ImageProbe { scene: self.bed.image_plane()?, task: self })
     }
+    /// The counted probe of this integral's generic integrand ([`crate::integrand`]), when the
+    /// scene has one.
+    pub fn integrand(&self) -> Option<IntegrandProbe<'_>> {
+        Some(IntegrandProbe { f: self.bed.integrand()?, task: self })
+    }
     /// Counts `n` evaluations of an adaptive sampler's target density ([`Costs::target_evals`])
     /// that no probe counts: the estimator calls it where it evaluates its target.
     pub fn count_target_evals(&self, n: u64) {
@@ -206,6 +211,24 @@ impl<'a> Task<'a> {
         let mut c = self.costs.get();
         f(&mut c);
         self.costs.set(c);
+    }
+}
+
+/// Counted access to the generic integrand of a task: every evaluation is one sample.
+pub struct IntegrandProbe<'a> {
+    f: &'a dyn crate::integrand::Integrand,
+    task: &'a Task<'a>,
+}
+
+impl IntegrandProbe<'_> {
+    /// The domain (free).
+    pub fn domain(&self) -> crate::integrand::Domain {
+        self.f.domain()
+    }
+    /// `f(x)`: one sample.
+    pub fn eval(&self, x: &[f64]) -> f64 {
+        self.task.count(|c| c.samples += 1);
+        self.f.eval(x)
     }
 }
 

@@ -25,13 +25,16 @@ impl Needs {
     pub const AREA_LIGHTS: Needs = Needs(16);
     /// Pixel integrals over the image plane, sampled at chosen positions ([`ImagePlaneScene`]).
     pub const IMAGE_PLANE: Needs = Needs(32);
-    const NAMES: [(Needs, &'static str); 6] = [
+    /// A generic integrand on a named domain ([`crate::integrand::Integrand`]).
+    pub const INTEGRAND: Needs = Needs(64);
+    const NAMES: [(Needs, &'static str); 7] = [
         (Needs::SURFACE, "surface"),
         (Needs::MEDIUM, "medium"),
         (Needs::POINT_LIGHT, "point light"),
         (Needs::ENV_SEQUENCE, "environment sequence"),
         (Needs::AREA_LIGHTS, "area lights"),
         (Needs::IMAGE_PLANE, "image plane"),
+        (Needs::INTEGRAND, "integrand"),
     ];
     /// Union of two sets.
     pub const fn and(self, o: Needs) -> Needs {
@@ -387,6 +390,10 @@ pub trait TestBed: Send + Sync {
     }
     /// The image-plane view of the scene (paper 003 PMC-IP), when it has one.
     fn image_plane(&self) -> Option<&dyn ImagePlaneScene> {
+        None
+    }
+    /// The generic integrand of the scene ([`crate::integrand`]), when it is one.
+    fn integrand(&self) -> Option<&dyn crate::integrand::Integrand> {
         None
     }
     /// The environment-sequence view of the scene (paper 004), when it has one.

@@ -5,9 +5,10 @@ use mcbench_core::entry::{EstimatorEntry, TestBedEntry};
 use mcbench_core::error::ConfigError;
 use mcbench_core::Catalog;
 
-/// The built-in estimators and test beds, to hand to a registry (`Registry::with_catalog`).
+/// The built-in estimators and test beds with their stored references
+/// ([`crate::built_in_references`]), to hand to a registry (`Registry::with_catalog`).
 pub fn catalog() -> Catalog {
-    Catalog::new(ESTIMATORS, TESTBEDS)
+    Catalog::new(ESTIMATORS, TESTBEDS).with_references(&crate::built_in_references::BUILT_IN)
 }
 
 /// Every built-in estimator, in the order `mcbench list estimators` shows them.
@@ -48,6 +49,9 @@ pub static ESTIMATORS: &[&EstimatorEntry] = &[
     &crate::single_scatter::attenuation_driven_sir::ENTRY,
     &crate::single_scatter::source_driven::ENTRY,
     &crate::single_scatter::scattering_driven::ENTRY,
+    &crate::integrand_mc::MC,
+    &crate::integrand_mc::ANTITHETIC,
+    &crate::integrand_mc::CLAMPED,
 ];
 
 /// Every built-in test bed.
@@ -60,6 +64,8 @@ pub static TESTBEDS: &[&TestBedEntry] = &[
     &crate::testbeds::medium::PERLIN,
     &crate::testbeds::gradient_box::ENTRY,
     &crate::testbeds::canonical_1d::ENTRY,
+    &crate::testbeds::product_peak::ENTRY,
+    &crate::testbeds::cosine_power::ENTRY,
 ];
 
 /// Looks an estimator up by id.

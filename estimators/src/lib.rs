@@ -9,20 +9,20 @@
 //! baseline and the clamped control), [`surface_smc`] (paper 001's adaptive surface estimators
 //! with [`cache`], their radiance cache), [`media_smc`] (paper 000 in a medium), [`tracking`] and
 //! [`single_scatter`] (paper 002's trackers with their moment theory, and its single-scattering
-//! estimators), [`pmc`] (paper 003), [`envmap_smc`] (paper 004); and [`testbeds`], the eight test
-//! beds with their references.
+//! estimators), [`pmc`] (paper 003), [`envmap_smc`] (paper 004), [`integrand_mc`] (estimators of any generic integrand); and
+//! [`testbeds`], the test beds with their references.
 //!
 //! No I/O, plotting or CLI lives here (that is the `mcbench` crate, in `harness/`).
 #![warn(missing_docs)]
 
+pub mod built_in_references;
 pub mod builtins;
 pub mod cache;
 pub mod envmap_smc;
 pub mod independent;
+pub mod integrand_mc;
 pub mod media_smc;
 pub mod pmc;
-#[cfg(test)]
-mod repository;
 pub mod single_scatter;
 pub mod surface_smc;
 pub mod testbeds;

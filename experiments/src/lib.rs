@@ -130,6 +130,17 @@ pub(crate) fn test_registry() -> Registry {
     )))
 }
 
+/// The README's code blocks, compiled and run as doc tests (here, in the crate that is not
+/// published, so the published ones include no file outside their package).
+#[cfg(doctest)]
+#[doc = include_str!("../../README.md")]
+pub struct ReadmeDoctests;
+
+/// The Rust blocks of the book's plug-in chapter, compiled and run as doc tests.
+#[cfg(doctest)]
+#[doc = include_str!("../../docs/src/extending.md")]
+pub struct BookPluginDoctests;
+
 #[cfg(test)]
 mod tests {
     /// Every experiment file parses and gives valid sweeps in both modes.

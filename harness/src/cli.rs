@@ -10,6 +10,7 @@ use crate::registry::Registry;
 use crate::run::execute::{self, ExecOptions};
 use crate::run::progress::Progress;
 use crate::run::shard::ShardSpec;
+use crate::selection::Selection;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use mcbench_core::params::Params;
 use std::ffi::OsString;
@@ -83,6 +84,12 @@ enum Command {
     Conformance {
         /// Estimator ids.
         estimators: Vec<String>,
+        /// Only these estimators too: ids or `*` globs, comma separated.
+        #[arg(long = "estimators", value_name = "LIST")]
+        estimator_list: Option<String>,
+        /// Only the cases of these test beds: ids or `*` globs, comma separated.
+        #[arg(long, value_name = "LIST")]
+        testbeds: Option<String>,
         /// Results root (stored references are read from its `references` folder).
         #[arg(long, value_name = "DIR", default_value = "results")]
         results: PathBuf,
@@ -178,6 +185,12 @@ struct RunArgs {
     /// The per-integral file: gz (integrals.csv.gz), csv (plain integrals.csv) or none
     #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
     integrals: IntegralsFormat,
+    /// Only these estimators: ids or `*` globs, comma separated (`--estimators 'my_*,is0_cv0'`).
+    #[arg(long, value_name = "LIST")]
+    estimators: Option<String>,
+    /// Only these test beds: ids or `*` globs, comma separated.
+    #[arg(long, value_name = "LIST")]
+    testbeds: Option<String>,
 }
 
 impl RunArgs {
@@ -248,10 +261,12 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
                 .into());
             }
             let registry = with_references(registry, &cli.run.results, &cli.run.references);
+            let registry = selected(&registry, &selection(&cli.run))?;
             run(&names, &cli.run, &registry)
         }
         Some(Command::Run { experiments, args }) => {
             let registry = with_references(registry, &args.results, &args.references);
+            let registry = selected(&registry, &selection(&args))?;
             run(&experiments, &args, &registry)
         }
         Some(Command::List { what, params }) => {
@@ -284,8 +299,10 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             Ok(())
         }
         Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait, registry),
-        Some(Command::Conformance { estimators, results, references }) => {
-            conformance(&estimators, &with_references(registry, &results, &references))
+        Some(Command::Conformance { estimators, estimator_list, testbeds, results, references }) => {
+            let only = Selection::new(estimator_list.as_deref(), testbeds.as_deref()).with_estimator_ids(&estimators);
+            let registry = selected(&with_references(registry, &results, &references), &only)?;
+            conformance(&[], &registry)
         }
     }
 }
@@ -306,7 +323,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
                 format!("name one (valid: {}) or give --config", valid_experiments(registry)),
             )
         })?;
-        plans.push((None, file.apply(None, mode)?));
+        plans.push((None, selection(args).filter_sweep(file.apply(None, mode)?)));
     } else {
         for name in names {
             let def = registry.experiment(name)?;
@@ -315,7 +332,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
                 Some(f) => f.clone().apply(Some(sweep), mode)?,
                 None => sweep,
             };
-            plans.push((Some(def), sweep));
+            plans.push((Some(def), selection(args).filter_sweep(sweep)));
         }
     }
     let (mut prepared, mut times) = (Vec::new(), Vec::new());
@@ -432,6 +449,23 @@ fn conformance(ids: &[String], registry: &Registry) -> Result<()> {
         return Err(HarnessError::Failed(format!("{failed} estimators failed the conformance suite")));
     }
     Ok(())
+}
+
+/// The `--estimators` and `--testbeds` of a run.
+fn selection(args: &RunArgs) -> Selection {
+    Selection::new(args.estimators.as_deref(), args.testbeds.as_deref())
+}
+
+/// `registry` narrowed to `only`, printing a note for each test bed left out.
+fn selected(registry: &Registry, only: &Selection) -> Result<Registry> {
+    if only.is_all() {
+        return Ok(registry.clone());
+    }
+    let (narrowed, notes) = only.apply(registry)?;
+    for n in notes {
+        eprintln!("{n}");
+    }
+    Ok(narrowed)
 }
 
 /// `registry` reading stored references from `references`, or `<results>/references`.

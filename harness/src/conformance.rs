@@ -65,6 +65,8 @@ type Beds = Vec<(String, Box<dyn TestBed>)>;
 pub struct Conformance {
     stability: Beds,
     check: Beds,
+    /// Samplers the registry adds to the built-in ones ([`Registry::with_sampler`]).
+    samplers: Vec<&'static mcbench_core::SamplerEntry>,
 }
 
 impl Conformance {
@@ -90,33 +92,28 @@ impl Conformance {
                 into.push((format!("{}/{} {params:?}", entry.id, case.variant), bed));
             }
         }
-        Ok(Conformance { stability, check })
+        Ok(Conformance { stability, check, samplers: registry.samplers.clone() })
     }
 
     /// Runs every conformance check on one estimator and returns what failed.
     pub fn check(&self, entry: &EstimatorEntry) -> Vec<Failure> {
-        conformance_on(entry, &self.stability, &self.check)
+        conformance_on(entry, &self.stability, &self.check, &self.samplers)
     }
 }
 
 /// Every registered sampler's checks: (sampler id, failures as text).
 fn sampler_results() -> &'static Vec<(&'static str, Vec<String>)> {
     static RESULTS: OnceLock<Vec<(&'static str, Vec<String>)>> = OnceLock::new();
-    RESULTS.get_or_init(|| {
-        samplers::SAMPLERS
-            .par_iter()
-            .map(|s| {
-                let bad = (s.check)()
-                    .into_iter()
-                    .filter(|(_, c)| c.p_value.is_nan() || c.p_value <= sampler_alpha())
-                    .map(|(name, c)| {
-                        format!("{name}: chi-square {:.1} on {} dof, p = {:.2e}", c.statistic, c.dof, c.p_value)
-                    })
-                    .collect();
-                (s.id, bad)
-            })
-            .collect()
-    })
+    RESULTS.get_or_init(|| samplers::SAMPLERS.par_iter().map(|s| (s.id, sampler_failures(s))).collect())
+}
+
+/// The failed chi-square tests of one sampler, as text.
+fn sampler_failures(s: &mcbench_core::SamplerEntry) -> Vec<String> {
+    (s.check)()
+        .into_iter()
+        .filter(|(_, c)| c.p_value.is_nan() || c.p_value <= sampler_alpha())
+        .map(|(name, c)| format!("{name}: chi-square {:.1} on {} dof, p = {:.2e}", c.statistic, c.dof, c.p_value))
+        .collect()
 }
 
 /// Whether `est` runs on `bed` (static needs, dynamic support, validation).
@@ -232,7 +229,12 @@ fn independence<'a>(
     })
 }
 
-fn conformance_on(entry: &EstimatorEntry, stability: &Beds, unbiased: &Beds) -> Vec<Failure> {
+fn conformance_on(
+    entry: &EstimatorEntry,
+    stability: &Beds,
+    unbiased: &Beds,
+    own_samplers: &[&'static mcbench_core::SamplerEntry],
+) -> Vec<Failure> {
     let fail = |check, detail: String| Failure { estimator: entry.id.into(), check, detail };
     let est = match (entry.build)(&Params::new()) {
         Ok(e) => e,
@@ -277,9 +279,18 @@ fn conformance_on(entry: &EstimatorEntry, stability: &Beds, unbiased: &Beds) -> 
     }
     // 4. Samplers.
     for name in entry.samplers {
-        match sampler_results().iter().find(|(id, _)| id == name) {
-            None => out.push(fail("samplers", format!("names `{name}`, which is not in samplers::registry"))),
-            Some((_, bad)) => out.extend(bad.iter().map(|b| fail("samplers", format!("{name}: {b}")))),
+        let bad = match own_samplers.iter().find(|s| s.id == *name) {
+            Some(own) => Some(sampler_failures(own)),
+            None => sampler_results().iter().find(|(id, _)| id == name).map(|(_, bad)| bad.clone()),
+        };
+        match bad {
+            None => out.push(fail(
+                "samplers",
+                format!(
+                    "names `{name}`, which is neither in samplers::registry nor registered with Registry::with_sampler"
+                ),
+            )),
+            Some(bad) => out.extend(bad.iter().map(|b| fail("samplers", format!("{name}: {b}")))),
         }
     }
     // 5. Unbiasedness at a small budget.

@@ -23,6 +23,7 @@
 //! | [`analysis`] | metrics, slope fits, unbiasedness tests, speed-ups, claim checks, RMSE bands |
 //! | [`output`] | `summary.csv`/`summary.json`, `integrals.csv`, report, console, plots, HTML, listings |
 //! | [`unbiasedness`], [`calibration`], [`sensitivity`], [`conformance`] | the built-in experiments and the plug-in check |
+//! | [`registry`], [`plugins`], [`selection`] | names looked up, what a user's crate adds to built-in checks, the entries a run is limited to |
 //!
 //! ## Quick start: your own estimator, from your own crate
 //!
@@ -80,12 +81,15 @@ pub mod conformance;
 pub mod error;
 pub mod output;
 pub mod plan;
+pub mod plugins;
 pub mod registry;
 pub mod run;
+pub mod selection;
 pub mod sensitivity;
 pub mod store;
 pub mod unbiasedness;
 pub mod verdict;
+pub mod wording;
 
 /// The plug-in API (`mcbench-core`), for crates that depend on the harness alone.
 pub use mcbench_core;
@@ -94,13 +98,3 @@ pub use mcbench_core::{
     Needs, ParamSpec, Reference, Rgb, StreamRng, Task, TestBed, TestBedEntry,
 };
 pub use registry::{Experiment, Registry};
-
-/// The README's code blocks, compiled and run as doc tests.
-#[cfg(doctest)]
-#[doc = include_str!("../../README.md")]
-pub struct ReadmeDoctests;
-
-/// The Rust blocks of the book's plug-in chapter, compiled and run as doc tests.
-#[cfg(doctest)]
-#[doc = include_str!("../../docs/src/extending.md")]
-pub struct BookPluginDoctests;

@@ -25,10 +25,10 @@ use crate::plan::Plan;
 use crate::run::runner::RunResults;
 use crate::store::folder::OutputDir;
 use crate::store::references::ReferenceDir;
-use mcbench_core::entry::{EstimatorEntry, TestBedEntry};
+use mcbench_core::entry::{EstimatorEntry, Exemption, TestBedEntry};
 use mcbench_core::error::ConfigError;
-use mcbench_core::references::ReferenceSource;
-use mcbench_core::Catalog;
+use mcbench_core::references::{Chain, ReferenceKey, ReferenceSource, StoredReference};
+use mcbench_core::{Catalog, SamplerEntry};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -117,13 +117,21 @@ impl std::fmt::Debug for Experiment {
 /// Estimators, test beds and experiments by name, and where stored references are found.
 #[derive(Clone)]
 pub struct Registry {
-    estimators: Vec<&'static EstimatorEntry>,
-    test_beds: Vec<&'static TestBedEntry>,
+    pub(crate) estimators: Vec<&'static EstimatorEntry>,
+    pub(crate) test_beds: Vec<&'static TestBedEntry>,
     experiments: Vec<Experiment>,
     /// Names of experiments that run only when named (not in the default suite).
     on_demand: Vec<String>,
     references: Arc<dyn ReferenceSource>,
+    /// The references the catalogs ship, asked after `references`.
+    built_in: Vec<&'static dyn ReferenceSource>,
+    /// `references`, then `built_in`.
+    chain: Chain,
     display_names: DisplayNames,
+    /// Exemptions of controls added by the crate that registers them ([`crate::plugins`]).
+    pub(crate) exemptions: Vec<(&'static str, Exemption)>,
+    /// Samplers added by the crate that registers them ([`crate::plugins`]).
+    pub(crate) samplers: Vec<&'static SamplerEntry>,
 }
 
 impl Default for Registry {
@@ -134,7 +142,11 @@ impl Default for Registry {
             experiments: Vec::new(),
             on_demand: Vec::new(),
             references: Arc::new(ReferenceDir::new(DEFAULT_REFERENCES)),
+            built_in: Vec::new(),
+            chain: Chain(vec![Arc::new(ReferenceDir::new(DEFAULT_REFERENCES))]),
             display_names: DisplayNames::NONE,
+            exemptions: Vec::new(),
+            samplers: Vec::new(),
         }
     }
 }
@@ -174,6 +186,13 @@ impl Registry {
     pub fn with_catalog(mut self, catalog: Catalog) -> Self {
         self.estimators.extend(catalog.estimators);
         self.test_beds.extend(catalog.testbeds);
+        self.built_in.extend(catalog.references);
+        self.rechain()
+    }
+
+    fn rechain(mut self) -> Self {
+        let built_in = self.built_in.iter().map(|s| Arc::new(BuiltIn(*s)) as Arc<dyn ReferenceSource>);
+        self.chain = Chain(std::iter::once(self.references.clone()).chain(built_in).collect());
         self
     }
 
@@ -184,15 +203,17 @@ impl Registry {
         self
     }
 
-    /// Looks stored references up in `source` (for example a [`ReferenceDir`]).
+    /// Looks stored references up in `source` (for example a [`ReferenceDir`]) first, then in
+    /// those the catalogs ship ([`Catalog::with_references`]).
     pub fn with_references(mut self, source: impl ReferenceSource + 'static) -> Self {
         self.references = Arc::new(source);
-        self
+        self.rechain()
     }
 
-    /// Where test beds find stored references.
+    /// Where test beds find stored references: the source of [`Registry::with_references`],
+    /// then the catalogs' own.
     pub fn references(&self) -> &dyn ReferenceSource {
-        self.references.as_ref()
+        &self.chain
     }
 
     /// Names estimators and test beds in plots' legends and titles with `names` (a suite's
@@ -295,6 +316,18 @@ impl Registry {
             .iter()
             .find(|e| e.name == name)
             .ok_or_else(|| ConfigError::unknown("experiment", name, self.experiments.iter().map(|e| e.name.as_str())))
+    }
+}
+
+/// A `'static` source as an owned one (for the chain).
+struct BuiltIn(&'static dyn ReferenceSource);
+
+impl ReferenceSource for BuiltIn {
+    fn stored(&self, key: &ReferenceKey) -> std::result::Result<Option<StoredReference>, ConfigError> {
+        self.0.stored(key)
+    }
+    fn location(&self) -> String {
+        self.0.location()
     }
 }
 

@@ -20,7 +20,7 @@ fn bed(variant: &str) -> Box<dyn TestBed> {
         .with("env_width", 64.0)
         .with("env_height", 32.0)
         .with("sun", 200.0);
-    (builtins::testbed("envmap-sequence").unwrap().build)(variant, &p, &crate::repository::Repository).unwrap()
+    (builtins::testbed("envmap-sequence").unwrap().build)(variant, &p, &crate::built_in_references::BUILT_IN).unwrap()
 }
 
 /// Smallest Holm-adjusted p-value of an estimator's per-integral t-tests over `reps` runs.
@@ -179,7 +179,8 @@ fn stable_under_a_1e6_sun_and_30_degree_rotations() {
         .with("sun", 1e5)
         .with("rotation", 30.0);
     let b =
-        (builtins::testbed("envmap-sequence").unwrap().build)("specular", &p, &crate::repository::Repository).unwrap();
+        (builtins::testbed("envmap-sequence").unwrap().build)("specular", &p, &crate::built_in_references::BUILT_IN)
+            .unwrap();
     for id in ["bidirectional_is", "smc", "smc_bridge", "smc_path", "smc_adaptive"] {
         let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
         for rep in 0..20 {
@@ -189,7 +190,8 @@ fn stable_under_a_1e6_sun_and_30_degree_rotations() {
         }
     }
     let mixed =
-        (builtins::testbed("envmap-sequence").unwrap().build)("mixed", &p, &crate::repository::Repository).unwrap();
+        (builtins::testbed("envmap-sequence").unwrap().build)("mixed", &p, &crate::built_in_references::BUILT_IN)
+            .unwrap();
     for (id, params) in [("bidirectional_is", Params::new()), ("smc", Params::new().with("moves", 2.0))] {
         let p = holm_p(mixed.as_ref(), id, params.with("candidates", 16.0), 4, 1500);
         eprintln!("stability (sun 1e5, 30 degrees a frame) {id}: Holm p = {p:e}");

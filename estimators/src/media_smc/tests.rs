@@ -12,8 +12,12 @@ use mcbench_core::stats::{holm_bonferroni, one_sample_t, Moments};
 use mcbench_core::testbed::{ReferenceKind, TestBed};
 
 fn bed(variant: &str, resolution: usize) -> GradientBox {
-    GradientBox::new(variant, &Params::new().with("resolution", resolution as f64), &crate::repository::Repository)
-        .unwrap()
+    GradientBox::new(
+        variant,
+        &Params::new().with("resolution", resolution as f64),
+        &crate::built_in_references::BUILT_IN,
+    )
+    .unwrap()
 }
 
 /// `reps` independent whole-image estimates of `id` at `spp`; per pixel and channel moments.
@@ -171,7 +175,7 @@ fn unbiased_against_stored_references_and_ray_marching_flagged() {
 #[test]
 fn optically_thick_box_is_finite_and_agrees_with_its_reference() {
     use mcbench_core::stats::welch;
-    let b = GradientBox::new("thick", &Params::new(), &crate::repository::Repository).unwrap();
+    let b = GradientBox::new("thick", &Params::new(), &crate::built_in_references::BUILT_IN).unwrap();
     let r = b.reference();
     let ReferenceKind::Stored { samples, .. } = r.kind else { panic!("stored") };
     for id in ["is0_cv0", "is1_cv2"] {

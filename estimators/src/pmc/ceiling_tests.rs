@@ -2,7 +2,7 @@
 //! constant combinations, and its value on the stored `checker-image` references.
 
 use super::*;
-use crate::repository::Repository;
+use crate::built_in_references::BUILT_IN;
 use crate::testbeds::checker_image::CheckerImage;
 use crate::testbeds::checker_image_reference::sample_variances;
 use mcbench_core::params::Params;
@@ -79,7 +79,7 @@ fn constant_initial_weights_cap_the_gain() {
 #[test]
 fn ceilings_on_the_stored_checker_image_references() {
     for variant in ["default", "occluded", "soft-shadow"] {
-        let bed = CheckerImage::new(variant, &Params::new(), &Repository).unwrap();
+        let bed = CheckerImage::new(variant, &Params::new(), &BUILT_IN).unwrap();
         let reference = mcbench_core::testbed::TestBed::reference(&bed);
         let variance = sample_variances(reference).unwrap();
         let luminance: Vec<f64> = reference.value.iter().map(|v| mcbench_core::perception::luminance(*v)).collect();

@@ -54,7 +54,7 @@ fn bed(variant: &str) -> Box<dyn TestBed> {
     (builtins::testbed("checker-direct").unwrap().build)(
         variant,
         &Params::new().with("resolution", 5.0),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .unwrap()
 }
@@ -126,9 +126,12 @@ fn pmc_evaluates_its_target_once_per_sample() {
             assert_eq!((c.target_evals, c.cache_ops), (per_sample * c.samples, 0), "{id} at {spp} spp");
         }
     }
-    let image =
-        (builtins::testbed("checker-image").unwrap().build)("default", &Params::new(), &crate::repository::Repository)
-            .unwrap();
+    let image = (builtins::testbed("checker-image").unwrap().build)(
+        "default",
+        &Params::new(),
+        &crate::built_in_references::BUILT_IN,
+    )
+    .unwrap();
     for (id, per_sample) in [("pmc_ip", 1), ("uniform_image", 0), ("threshold_image", 0)] {
         let est = (builtins::estimator(id).unwrap().build)(&Params::new()).unwrap();
         let tasks: Vec<Task<'_>> =

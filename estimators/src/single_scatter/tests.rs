@@ -27,7 +27,7 @@ fn build(id: &str, p: Params) -> Box<dyn Estimator> {
 }
 
 fn bed(params: Params) -> MediumBed {
-    MediumBed::new(Field::Eq21, "single-scatter", &params, &crate::repository::Repository).unwrap()
+    MediumBed::new(Field::Eq21, "single-scatter", &params, &crate::built_in_references::BUILT_IN).unwrap()
 }
 
 /// Per-pixel moments of `reps` estimates of `spp` primary rays each (pixels `pixels`).
@@ -88,7 +88,8 @@ fn unbiased_ids_pass_and_ray_marching_is_flagged() {
 /// fetch budgets make the ray count a stopping time; these budgets do not).
 #[test]
 fn unbiased_ids_pass_on_the_perlin_medium() {
-    let bed = MediumBed::new(Field::Perlin, "single-scatter", &Params::new(), &crate::repository::Repository).unwrap();
+    let bed =
+        MediumBed::new(Field::Perlin, "single-scatter", &Params::new(), &crate::built_in_references::BUILT_IN).unwrap();
     let pixels: Vec<usize> = (0..16).filter(|i| ![0, 3, 12, 15].contains(i)).collect();
     for (k, id) in IDS.iter().enumerate().skip(1) {
         let m = moments(&bed, build(id, Params::new()).as_ref(), &pixels, 300, 4, 500 + 50 * k as u64);
@@ -151,7 +152,7 @@ fn bad_input_is_refused_naming_the_field() {
         Field::Eq21,
         "single-scatter",
         &Params::new().with("resolution", 4.0).with("light_x", -2.5).with("light_z", 12.5),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .err()
     .map(|e| e.to_string())
@@ -161,7 +162,7 @@ fn bad_input_is_refused_naming_the_field() {
         Field::Eq21,
         "transmittance",
         &Params::new().with("light_x", 1.0),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .err()
     .map(|e| e.to_string());
@@ -194,13 +195,13 @@ fn supports_accepts_the_single_scatter_ids_only() {
         Field::Eq21,
         "transmittance",
         &Params::new().with("resolution", 2.0),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .unwrap();
     let checker = (builtins::testbed("checker-direct").unwrap().build)(
         "default",
         &Params::new().with("resolution", 2.0),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .unwrap();
     for entry in ESTIMATORS {

@@ -121,7 +121,7 @@ mod tests {
             Field::Eq21,
             "central-ray",
             &Params::new().with("points", 10.0),
-            &crate::repository::Repository,
+            &crate::built_in_references::BUILT_IN,
         )
         .unwrap();
         let z = mcbench_core::math::Vec3::Z;

@@ -236,10 +236,11 @@ mod tests {
         assert!(e.err().unwrap().to_string().contains("checker-image/nope"));
         // No reference is stored at resolution 7 (the error names the resolution, or the missing
         // file when no reference is stored at all).
-        let e = CheckerImage::new("default", &Params::new().with("resolution", 7.0), &crate::repository::Repository)
-            .err()
-            .unwrap()
-            .to_string();
+        let e =
+            CheckerImage::new("default", &Params::new().with("resolution", 7.0), &crate::built_in_references::BUILT_IN)
+                .err()
+                .unwrap()
+                .to_string();
         assert!(e.contains("resolution") || e.contains("checker-image_default.json"), "{e}");
     }
 }

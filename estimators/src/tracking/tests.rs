@@ -41,14 +41,18 @@ fn holm_p(bed: &MediumBed, est: &dyn Estimator, reps: usize, spp: u64, seed: u64
 /// coarse ray-marching control is flagged.
 #[test]
 fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
-    let eq21 =
-        MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 8.0), &crate::repository::Repository)
-            .unwrap();
+    let eq21 = MediumBed::new(
+        Field::Eq21,
+        "central-ray",
+        &Params::new().with("points", 8.0),
+        &crate::built_in_references::BUILT_IN,
+    )
+    .unwrap();
     let perlin = MediumBed::new(
         Field::Perlin,
         "central-ray",
         &Params::new().with("points", 4.0),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .unwrap();
     let s = |v: f64| Params::new().with("sigma_samp", v);
@@ -82,9 +86,13 @@ fn transmittance_estimators_are_unbiased_and_ray_marching_is_flagged() {
 /// run, naming the field; at run time an out-of-range r is refused, never silently used.
 #[test]
 fn invalid_terminating_configurations_are_refused() {
-    let bed =
-        MediumBed::new(Field::Eq21, "central-ray", &Params::new().with("points", 4.0), &crate::repository::Repository)
-            .unwrap();
+    let bed = MediumBed::new(
+        Field::Eq21,
+        "central-ray",
+        &Params::new().with("points", 4.0),
+        &crate::built_in_references::BUILT_IN,
+    )
+    .unwrap();
     let err = build("single_particle_terminating", Params::new().with("sigma_samp", 0.4))
         .validate(&bed)
         .unwrap_err()
@@ -159,7 +167,7 @@ fn stability_cases_are_finite() {
         Field::Eq21,
         "central-ray",
         &Params::new().with("points", 200.0),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .unwrap();
     for sigma in [1e-6, 1e6] {
@@ -171,7 +179,7 @@ fn stability_cases_are_finite() {
         Field::Eq21,
         "central-ray",
         &Params::new().with("points", 2.0).with("scale", 1500.0),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .unwrap();
     assert!(thick.reference().value[1][0] == 0.0 || thick.reference().value[1][0] < 1e-300);
@@ -184,7 +192,7 @@ fn stability_cases_are_finite() {
         Field::Eq21,
         "transmittance",
         &Params::new().with("resolution", 4.0),
-        &crate::repository::Repository,
+        &crate::built_in_references::BUILT_IN,
     )
     .unwrap();
     for id in ["ratio_tracking", "residual_ratio_tracking", "ray_marching", "delta_tracking"] {

@@ -72,7 +72,7 @@ mod tests {
             Field::Eq21,
             "central-ray",
             &Params::new().with("points", 4.0),
-            &crate::repository::Repository,
+            &crate::built_in_references::BUILT_IN,
         )
         .unwrap();
         let grid: Vec<f64> = (0..4).map(|k| bed.medium().unwrap().ray(k).length).collect();

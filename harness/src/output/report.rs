@@ -142,10 +142,10 @@ fn claim_row(c: &Claim) -> Vec<String> {
 }
 
 fn claims_section(out: &mut String, report: &RunReport, plots_dir: &Path, results_dir: &Path) {
-    heading(out, "Paper claims");
+    heading(out, crate::wording::claims_heading(&report.paper));
     let claims = &report.paper;
     if claims.is_empty() {
-        out.push_str("No paper claims for this experiment.\n");
+        out.push_str("No claims for this experiment.\n");
         return;
     }
     let link = table_link(plots_dir, results_dir, tables::CLAIMS_CSV);

@@ -76,10 +76,9 @@ fn pilot_of(sweep: &Sweep) -> Sweep {
 }
 
 /// Why a biased control `id` is not required to be flagged on `testbed/variant`, if its registry
-/// entry says so.
+/// entry or the registry says so ([`Registry::exemption`]).
 pub fn exemption(registry: &Registry, id: &str, testbed: &str, variant: &str) -> Option<&'static str> {
-    let entry = registry.estimator(id).ok()?;
-    entry.checks.exempt.iter().find(|e| e.covers(testbed, variant)).map(|e| e.reason)
+    registry.exemption(id, testbed, variant)
 }
 
 /// The plans of a part's sweep. A pair whose configuration is invalid on a test bed (the terminating

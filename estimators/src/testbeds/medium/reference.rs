@@ -200,7 +200,7 @@ mod tests {
                 field,
                 "central-ray",
                 &Params::new().with("points", 4.0),
-                &crate::repository::Repository,
+                &crate::built_in_references::BUILT_IN,
             )
             .unwrap();
             let (x, w) = gauss_legendre(20);
@@ -259,12 +259,12 @@ mod tests {
     /// bit for bit, and a build reads them; a stored one of another method is not used.
     #[test]
     fn stored_transmittance_references_are_the_computed_ones() {
-        use crate::repository::Repository;
+        use crate::built_in_references::BUILT_IN;
         use mcbench_core::references::{InMemory, NoReferences, ReferenceSource, StoredReference};
         for (variant, params) in [("central-ray", ("points", 8.0)), ("transmittance", ("resolution", 4.0))] {
             let p = Params::new().with(params.0, params.1);
             let bare = MediumBed::without_reference(Field::Perlin, variant, &p).unwrap();
-            let stored = Repository.stored(&bare.reference_key()).unwrap().expect("stored in results/references");
+            let stored = BUILT_IN.stored(&bare.reference_key()).unwrap().expect("built in");
             let computed = transmittance_reference(&bare);
             assert_eq!(stored.reference, computed, "{variant}");
             assert_eq!(MediumBed::new(Field::Perlin, variant, &p, &NoReferences).unwrap().reference, computed);

@@ -116,7 +116,7 @@ fn perlin_settings_are_within_their_bound_on_a_short_segment() {
 #[test]
 fn perlin_default_reference_is_stored_with_the_current_settings() {
     let bed = MediumBed::without_reference(Field::Perlin, "single-scatter", &Params::new()).unwrap();
-    let r = load_stored(&bed, &crate::repository::Repository)
+    let r = load_stored(&bed, &crate::built_in_references::BUILT_IN)
         .unwrap()
         .expect("results/references/perlin-medium_single-scatter.json");
     let ReferenceKind::Exact { bound, .. } = r.kind else { panic!("not exact") };

@@ -238,7 +238,7 @@ pub fn render_root(root: &Path) -> String {
         if let Entry::Read(o) = e {
             let _ = writeln!(body, "<h2 id=\"{}\">{}</h2>", esc(name), page_link(name, &root.join(name)));
             let claims = claims_table(o);
-            body.push_str(if claims.is_empty() { "<p class=\"muted\">No paper claims.</p>\n" } else { &claims });
+            body.push_str(if claims.is_empty() { "<p class=\"muted\">No claims.</p>\n" } else { &claims });
         }
     }
     let nav: Vec<(String, String)> = found.iter().map(|(n, _)| (format!("#{}", url(n)), n.clone())).collect();

@@ -118,9 +118,9 @@ fn meta(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
 }
 
 fn claims(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
-    b.push_str("<h2 id=\"claims\">Paper claims</h2>\n");
+    b.push_str(&format!("<h2 id=\"claims\">{}</h2>\n", crate::wording::claims_heading(&report.paper)));
     if report.paper.is_empty() {
-        b.push_str("<p class=\"muted\">No paper claims for this experiment.</p>\n");
+        b.push_str("<p class=\"muted\">No claims for this experiment.</p>\n");
         return;
     }
     let counts = count_badges(&digest::claim_counts(&report.paper));
