@@ -11,7 +11,7 @@ use mcbench::run::runner::{self, RunOptions, Silent};
 use mcbench_core::budget::Budget;
 use mcbench_core::params::Params;
 
-const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
+const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../estimators/references");
 
 fn registry() -> &'static mcbench::Registry {
     static REGISTRY: std::sync::OnceLock<mcbench::Registry> = std::sync::OnceLock::new();

@@ -111,7 +111,7 @@ fn registry() -> &'static mcbench::Registry {
     REGISTRY.get_or_init(|| {
         experiments::registry().with_references(mcbench::store::references::ReferenceDir::new(concat!(
             env!("CARGO_MANIFEST_DIR"),
-            "/../results/references"
+            "/../estimators/references"
         )))
     })
 }

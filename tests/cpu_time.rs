@@ -75,7 +75,7 @@ fn registry() -> &'static Registry {
         experiments::registry().with_estimator(&SLEEPER).with_estimator(&SPINNER).with_references(
             mcbench::store::references::ReferenceDir::new(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/../results/references"
+                "/../estimators/references"
             )),
         )
     })

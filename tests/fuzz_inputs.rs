@@ -317,7 +317,7 @@ fn edited_manifests_never_panic_and_fail_in_one_line() {
 /// that their squares, which the metrics sum, stay finite.
 #[test]
 fn edited_references_never_panic_and_pass_only_when_well_formed() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/references/gradient-box_albedo-0.8.json");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../estimators/references/gradient-box_albedo-0.8.json");
     let original = std::fs::read_to_string(path).expect("stored reference");
     runner(300)
         .run(&edits(), |edits| {
@@ -344,7 +344,7 @@ fn edited_references_never_panic_and_pass_only_when_well_formed() {
 }
 
 /// The repository's stored references.
-const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
+const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../estimators/references");
 
 /// The registry of the `mcbench` binary (built-in plug-ins and the paper suite), reading the
 /// repository's stored references.

@@ -281,7 +281,7 @@ fn a_fetch_budget_buys_a_fixed_calibrated_number_of_rays() {
 }
 
 /// The repository's stored references.
-const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
+const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../estimators/references");
 
 /// The registry of the `mcbench` binary (built-in plug-ins and the paper suite), reading the
 /// repository's stored references.

@@ -200,7 +200,7 @@ fn stored_references_that_break_a_metric_are_refused() {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = dir.path();
     let name = "gradient-box_albedo-0.8.json";
-    let stored = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references/gradient-box_albedo-0.8.json");
+    let stored = concat!(env!("CARGO_MANIFEST_DIR"), "/../estimators/references/gradient-box_albedo-0.8.json");
     let original: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(stored).expect("stored")).expect("json");
     std::fs::create_dir(d.join("refs")).expect("refs");

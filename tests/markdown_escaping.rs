@@ -23,7 +23,7 @@ static HOSTILE: EstimatorEntry = EstimatorEntry {
 /// The repository's stored reference of `gradient-box/albedo-0.8` with both tags in its command.
 fn planted_references(dir: &Path) -> PathBuf {
     let name = "gradient-box_albedo-0.8.json";
-    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/references").join(name);
+    let source = Path::new(env!("CARGO_MANIFEST_DIR")).join("../estimators/references").join(name);
     let mut v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(source).expect("stored reference")).expect("json");
     let command = format!("mcbench reference {SCRIPT} | {IMG}");

@@ -98,4 +98,4 @@ fn first_estimates_are_pinned() {
 }
 
 /// The repository's stored references.
-const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
+const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../estimators/references");

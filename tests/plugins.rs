@@ -66,7 +66,7 @@ static THROW_AWAY: EstimatorEntry = EstimatorEntry {
 
 fn registry() -> Registry {
     Registry::new().with_catalog(mcbench_papers::catalog()).with_estimator(&THROW_AWAY).with_references(
-        mcbench::store::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+        mcbench::store::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../estimators/references")),
     )
 }
 

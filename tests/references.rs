@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 /// The repository's stored references.
-const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references");
+const REFERENCES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../estimators/references");
 
 /// Runs the copied binary. A freshly written executable can be "busy" for a moment when another
 /// test thread forked while its file was open for writing (ETXTBSY): retried, not failed.

@@ -143,7 +143,7 @@ fn runs_write_and_print_nothing_that_cites_an_outside_document() {
     run("plot", &["plot", "results/tiny", "--plots", "redrawn"]);
     // The conformance suite builds every test bed's cases, some from stored references: a copy of
     // the repository's, so that nothing is written beside the originals.
-    let stored = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/references");
+    let stored = Path::new(env!("CARGO_MANIFEST_DIR")).join("../estimators/references");
     std::fs::create_dir(d.join("stored")).expect("mkdir");
     for f in std::fs::read_dir(&stored).expect("the repository's references") {
         let f = f.expect("entry").path();

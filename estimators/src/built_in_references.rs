@@ -1,67 +1,67 @@
 //! The stored references of the built-in test beds, compiled into the crate ([`BUILT_IN`]): a
 //! binary finds them without any folder, and a run's `--references` folder, asked first, overrides
-//! them. The files are the repository's `results/references` (made by `mcbench reference`).
+//! them. The files are the package's `references/` folder (made by `mcbench reference ... --references estimators/references`).
 
 use mcbench_core::error::ConfigError;
 use mcbench_core::references::{ReferenceKey, ReferenceSource, StoredReference};
 
 /// Every stored reference of the built-in test beds: (file name, contents).
 static FILES: &[(&str, &str)] = &[
-    ("checker-image_default.json", include_str!("../../results/references/checker-image_default.json")),
-    ("checker-image_occluded.json", include_str!("../../results/references/checker-image_occluded.json")),
-    ("checker-image_soft-shadow.json", include_str!("../../results/references/checker-image_soft-shadow.json")),
+    ("checker-image_default.json", include_str!("../references/checker-image_default.json")),
+    ("checker-image_occluded.json", include_str!("../references/checker-image_occluded.json")),
+    ("checker-image_soft-shadow.json", include_str!("../references/checker-image_soft-shadow.json")),
     (
         "envmap-sequence_mixed-lns_0b5d04e5a1dff920.json",
-        include_str!("../../results/references/envmap-sequence_mixed-lns_0b5d04e5a1dff920.json"),
+        include_str!("../references/envmap-sequence_mixed-lns_0b5d04e5a1dff920.json"),
     ),
     (
         "envmap-sequence_mixed_0b5d04e5a1dff920.json",
-        include_str!("../../results/references/envmap-sequence_mixed_0b5d04e5a1dff920.json"),
+        include_str!("../references/envmap-sequence_mixed_0b5d04e5a1dff920.json"),
     ),
     (
         "envmap-sequence_specular_0b5d04e5a1dff920.json",
-        include_str!("../../results/references/envmap-sequence_specular_0b5d04e5a1dff920.json"),
+        include_str!("../references/envmap-sequence_specular_0b5d04e5a1dff920.json"),
     ),
-    ("eq21-medium_multiple.json", include_str!("../../results/references/eq21-medium_multiple.json")),
+    ("eq21-medium_multiple.json", include_str!("../references/eq21-medium_multiple.json")),
     (
         "eq21-medium_multiple_36cb30862c5be2b5.json",
-        include_str!("../../results/references/eq21-medium_multiple_36cb30862c5be2b5.json"),
+        include_str!("../references/eq21-medium_multiple_36cb30862c5be2b5.json"),
     ),
-    ("gradient-box_albedo-0.5.json", include_str!("../../results/references/gradient-box_albedo-0.5.json")),
-    ("gradient-box_albedo-0.8.json", include_str!("../../results/references/gradient-box_albedo-0.8.json")),
+    ("gradient-box_albedo-0.5.json", include_str!("../references/gradient-box_albedo-0.5.json")),
+    ("gradient-box_albedo-0.8.json", include_str!("../references/gradient-box_albedo-0.8.json")),
     (
         "gradient-box_albedo-0.8_00b40f450a505d61.json",
-        include_str!("../../results/references/gradient-box_albedo-0.8_00b40f450a505d61.json"),
+        include_str!("../references/gradient-box_albedo-0.8_00b40f450a505d61.json"),
     ),
     (
         "gradient-box_albedo-0.8_2a5d4e544549f584.json",
-        include_str!("../../results/references/gradient-box_albedo-0.8_2a5d4e544549f584.json"),
+        include_str!("../references/gradient-box_albedo-0.8_2a5d4e544549f584.json"),
     ),
     (
         "gradient-box_albedo-0.8_532d035989ee24ee.json",
-        include_str!("../../results/references/gradient-box_albedo-0.8_532d035989ee24ee.json"),
+        include_str!("../references/gradient-box_albedo-0.8_532d035989ee24ee.json"),
     ),
     (
         "gradient-box_albedo-0.8_6515b232c52478b9.json",
-        include_str!("../../results/references/gradient-box_albedo-0.8_6515b232c52478b9.json"),
+        include_str!("../references/gradient-box_albedo-0.8_6515b232c52478b9.json"),
     ),
     (
         "gradient-box_albedo-0.8_e83e002a82f860b1.json",
-        include_str!("../../results/references/gradient-box_albedo-0.8_e83e002a82f860b1.json"),
+        include_str!("../references/gradient-box_albedo-0.8_e83e002a82f860b1.json"),
     ),
-    ("gradient-box_albedo-1.json", include_str!("../../results/references/gradient-box_albedo-1.json")),
-    ("gradient-box_hg-0.1.json", include_str!("../../results/references/gradient-box_hg-0.1.json")),
-    ("gradient-box_thick.json", include_str!("../../results/references/gradient-box_thick.json")),
+    ("gradient-box_albedo-1.json", include_str!("../references/gradient-box_albedo-1.json")),
+    ("gradient-box_hg-0.1.json", include_str!("../references/gradient-box_hg-0.1.json")),
+    ("gradient-box_thick.json", include_str!("../references/gradient-box_thick.json")),
     (
         "perlin-medium_central-ray_64684c84ff0fed7a.json",
-        include_str!("../../results/references/perlin-medium_central-ray_64684c84ff0fed7a.json"),
+        include_str!("../references/perlin-medium_central-ray_64684c84ff0fed7a.json"),
     ),
-    ("perlin-medium_multiple.json", include_str!("../../results/references/perlin-medium_multiple.json")),
-    ("perlin-medium_single-scatter.json", include_str!("../../results/references/perlin-medium_single-scatter.json")),
-    ("perlin-medium_transmittance.json", include_str!("../../results/references/perlin-medium_transmittance.json")),
+    ("perlin-medium_multiple.json", include_str!("../references/perlin-medium_multiple.json")),
+    ("perlin-medium_single-scatter.json", include_str!("../references/perlin-medium_single-scatter.json")),
+    ("perlin-medium_transmittance.json", include_str!("../references/perlin-medium_transmittance.json")),
     (
         "perlin-medium_transmittance_62726640a84e7326.json",
-        include_str!("../../results/references/perlin-medium_transmittance_62726640a84e7326.json"),
+        include_str!("../references/perlin-medium_transmittance_62726640a84e7326.json"),
     ),
 ];
 
@@ -92,7 +92,7 @@ mod tests {
     /// each parses and is found by its own key.
     #[test]
     fn every_stored_reference_is_built_in_and_found_by_its_key() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../results/references");
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("references");
         let mut on_disk: Vec<String> = std::fs::read_dir(dir)
             .expect("the folder")
             .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())

@@ -126,7 +126,7 @@ pub fn registry() -> Registry {
 pub(crate) fn test_registry() -> Registry {
     registry().with_references(mcbench::store::references::ReferenceDir::new(concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../results/references"
+        "/../estimators/references"
     )))
 }
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Cross-check of the stored gradient-box references (results/references/gradient-box_*.json)
+"""Cross-check of the stored gradient-box references (estimators/references/gradient-box_*.json)
 against Mitsuba 3's `volpath`, a renderer that shares no code with mcbench.
 
 Not built or run by cargo. Setup as in mitsuba_gradient_box.py (a venv with mitsuba + numpy; the
@@ -88,7 +88,7 @@ def scene_dict(mi, variant, pixels, env_width):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--references", default="results/references")
+    ap.add_argument("--references", default="estimators/references")
     ap.add_argument("--variants", nargs="*", default=DEFAULT, choices=list(VARIANTS))
     ap.add_argument("--paths", type=int, default=1 << 20, help="Mitsuba camera paths per pixel")
     ap.add_argument("--passes", type=int, default=16)

@@ -11,7 +11,7 @@ OUT="${1:-/tmp/mcbench-load-verdicts}"
 BIN="${MCBENCH:-$ROOT/target/release/mcbench}"
 [ -x "$BIN" ] || (cd "$ROOT" && cargo build --release -q)
 rm -rf "$OUT" && mkdir -p "$OUT"
-suite() { "$BIN" --results "$OUT/$1/results" --plots "$OUT/$1/plots" --references "$ROOT/results/references" > "$OUT/$1.log" 2>&1; }
+suite() { "$BIN" --results "$OUT/$1/results" --plots "$OUT/$1/plots" --references "$ROOT/estimators/references" > "$OUT/$1.log" 2>&1; }
 
 start=$(date +%s); suite idle; echo "idle run: $(( $(date +%s) - start )) s"
 pids=()

@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 MCBENCH="${1:-target/release/mcbench}"
-REFS="${2:-results/references}"
+REFS="${2:-estimators/references}"
 for sigma_t in 0.125 0.25 0.5 1 4; do
     "$MCBENCH" reference gradient-box --variant albedo-0.8 --param "sigma_t=$sigma_t" --references "$REFS"
 done

@@ -175,7 +175,10 @@ mod tests {
     #[test]
     fn families_cover_the_controls_and_few_unbiased_estimators_per_case() {
         let registry = Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
-            crate::store::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+            crate::store::references::ReferenceDir::new(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../estimators/references"
+            )),
         );
         let all = families(&registry, Mode::Quick);
         let mut per_case = std::collections::HashMap::new();

@@ -120,7 +120,10 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
     let plan = Plan::prepare(
         sweep,
         &crate::registry::Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
-            crate::store::references::ReferenceDir::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../results/references")),
+            crate::store::references::ReferenceDir::new(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../estimators/references"
+            )),
         ),
     )
     .unwrap();

@@ -5,7 +5,7 @@
 //!   beds): one panel per crossing of a lattice plane of any octave (each
 //!   octave is a polynomial between crossings) and per kink of the clamp to [0, 1];
 //! - multiple scattering: stored long-run Monte Carlo with per-pixel standard errors in
-//!   `results/references/<id>_multiple.json`, made by `mcbench reference <id> --variant multiple`
+//!   `estimators/references/<id>_multiple.json`, made by `mcbench reference <id> --variant multiple`
 //!   ([`super::independent_reference`], which shares no code with the tracking estimators).
 
 use super::{clip_sphere, density, Field, MediumBed};

@@ -19,7 +19,7 @@
 //! Cost: Eq. 21 (smooth, 25 ns per fetch) takes about a millisecond per pixel, so its reference is
 //! computed when the test bed is built; the Perlin stack (0.5 us per fetch, features 1/512 wide)
 //! needs about 1e7 fetches per pixel, so its default reference ([`PERLIN_RESOLUTION`]) is stored in
-//! `results/references/perlin-medium_single-scatter.json` (made by
+//! `estimators/references/perlin-medium_single-scatter.json` (made by
 //! `mcbench reference perlin-medium --variant single-scatter`) and other settings compute theirs.
 
 use super::reference::optical_depth_with;

@@ -118,7 +118,7 @@ fn perlin_default_reference_is_stored_with_the_current_settings() {
     let bed = MediumBed::without_reference(Field::Perlin, "single-scatter", &Params::new()).unwrap();
     let r = load_stored(&bed, &crate::built_in_references::BUILT_IN)
         .unwrap()
-        .expect("results/references/perlin-medium_single-scatter.json");
+        .expect("estimators/references/perlin-medium_single-scatter.json");
     let ReferenceKind::Exact { bound, .. } = r.kind else { panic!("not exact") };
     let brightest = r.value.iter().map(|v| v[0]).fold(0.0f64, f64::max);
     assert!(brightest > 0.0 && bound <= 1e-3 * brightest, "bound {bound:e}, brightest {brightest}");
