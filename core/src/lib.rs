@@ -53,7 +53,7 @@ pub use entry::{
 pub use error::{ConfigError, EstimateError};
 pub use estimator::{Bias, EstimateMoments, Estimator};
 pub use math::{Frame, Rgb, Vec3};
-pub use params::{NoParams, ParamSet, ParamSpec, Params};
+pub use params::{NoParams, ParamSet, ParamSpec, ParamWords, Params};
 pub use references::{ReferenceKey, ReferenceSource, StoredReference};
 pub use rng::StreamRng;
 pub use samplers::registry::SamplerEntry;

@@ -123,7 +123,6 @@ pub struct Registry {
     /// Names of experiments that run only when named (not in the default suite).
     on_demand: Vec<String>,
     references: Arc<dyn ReferenceSource>,
-    display_names: DisplayNames,
 }
 
 impl Default for Registry {
@@ -134,7 +133,6 @@ impl Default for Registry {
             experiments: Vec::new(),
             on_demand: Vec::new(),
             references: Arc::new(ReferenceDir::new(DEFAULT_REFERENCES)),
-            display_names: DisplayNames::NONE,
         }
     }
 }
@@ -195,16 +193,10 @@ impl Registry {
         self.references.as_ref()
     }
 
-    /// Names estimators and test beds in plots' legends and titles with `names` (a suite's
-    /// vocabulary; ids and registered labels where it has none).
-    pub fn with_display_names(mut self, names: DisplayNames) -> Self {
-        self.display_names = names;
-        self
-    }
-
-    /// The display names of plots.
-    pub fn display_names(&self) -> &DisplayNames {
-        &self.display_names
+    /// The display names of plots' legends and titles: the registered entries' display names
+    /// (their labels and ids where they have none).
+    pub fn display_names(&self) -> DisplayNames<'_> {
+        DisplayNames::new(&self.estimators, &self.test_beds)
     }
 
     /// Adds an estimator.
