@@ -147,6 +147,11 @@ pub type ComputeReference =
     fn(&str, &Params, Option<u64>, usize) -> Result<(ReferenceKey, StoredReference), ConfigError>;
 
 impl TestBedEntry {
+    /// The name shown in titles and tables: [`ParamSpec::display`], else the id.
+    pub fn display_name(&self) -> &'static str {
+        self.params.display.unwrap_or(self.id)
+    }
+
     /// Builds a variant whose reference needs no stored file (closed forms and quadratures): `build`
     /// with [`crate::references::NoReferences`].
     pub fn build_exact(&self, variant: &str, params: &Params) -> Result<Box<dyn TestBed>, ConfigError> {
@@ -164,6 +169,11 @@ impl TestBedEntry {
 }
 
 impl EstimatorEntry {
+    /// The name shown in legends and tables: [`ParamSpec::display`], else the label.
+    pub fn display_name(&self) -> &'static str {
+        self.params.display.unwrap_or(self.label)
+    }
+
     /// Why this estimator cannot run on a test bed providing `provided`, if it cannot.
     pub fn skip_reason(&self, provided: Needs) -> Option<String> {
         self.needs.missing_from(provided).map(|m| format!("{} needs {m}, which the test bed does not provide", self.id))

@@ -57,7 +57,7 @@ pub use estimator::{Bias, EstimateMoments, Estimator};
 pub use integrand::{Domain, Integrand};
 pub use integrand_bed::IntegrandBed;
 pub use math::{Frame, Rgb, Vec3};
-pub use params::{NoParams, ParamSet, ParamSpec, Params};
+pub use params::{NoParams, ParamSet, ParamSpec, ParamWords, Params};
 pub use references::{ReferenceKey, ReferenceSource, StoredReference};
 pub use rng::StreamRng;
 pub use samplers::registry::SamplerEntry;

@@ -203,22 +203,48 @@ pub fn resolve<P: ParamSet>(owner: &str, raw: &Params) -> Result<serde_json::Val
     serde_json::to_value(p).map_err(|e| ConfigError::invalid(owner, "parameters", e.to_string()))
 }
 
-/// What a registry entry says of its parameters: how to document and resolve them.
+/// Puts one parameter in words (`("bridges", "5")` -> "5 bridges"); `None` leaves it as
+/// `key = value`. A test bed's variant is handed over as the parameter `variant`.
+pub type ParamWords = fn(&str, &str) -> Option<String>;
+
+/// What a registry entry says of its parameters: how to document and resolve them, and how the
+/// entry is named in legends, titles and tables.
 #[derive(Clone, Copy)]
 pub struct ParamSpec {
     /// The documentation of each parameter ([`describe`]).
     pub describe: fn() -> Vec<ParamDoc>,
     /// The parameters with defaults filled in ([`resolve`]).
     pub resolve: fn(&str, &Params) -> Result<serde_json::Value, ConfigError>,
+    /// The name shown in legends, titles and tables ([`ParamSpec::display`]); `None`: the
+    /// entry's label (an estimator) or its id (a test bed).
+    pub display: Option<&'static str>,
+    /// Its parameters (or a test bed's variant) in words ([`ParamSpec::words`]); `None`: each
+    /// parameter as `key = value`, a variant as it is.
+    pub words: Option<ParamWords>,
 }
 
 impl ParamSpec {
     /// The spec of the typed parameters `P`.
     pub const fn of<P: ParamSet>() -> Self {
-        ParamSpec { describe: describe::<P>, resolve: resolve::<P> }
+        ParamSpec { describe: describe::<P>, resolve: resolve::<P>, display: None, words: None }
     }
     /// No parameters.
     pub const NONE: ParamSpec = ParamSpec::of::<NoParams>();
+
+    /// With the name shown in legends, titles and tables.
+    pub const fn display(self, name: &'static str) -> Self {
+        ParamSpec { display: Some(name), ..self }
+    }
+
+    /// With its parameters (or a test bed's variant) put in words.
+    pub const fn words(self, words: ParamWords) -> Self {
+        ParamSpec { words: Some(words), ..self }
+    }
+
+    /// One parameter in words: the entry's [`ParamWords`], else `key = value`.
+    pub fn word(&self, key: &str, value: &str) -> String {
+        self.words.and_then(|f| f(key, value)).unwrap_or_else(|| format!("{key} = {value}"))
+    }
 }
 
 #[cfg(test)]

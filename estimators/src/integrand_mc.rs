@@ -39,7 +39,7 @@ pub static MC: EstimatorEntry = EstimatorEntry {
         parse::<NoParams>("integrand_mc", p)?;
         Ok(Box::new(Plain { clamp: None }))
     },
-    params: ParamSpec::NONE,
+    params: ParamSpec::NONE.display("plain MC").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 
@@ -56,7 +56,7 @@ pub static ANTITHETIC: EstimatorEntry = EstimatorEntry {
         parse::<NoParams>("integrand_antithetic", p)?;
         Ok(Box::new(Antithetic))
     },
-    params: ParamSpec::NONE,
+    params: ParamSpec::NONE.display("antithetic MC").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 
@@ -70,7 +70,7 @@ pub static CLAMPED: EstimatorEntry = EstimatorEntry {
     samplers: SAMPLERS,
     summary: "biased control: plain MC with each contribution clamped at `clamp` x the estimate's mean (default 1.25)",
     build: |p| Ok(Box::new(Plain { clamp: Some(parse::<ClampParams>("integrand_clamped_mc", p)?.clamp) })),
-    params: ParamSpec::of::<ClampParams>(),
+    params: ParamSpec::of::<ClampParams>().display("clamped MC (biased control)").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

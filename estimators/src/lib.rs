@@ -27,5 +27,6 @@ pub mod single_scatter;
 pub mod surface_smc;
 pub mod testbeds;
 pub mod tracking;
+pub mod words;
 
 pub use builtins::catalog;

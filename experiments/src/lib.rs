@@ -18,7 +18,6 @@ pub mod envmap_smc_post;
 pub mod envmap_unbiasedness;
 pub mod media_smc;
 pub mod media_smc_post;
-pub mod names;
 pub mod particle_sweep;
 pub mod particle_sweep_post;
 pub mod pmc_hi;
@@ -117,7 +116,6 @@ pub fn registry() -> Registry {
         .fold(Registry::empty().with_catalog(mcbench_papers::catalog()), |r, s| r.with_experiment(s.experiment()))
         .with_experiment_on_demand(mcbench::calibration::experiment())
         .with_experiment_on_demand(sensitivity::experiment())
-        .with_display_names(names::DISPLAY)
 }
 
 /// The registry for the crate's own tests: [`registry`] reading the repository's stored

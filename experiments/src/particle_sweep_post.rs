@@ -44,7 +44,8 @@ fn model_of(name: &str) -> &str {
 
 /// Writes `fom.csv` and one FoM-vs-sigma_samp plot per medium.
 pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
-    let PostContext { report, out: results, plots, .. } = cx;
+    let PostContext { report, out: results, plots, registry, .. } = cx;
+    let names = registry.display_names();
     let rows: Vec<FomRow<'_>> = report
         .rows
         .iter()
@@ -67,7 +68,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
         let rows: Vec<&SummaryRow> = report.rows.iter().filter(|r| r.testbed == tb && r.budget == budget).collect();
         let mut series = Vec::new();
         for (style, model) in IDS.iter().enumerate() {
-            let name = crate::names::estimator(model).unwrap_or_else(|| model.to_string());
+            let name = names.named_estimator(model).unwrap_or_else(|| model.to_string());
             if *model == "delta_tracking" {
                 let f = rows.iter().find(|r| r.estimator == *model).and_then(|r| r.fom);
                 let points = f.map(|f| vec![(SIGMAS[0], f), (SIGMAS[SIGMAS.len() - 1], f)]).unwrap_or_default();
@@ -84,7 +85,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
             points.sort_by(|a, b| a.0.total_cmp(&b.0));
             series.push(Series::new(name, style, points));
         }
-        let bed = crate::names::testbed(tb, "multiple").unwrap_or_else(|| tb.to_string());
+        let bed = names.named_testbed(tb, "multiple").unwrap_or_else(|| tb.to_string());
         panels.push(Figure::new(
             bed,
             "sampling density σ_samp (max extinction = 1)",

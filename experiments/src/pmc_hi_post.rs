@@ -123,7 +123,8 @@ fn table2(report: &RunReport) -> Vec<Table2Row<'_>> {
 
 /// Writes `table2.csv`, `alpha_maps.csv` and the Fig. 7 maps.
 pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
-    let PostContext { plan, report, out: results, plots, .. } = cx;
+    let PostContext { plan, report, out: results, plots, registry, .. } = cx;
+    let names = registry.display_names();
     results.write_csv("table2.csv", &table2(report))?;
     let Some(est) = plan.estimators.iter().find(|e| e.name == "pmc_hi") else { return Ok(Vec::new()) };
     let budget = Budget::samples(FIG7_SPP).map_err(|e| HarnessError::write("fig7", e))?;
@@ -158,7 +159,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
                 alpha_cone: maps[3][i],
             });
         }
-        let heading = crate::names::testbed(&bed.spec.id, &bed.variant).unwrap_or_else(|| bed.label());
+        let heading = names.named_testbed(&bed.spec.id, &bed.variant).unwrap_or_else(|| bed.label());
         panels.extend(maps.into_iter().zip(WEIGHTS).enumerate().map(|(k, (values, (_, label)))| Map {
             heading: if k == 0 { heading.clone() } else { String::new() },
             label: label.into(),

@@ -178,7 +178,8 @@ fn one_run(plan: &Plan, bed: &PreparedBed, ip: &PmcIp, budget: u64) -> Result<(T
 
 /// Writes `table1.csv`, `pixels.csv` and the Fig. 4 maps; adds the reference-precision claims.
 pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
-    let PostContext { plan, results: run, report, out: results, plots, .. } = cx;
+    let PostContext { plan, results: run, report, out: results, plots, registry, .. } = cx;
+    let names = registry.display_names();
     results.write_csv("table1.csv", &table1(plan, report))?;
     report.paper.extend(mcbench::analysis::claims::reference_precision(plan, report));
     let budget = 10;
@@ -234,7 +235,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
             map(&format!("variance, PMC-IP {sched}"), var_p, variance),
             map(&format!("variance, uniform {budget} spp"), var_u, variance),
         ];
-        maps[0].heading = crate::names::testbed(&bed.spec.id, &bed.variant).unwrap_or_else(|| bed.label());
+        maps[0].heading = names.named_testbed(&bed.spec.id, &bed.variant).unwrap_or_else(|| bed.label());
         all.extend(maps);
     }
     results.write_csv("pixels.csv", &rows)?;

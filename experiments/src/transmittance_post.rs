@@ -44,7 +44,8 @@ struct BandRow {
 
 /// Writes `fig8_bands.csv` and the band plot, and adds the band agreement to the `paper` block.
 pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
-    let PostContext { report, out: results, plots, .. } = cx;
+    let PostContext { report, out: results, plots, registry, .. } = cx;
+    let names = registry.display_names();
     let Some((bed, grid)) = central_ray(POINTS) else { return Ok(Vec::new()) };
     let sigma = |t: f64| bed.extinction(Vec3::new(0.0, 0.0, t));
     let mut rows = Vec::new();
@@ -74,7 +75,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
             p_pts.push((s, v.sqrt() / t));
             m_pts.push((s, variance.sqrt() / t));
         }
-        let name = crate::names::estimator(&format!("{id}[sigma_samp={samp}]")).unwrap_or_else(|| id.to_string());
+        let name = names.named_estimator(&format!("{id}[sigma_samp={samp}]")).unwrap_or_else(|| id.to_string());
         series.push(Series::new(name, ci, m_pts));
         series.push(Series::new("", ci, p_pts).with_line(Line::Dashed).without_markers());
         report.paper.push(Claim {

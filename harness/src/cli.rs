@@ -492,7 +492,7 @@ fn plot(results_dir: &std::path::Path, plots: &std::path::Path, wait: bool, regi
     let dir = plots.join(&name);
     crate::store::folder::check_own_dir("--plots", &dir)?;
     let _lock = crate::store::folder::FolderLock::acquire(&dir, wait, &[])?;
-    execute::draw(&report, &dir, results_dir, registry.display_names())?;
+    execute::draw(&report, &dir, results_dir, &registry.display_names())?;
     println!("plots, report.md and index.html written to {}", dir.display());
     Ok(())
 }

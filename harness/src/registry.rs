@@ -127,7 +127,6 @@ pub struct Registry {
     built_in: Vec<&'static dyn ReferenceSource>,
     /// `references`, then `built_in`.
     chain: Chain,
-    display_names: DisplayNames,
     /// Exemptions of controls added by the crate that registers them ([`crate::plugins`]).
     pub(crate) exemptions: Vec<(&'static str, Exemption)>,
     /// Samplers added by the crate that registers them ([`crate::plugins`]).
@@ -144,7 +143,6 @@ impl Default for Registry {
             references: Arc::new(ReferenceDir::new(DEFAULT_REFERENCES)),
             built_in: Vec::new(),
             chain: Chain(vec![Arc::new(ReferenceDir::new(DEFAULT_REFERENCES))]),
-            display_names: DisplayNames::NONE,
             exemptions: Vec::new(),
             samplers: Vec::new(),
         }
@@ -216,16 +214,10 @@ impl Registry {
         &self.chain
     }
 
-    /// Names estimators and test beds in plots' legends and titles with `names` (a suite's
-    /// vocabulary; ids and registered labels where it has none).
-    pub fn with_display_names(mut self, names: DisplayNames) -> Self {
-        self.display_names = names;
-        self
-    }
-
-    /// The display names of plots.
-    pub fn display_names(&self) -> &DisplayNames {
-        &self.display_names
+    /// The display names of plots' legends and titles: the registered entries' display names
+    /// (their labels and ids where they have none).
+    pub fn display_names(&self) -> DisplayNames<'_> {
+        DisplayNames::new(&self.estimators, &self.test_beds)
     }
 
     /// Adds an estimator.

@@ -23,6 +23,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let p = parse::<BidirectionalParams>("bidirectional_is", p)?;
         Ok(Box::new(super::SmcEstimator(p.common().config("bidirectional_is", None)?)))
     },
-    params: ParamSpec::of::<BidirectionalParams>(),
+    params: ParamSpec::of::<BidirectionalParams>().display("bidirectional IS").words(crate::words::param),
     checks: Checks::DEFAULT,
 };

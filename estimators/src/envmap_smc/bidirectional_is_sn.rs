@@ -29,7 +29,9 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let p = parse::<BidirectionalSnParams>("bidirectional_is_sn", p)?;
         Ok(Box::new(BidirectionalSn(p.common().config("bidirectional_is_sn", None)?)))
     },
-    params: ParamSpec::of::<BidirectionalSnParams>(),
+    params: ParamSpec::of::<BidirectionalSnParams>()
+        .display("self-normalised SIR (biased control)")
+        .words(crate::words::param),
     // Five candidates: the self-normalisation bias shrinks like 1/M, so many would hide it; at two
     // (bias -56% on `specular`) the per-repetition sums are so skewed (4.5 against the pooled
     // test's limit 2.95 at 1500 repetitions) that no seed can test it; at five the bias is about

@@ -30,6 +30,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let config = p.common().config("smc", Some(transition))?;
         Ok(Box::new(super::SmcEstimator(super::engine::Config { recompute: p.recompute, ..config })))
     },
-    params: ParamSpec::of::<SmcParams>(),
+    params: ParamSpec::of::<SmcParams>().display("SMC, one distribution").words(crate::words::param),
     checks: Checks::DEFAULT,
 };

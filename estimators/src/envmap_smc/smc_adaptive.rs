@@ -26,6 +26,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let transition = Transition::Adaptive { cess: p.cess, max: p.max_bridges };
         Ok(Box::new(super::SmcEstimator(p.common().config("smc_adaptive", Some(transition))?)))
     },
-    params: ParamSpec::of::<SmcAdaptiveParams>(),
+    params: ParamSpec::of::<SmcAdaptiveParams>().display("SMC, adaptive bridges").words(crate::words::param),
     checks: Checks::DEFAULT,
 };

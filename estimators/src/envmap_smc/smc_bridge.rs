@@ -28,6 +28,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let config = p.common().config("smc_bridge", Some(transition))?;
         Ok(Box::new(super::SmcEstimator(super::engine::Config { recompute: p.recompute, ..config })))
     },
-    params: ParamSpec::of::<SmcBridgeParams>(),
+    params: ParamSpec::of::<SmcBridgeParams>().display("SMC, ratio").words(crate::words::param),
     checks: Checks::DEFAULT,
 };

@@ -23,7 +23,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         parse::<NoParams>("brdf_is0_cv0", p)?;
         Ok(Box::new(BrdfIs0Cv0))
     },
-    params: ParamSpec::NONE,
+    params: ParamSpec::NONE.display("BRDF sampling (IS0 CV0)").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

@@ -24,7 +24,9 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["uniform_hemisphere"],
     summary: "biased control: is0_cv0 with each sample clamped at `clamp` (default 2)",
     build: |p| Ok(Box::new(ClampedIs0Cv0 { clamp: parse::<ClampedParams>("clamped_is0_cv0", p)?.clamp })),
-    params: ParamSpec::of::<ClampedParams>(),
+    params: ParamSpec::of::<ClampedParams>()
+        .display("clamped independent MC (biased control)")
+        .words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

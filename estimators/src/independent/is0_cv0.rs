@@ -27,7 +27,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             medium: Box::new(crate::media_smc::PathTracer),
         }))
     },
-    params: ParamSpec::NONE,
+    params: ParamSpec::NONE.display("independent MC (papers' MCMC)").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

@@ -31,7 +31,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let est = MediaSmc::from_params(Sampling::Cache, ControlVariate::Bilinear, &p.octree());
         Ok(Box::new(est.ray_marching(p.step)))
     },
-    params: ParamSpec::of::<RmIs1Cv2Params>(),
+    params: ParamSpec::of::<RmIs1Cv2Params>().display("ray marching + IS1 CV2 (biased control)").words(crate::words::param),
     // A step of 4 (8 optical depths in the box, 4 to 8 steps across the spheres): at the default
     // 0.5 the bias on the spheres' `multiple` images is about 1%, below what their rows resolve.
     checks: Checks {

@@ -39,7 +39,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["brdf", "rect_light", "cone", "mixture"],
     summary: "PMC for hemispheric integrals: BRDF + per-light + cone mixture adapted per population (Eq. 7-9)",
     build: |p| Ok(Box::new(PmcHi::from_params(&parse::<PmcHiParams>("pmc_hi", p)?))),
-    params: ParamSpec::of::<PmcHiParams>(),
+    params: ParamSpec::of::<PmcHiParams>().display("PMC-HI").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 
@@ -53,7 +53,7 @@ pub static FEEDBACK: EstimatorEntry = EstimatorEntry {
     samplers: &["brdf", "rect_light", "cone", "mixture"],
     summary: "PMC-HI whose weights start from the previous image-plane pass (paper 003 §6.1)",
     build: |p| Ok(Box::new(PmcHi::from_params(&parse::<PmcHiFeedbackParams>("pmc_hi_feedback", p)?.into()))),
-    params: ParamSpec::of::<PmcHiFeedbackParams>(),
+    params: ParamSpec::of::<PmcHiFeedbackParams>().display("PMC-HI with feedback").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

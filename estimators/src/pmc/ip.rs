@@ -72,7 +72,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &[],
     summary: "PMC image-plane sampler: per-pixel mixture, alpha ∝ eps + sigma^2/tvi(L), DMS allocation (§4)",
     build: |p| Ok(Box::new(PmcIp::from_params(p)?)),
-    params: ParamSpec::of::<PmcIpParams>(),
+    params: ParamSpec::of::<PmcIpParams>().display("PMC-IP").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

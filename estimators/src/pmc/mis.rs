@@ -34,7 +34,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             other: Box::new(Mis { power: p.power }),
         }))
     },
-    params: ParamSpec::of::<MisParams>(),
+    params: ParamSpec::of::<MisParams>().display("MIS").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

@@ -34,7 +34,9 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let p = parse::<ThresholdImageParams>("threshold_image", p)?;
         Ok(Box::new(ThresholdImage { initial: p.initial, threshold: p.threshold }))
     },
-    params: ParamSpec::of::<ThresholdImageParams>(),
+    params: ParamSpec::of::<ThresholdImageParams>()
+        .display("threshold stopping (biased control)")
+        .words(crate::words::param),
     // Stopping at a relative standard error of 0.3: at 4 samples per pixel its bias on
     // `checker-image` is about +3.6% (default) and +1.1% (occluded), 1.5-1.8x what 128 repetitions
     // detect; at the default 0.1 it is smaller, and at 0.5 and above nearly every pixel stops at

@@ -26,7 +26,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         parse::<NoParams>("uniform_image", p)?;
         Ok(Box::new(UniformImage))
     },
-    params: ParamSpec::NONE,
+    params: ParamSpec::NONE.display("uniform image sampling").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

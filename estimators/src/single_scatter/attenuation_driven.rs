@@ -33,7 +33,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let p = parse::<ResidualParams>("attenuation_driven", p)?;
         Ok(Box::new(AttenuationDriven { cfg: ResidualRatioTracking::from_params(&p, "attenuation_driven")? }))
     },
-    params: ParamSpec::of::<ResidualParams>(),
+    params: ParamSpec::of::<ResidualParams>().display("attenuation-driven").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

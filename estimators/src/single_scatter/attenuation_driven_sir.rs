@@ -36,7 +36,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let cfg = ResidualRatioTracking::from_params(&p.residual(), "attenuation_driven_sir")?;
         Ok(Box::new(AttenuationDrivenSir { cfg, shadow_rays: p.shadow_rays }))
     },
-    params: ParamSpec::of::<AttenuationSirParams>(),
+    params: ParamSpec::of::<AttenuationSirParams>().display("attenuation-driven SIR").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

@@ -36,7 +36,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let cfg = ResidualRatioTracking::from_params(&p.residual(), "scattering_driven")?;
         Ok(Box::new(ScatteringDriven { cfg, points: p.points, floor: p.scatter_floor }))
     },
-    params: ParamSpec::of::<ScatteringDrivenParams>(),
+    params: ParamSpec::of::<ScatteringDrivenParams>().display("scattering-driven").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

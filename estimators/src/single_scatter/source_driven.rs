@@ -33,7 +33,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let cfg = ResidualRatioTracking::from_params(&p.residual(), "source_driven")?;
         Ok(Box::new(SourceDriven { cfg, points: p.points }))
     },
-    params: ParamSpec::of::<SourceDrivenParams>(),
+    params: ParamSpec::of::<SourceDrivenParams>().display("source-driven").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

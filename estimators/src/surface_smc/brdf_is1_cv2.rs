@@ -24,6 +24,8 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let p = parse::<SurfaceSmcParams>("brdf_is1_cv2", p)?;
         Ok(Box::new(SmcSurface::from_params(Sampling::BrdfTracked, ControlVariate::Bilinear, &p)))
     },
-    params: ParamSpec::of::<SurfaceSmcParams>(),
+    params: ParamSpec::of::<SurfaceSmcParams>()
+        .display("BRDF or IS1 CV2 by variance (SMC cache)")
+        .words(crate::words::param),
     checks: Checks::DEFAULT,
 };

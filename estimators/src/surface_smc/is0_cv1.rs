@@ -20,6 +20,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: uniform sampling, piecewise-constant control variate (cv1); on a medium, the octree of spherical caches (paper 000)",
     build: |p| build_surface_or_medium("is0_cv1", (Sampling::Uniform, MediaSampling::Uniform), ControlVariate::Constant, p),
-    params: ParamSpec::of::<CacheSmcParams>(),
+    params: ParamSpec::of::<CacheSmcParams>().display("IS0 CV1 (SMC cache)").words(crate::words::param),
     checks: Checks::DEFAULT,
 };

@@ -20,6 +20,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: uniform sampling, bilinear control variate (cv2); on a medium, the octree of spherical caches (paper 000)",
     build: |p| build_surface_or_medium("is0_cv2", (Sampling::Uniform, MediaSampling::Uniform), ControlVariate::Bilinear, p),
-    params: ParamSpec::of::<CacheSmcParams>(),
+    params: ParamSpec::of::<CacheSmcParams>().display("IS0 CV2 (SMC cache)").words(crate::words::param),
     checks: Checks::DEFAULT,
 };

@@ -20,6 +20,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: cache-PDF importance sampling, no control variate; on a medium, the octree of spherical caches (paper 000)",
     build: |p| build_surface_or_medium("is1_cv0", (Sampling::Cache, MediaSampling::Cache), ControlVariate::None, p),
-    params: ParamSpec::of::<CacheSmcParams>(),
+    params: ParamSpec::of::<CacheSmcParams>().display("IS1 CV0 (SMC cache)").words(crate::words::param),
     checks: Checks::DEFAULT,
 };

@@ -20,6 +20,6 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     samplers: &["uniform_hemisphere", "phase", "free_flight"],
     summary: "SMC cache: cache-PDF importance sampling, piecewise-constant control variate; on a medium, the octree of spherical caches (paper 000)",
     build: |p| build_surface_or_medium("is1_cv1", (Sampling::Cache, MediaSampling::Cache), ControlVariate::Constant, p),
-    params: ParamSpec::of::<CacheSmcParams>(),
+    params: ParamSpec::of::<CacheSmcParams>().display("IS1 CV1 (SMC cache)").words(crate::words::param),
     checks: Checks::DEFAULT,
 };

@@ -75,7 +75,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     summary: "T of [0, 1] through 7 analytic extinction profiles x 5 target T, closed-form references",
     build: |variant, params, _| Ok(Box::new(Canonical1d::new(variant, params)?)),
     compute_reference: None,
-    params: ParamSpec::of::<Canonical1dParams>(),
+    params: ParamSpec::of::<Canonical1dParams>().display("canonical 1D segment").words(crate::words::canonical_variant),
     cases: cases!("constant", "cosine", "gaussian", "hole", "linear-up", "linear-down", "step"),
 };
 

@@ -43,7 +43,9 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         "checkerboard of diffuse/glossy squares under two area lights, direct lighting (paper 003 Fig. 6, Table 2)",
     build: |variant, params, _| Ok(Box::new(CheckerDirect::new(variant, params)?)),
     compute_reference: None,
-    params: ParamSpec::of::<CheckerDirectParams>(),
+    params: ParamSpec::of::<CheckerDirectParams>()
+        .display("checker, direct lighting (paper 003 Fig. 6)")
+        .words(crate::words::variant),
     cases: &[
         BedCase { variant: "occluded", params: &[("resolution", 2.0)], role: CaseRole::Stability },
         BedCase { variant: "default", params: &[("resolution", 2.0)], role: CaseRole::Check },

@@ -46,7 +46,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     summary: "checker scene, pixel-footprint integrals; a pixel sample = jittered position + MIS with 8 light samples (paper 003 Table 1)",
     build: |variant, params, refs| Ok(Box::new(CheckerImage::new(variant, params, refs)?)),
     compute_reference: Some(super::checker_image_reference::compute_reference),
-    params: ParamSpec::of::<CheckerImageParams>(),
+    params: ParamSpec::of::<CheckerImageParams>().display("checker image (paper 003 Table 1)").words(crate::words::variant),
     cases: &[
         BedCase { variant: "default", params: &[], role: CaseRole::Check },
         BedCase { variant: "default", params: &[], role: IMAGE_PART },

@@ -6,6 +6,7 @@
 use mcbench_core::entry::{BedCase, TestBedEntry};
 use mcbench_core::integrand::{Domain, Integrand};
 use mcbench_core::integrand_bed::{self, IntegrandBed};
+use mcbench_core::params::ParamSpec;
 
 /// The integrand: exponent `n`.
 pub struct CosinePower {
@@ -43,7 +44,10 @@ const SMOOTH: [BedCase; 2] = integrand_bed::cases("smooth", 32);
 const STIFF: [BedCase; 2] = integrand_bed::cases("stiff", 512);
 
 /// Registry entry.
-pub static ENTRY: TestBedEntry = integrand_bed::entry::<CosinePower>(&[SMOOTH[0], SMOOTH[1], STIFF[0], STIFF[1]]);
+pub static ENTRY: TestBedEntry = TestBedEntry {
+    params: ParamSpec::NONE.display("cosine-power lobe on the hemisphere").words(crate::words::variant),
+    ..integrand_bed::entry::<CosinePower>(&[SMOOTH[0], SMOOTH[1], STIFF[0], STIFF[1]])
+};
 
 #[cfg(test)]
 mod tests {

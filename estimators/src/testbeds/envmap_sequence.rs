@@ -69,7 +69,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         "Phong sphere under a rotating HDR sky (`moving`: narrow bright lobes that move with it; `moving-wall`: and a wall that hides part of it), L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
     build: |variant, params, refs| Ok(Box::new(EnvmapSequence::with_references(variant, params, refs)?)),
     compute_reference: None,
-    params: ParamSpec::of::<EnvmapSequenceParams>(),
+    params: ParamSpec::of::<EnvmapSequenceParams>().display("environment-map sequence (paper 004)").words(crate::words::variant),
     cases: &[
         BedCase {
             variant: "mixed",

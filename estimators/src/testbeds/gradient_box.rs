@@ -43,7 +43,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     summary: "homogeneous box under a gradient sky, orthographic 16x16, stored MC reference (paper 000 §5)",
     build: |variant, params, refs| Ok(Box::new(GradientBox::new(variant, params, refs)?)),
     compute_reference: Some(super::gradient_box_independent::compute_reference),
-    params: ParamSpec::of::<GradientBoxParams>(),
+    params: ParamSpec::of::<GradientBoxParams>().display("gradient box (paper 000)").words(crate::words::variant),
     cases: &[
         BedCase { variant: "furnace", params: &[("resolution", 2.0)], role: CaseRole::Stability },
         BedCase { variant: "albedo-0", params: &[("resolution", 2.0)], role: CaseRole::Stability },

@@ -40,7 +40,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
     summary: "Phong plane under a gradient sky, pinhole 32x32, exact reference (paper 001 §5)",
     build: |variant, params, _| Ok(Box::new(GradientPlane::new(variant, params)?)),
     compute_reference: None,
-    params: ParamSpec::of::<GradientPlaneParams>(),
+    params: ParamSpec::of::<GradientPlaneParams>().display("gradient plane (paper 001)").words(crate::words::variant),
     cases: &[
         BedCase { variant: "stiff", params: &[("resolution", 2.0)], role: CaseRole::Stability },
         BedCase { variant: "default", params: &[("resolution", 2.0)], role: CaseRole::Check },

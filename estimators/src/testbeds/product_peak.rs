@@ -7,6 +7,7 @@
 use mcbench_core::entry::{BedCase, TestBedEntry};
 use mcbench_core::integrand::{Domain, Integrand};
 use mcbench_core::integrand_bed::{self, IntegrandBed};
+use mcbench_core::params::ParamSpec;
 
 /// The peak's centre `u`.
 pub const CENTRE: [f64; 3] = [0.3, 0.62, 0.45];
@@ -46,7 +47,10 @@ const SMOOTH: [BedCase; 2] = integrand_bed::cases("smooth", 32);
 const STIFF: [BedCase; 2] = integrand_bed::cases("stiff", 512);
 
 /// Registry entry.
-pub static ENTRY: TestBedEntry = integrand_bed::entry::<ProductPeak>(&[SMOOTH[0], SMOOTH[1], STIFF[0], STIFF[1]]);
+pub static ENTRY: TestBedEntry = TestBedEntry {
+    params: ParamSpec::NONE.display("Genz product peak on [0,1]^3").words(crate::words::variant),
+    ..integrand_bed::entry::<ProductPeak>(&[SMOOTH[0], SMOOTH[1], STIFF[0], STIFF[1]])
+};
 
 #[cfg(test)]
 mod tests {

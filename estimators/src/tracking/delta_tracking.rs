@@ -43,7 +43,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             }),
         }))
     },
-    params: ParamSpec::of::<SigmaSampParams>(),
+    params: ParamSpec::of::<SigmaSampParams>().display("delta tracking").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

@@ -37,7 +37,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let control = MainPart::from_control(p.control, "double_particle")?;
         Ok(Box::new(DoubleParticle { sigma_samp, control, spacing: p.explorer_spacing }))
     },
-    params: ParamSpec::of::<DoubleParticleParams>(),
+    params: ParamSpec::of::<DoubleParticleParams>().display("double particle").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

@@ -29,7 +29,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let p = parse::<SigmaSampParams>("ratio_tracking", p)?;
         Ok(Box::new(RatioTracking { sigma_samp: SigmaSamp::from_params(&p, "ratio_tracking", SigmaSamp::Majorant)? }))
     },
-    params: ParamSpec::of::<SigmaSampParams>(),
+    params: ParamSpec::of::<SigmaSampParams>().display("ratio tracking").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

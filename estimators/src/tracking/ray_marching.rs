@@ -45,7 +45,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
             other: Box::new(RayMarching { step, fixed_step }),
         }))
     },
-    params: ParamSpec::of::<RayMarchingParams>(),
+    params: ParamSpec::of::<RayMarchingParams>().display("ray marching (biased control)").words(crate::words::param),
     // A coarse step (4 steps on the 20-unit central ray) whose Jensen bias the checks can resolve;
     // the default step 0.9 is the paper's baseline, biased far below what they can see.
     checks: Checks {

@@ -35,7 +35,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
         let p = parse::<ResidualParams>("residual_ratio_tracking", p)?;
         Ok(Box::new(ResidualRatioTracking::from_params(&p, "residual_ratio_tracking")?))
     },
-    params: ParamSpec::of::<ResidualParams>(),
+    params: ParamSpec::of::<ResidualParams>().display("residual ratio tracking").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

@@ -30,7 +30,7 @@ pub static TERMINATING: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "single particle model, terminating (Eq. 9, 19): refuses r > 2/(a+1) or r < 0",
     build: |p| build(p, "single_particle_terminating", true),
-    params: ParamSpec::of::<SigmaSampParams>(),
+    params: ParamSpec::of::<SigmaSampParams>().display("single particle, terminating").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 
@@ -44,7 +44,7 @@ pub static NONTERMINATING: EstimatorEntry = EstimatorEntry {
     samplers: &["free_flight"],
     summary: "single particle model, non-terminating (Eq. 12, 20), any r",
     build: |p| build(p, "single_particle_nonterminating", false),
-    params: ParamSpec::of::<SigmaSampParams>(),
+    params: ParamSpec::of::<SigmaSampParams>().display("single particle, non-terminating").words(crate::words::param),
     checks: Checks::DEFAULT,
 };
 

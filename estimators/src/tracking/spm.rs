@@ -91,7 +91,7 @@ pub fn trace(
 }
 
 macro_rules! spm_entry {
-    ($name:ident, $id:literal, $label:literal, $mode:expr, $summary:literal) => {
+    ($name:ident, $id:literal, $label:literal, $display:literal, $mode:expr, $summary:literal) => {
         #[doc = concat!("`", $id, "` registry entry.")]
         pub static $name: EstimatorEntry = EstimatorEntry {
             id: $id,
@@ -102,7 +102,7 @@ macro_rules! spm_entry {
             samplers: &["free_flight", "phase"],
             summary: $summary,
             build: |p| Ok(Box::new(Spm { sigma_samp: parse::<SpmParams>($id, p)?.sigma_samp, mode: $mode })),
-            params: ParamSpec::of::<SpmParams>(),
+            params: ParamSpec::of::<SpmParams>().display($display).words(crate::words::param),
             checks: Checks::DEFAULT,
         };
     };
@@ -112,12 +112,14 @@ spm_entry!(
     TERMINATING,
     "spm_terminating",
     "SPM terminating",
+    "SPM terminating",
     SpmMode::Terminating,
     "particle tracing, terminating single particle model (Eq. 9)"
 );
 spm_entry!(
     NONTERMINATING,
     "spm_nonterminating",
+    "SPM non-terminating",
     "SPM non-terminating",
     SpmMode::NonTerminating,
     "particle tracing, non-terminating single particle model (Eq. 12)"
@@ -126,6 +128,7 @@ spm_entry!(
     ADAPTIVE,
     "spm_adaptive",
     "SPM adaptive (SimulateParticle)",
+    "SPM adaptive",
     SpmMode::Adaptive,
     "particle tracing, the paper's adaptive SimulateParticle"
 );

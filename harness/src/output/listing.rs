@@ -37,9 +37,18 @@ pub fn list(what: Option<What>, params: bool, registry: &Registry) -> String {
         let rows: Vec<Vec<String>> = registry
             .test_beds()
             .iter()
-            .map(|t| vec![t.id.into(), t.variants.join(", "), t.provides.to_string(), t.summary.into()])
+            .map(|t| {
+                vec![
+                    t.id.into(),
+                    t.variants.join(", "),
+                    t.provides.to_string(),
+                    t.summary.into(),
+                    t.display_name().into(),
+                ]
+            })
             .collect();
-        let _ = writeln!(out, "{}", markdown_table(&["test bed", "variants", "provides", "summary"], &rows));
+        let header = ["test bed", "variants", "provides", "summary", "display name"];
+        let _ = writeln!(out, "{}", markdown_table(&header, &rows));
         if params {
             for t in registry.test_beds() {
                 params_table(&mut out, t.id, &(t.params.describe)());
@@ -60,10 +69,11 @@ pub fn list(what: Option<What>, params: bool, registry: &Registry) -> String {
                     e.needs.to_string(),
                     on.join(", "),
                     e.summary.into(),
+                    e.display_name().into(),
                 ]
             })
             .collect();
-        let header = ["estimator", "paper", "claim", "needs", "runs on", "summary"];
+        let header = ["estimator", "paper", "claim", "needs", "runs on", "summary", "display name"];
         let _ = writeln!(out, "{}", markdown_table(&header, &rows));
         if params {
             for e in registry.estimators() {
@@ -92,5 +102,17 @@ mod tests {
         assert!(text.contains("### gradient-box") && text.contains("sigma_t"), "{text}");
         assert!(text.contains("Extinction of the box"), "{text}");
         assert!(!text.contains("| estimator |"));
+    }
+
+    #[test]
+    fn entries_are_listed_with_their_display_names() {
+        let text = list(None, false, &Registry::new().with_catalog(mcbench_papers::catalog()));
+        // The last cell of the row of `id`.
+        let last = |id: &str| {
+            let row = text.lines().find(|l| l.starts_with(&format!("| {id} "))).unwrap_or_default();
+            row.split('|').rev().nth(1).unwrap_or_default().trim().to_string()
+        };
+        assert_eq!(last("smc_path"), "SMC, path sampling", "{text}");
+        assert_eq!(last("gradient-box"), "gradient box (paper 000)", "{text}");
     }
 }

@@ -229,7 +229,7 @@ pub fn finish(
     crate::output::report::write_tables(&results, &report)?;
     results.commit(&run_id, None)?;
     if opts.plots {
-        draw_with(&report, &plots_dir, &results_dir, extra_plots, &integrals, opts.registry.display_names())?;
+        draw_with(&report, &plots_dir, &results_dir, extra_plots, &integrals, &opts.registry.display_names())?;
     }
     Ok(Outcome { report, results_dir, plots_dir })
 }

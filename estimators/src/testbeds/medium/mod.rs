@@ -47,7 +47,7 @@ pub static EQ21: TestBedEntry = TestBedEntry {
     summary: "paper 002 Eq. 21 medium in a sphere, Rayleigh, albedo 0.7: central ray T(s), transmittance image, multiple scattering, point-light single scattering",
     build: |v, p, refs| Ok(Box::new(MediumBed::new(Field::Eq21, v, p, refs)?)),
     compute_reference: Some(|v, p, n, t| independent_reference::compute_stored(Field::Eq21, v, p, n, t)),
-    params: ParamSpec::of::<params::MediumParams>(),
+    params: ParamSpec::of::<params::MediumParams>().display("Eq. 21 medium (paper 002)").words(crate::words::variant),
     cases: &[
         BedCase { variant: "transmittance", params: &[("resolution", 4.0)], role: CaseRole::Stability },
         BedCase { variant: "single-scatter", params: &[("resolution", 2.0)], role: CaseRole::Stability },
@@ -76,7 +76,7 @@ pub static PERLIN: TestBedEntry = TestBedEntry {
     summary: "12-octave Perlin fbm medium (max 1, mostly < 0.6), Rayleigh, albedo 0.9; cheap = first 3 octaves; same variants",
     build: |v, p, refs| Ok(Box::new(MediumBed::new(Field::Perlin, v, p, refs)?)),
     compute_reference: Some(|v, p, n, t| independent_reference::compute_stored(Field::Perlin, v, p, n, t)),
-    params: ParamSpec::of::<params::MediumParams>(),
+    params: ParamSpec::of::<params::MediumParams>().display("Perlin medium").words(crate::words::variant),
     cases: &[
         BedCase { variant: "central-ray", params: &[("points", 8.0)], role: TRACKING_PART },
         BedCase { variant: "transmittance", params: &[("resolution", 4.0)], role: TRACKING_PART },

@@ -185,13 +185,11 @@ fn one_figure_of_panels_per_test_bed_as_svg_and_png() {
     assert!(names.iter().all(|n| !n.starts_with('.')), "no temporary files left: {names:?}");
 }
 
-fn named(name: &str) -> Option<String> {
-    (name == "is1_cv2").then(|| "IS1 CV2 (SMC cache)".to_string())
-}
-
-fn bed(_: &str, _: &str) -> Option<String> {
-    Some("gradient plane (a test)".to_string())
-}
+/// The test bed under a display name of its own.
+static BED: mcbench_core::entry::TestBedEntry = mcbench_core::entry::TestBedEntry {
+    params: mcbench_core::ParamSpec::NONE.display("gradient plane (a test)"),
+    ..mcbench_papers::testbeds::gradient_plane::ENTRY
+};
 
 #[test]
 fn bands_display_names_and_the_same_bytes_twice() {
@@ -202,7 +200,9 @@ fn bands_display_names_and_the_same_bytes_twice() {
     for r in &mut report.rows {
         (r.rmse_lo, r.rmse_hi) = (Some(r.rmse * 0.8), Some(r.rmse * 1.25));
     }
-    let names = DisplayNames { estimator: Some(named), testbed: Some(bed) };
+    // Only `is1_cv2` is registered: `is0_cv0` is shown by its label.
+    let (estimators, testbeds) = ([&mcbench_papers::surface_smc::is1_cv2::ENTRY], [&BED]);
+    let names = DisplayNames::new(&estimators, &testbeds);
     let (a, b) = (tempfile::TempDir::new().unwrap(), tempfile::TempDir::new().unwrap());
     let files = write_plots_named(&report, a.path(), &names).unwrap();
     write_plots_named(&report, b.path(), &names).unwrap();
@@ -214,7 +214,7 @@ fn bands_display_names_and_the_same_bytes_twice() {
     assert!(svg.contains("surface-smc: gradient plane (a test)"), "the test bed's display name");
     assert!(svg.contains("IS1 CV2 (SMC cache): slope"), "the estimator's display name");
     assert!(svg.contains(", right end -0.90 ["), "four budgets: the slope over the last three");
-    assert!(svg.contains("MCMC (independent MC): slope"), "the registered label where the hook has none");
+    assert!(svg.contains("MCMC (independent MC): slope"), "the registered label of an estimator not registered");
     assert!(svg.contains("Shaded: 90%"), "the band's note");
     assert!(svg.contains("opacity=\"0.16\""), "a shaded band");
 }
