@@ -25,6 +25,7 @@ fn beds() -> Vec<(&'static str, &'static str, Params)> {
         ("gradient-box", "albedo-0.8", Params::new()),
         ("envmap-sequence", "mixed", Params::new().with("resolution", 2.0).with("frames", 2.0)),
         ("checker-image", "default", Params::new()),
+        ("product-peak", "smooth", Params::new()),
     ]
 }
 

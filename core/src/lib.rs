@@ -35,6 +35,7 @@ pub mod integrand_bed;
 pub mod lighting;
 pub mod math;
 pub mod memo;
+pub mod needs;
 pub mod parallel;
 pub mod params;
 pub mod perception;
