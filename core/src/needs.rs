@@ -10,7 +10,7 @@ pub struct Needs(u32);
 impl Needs {
     /// Nothing.
     pub const NONE: Needs = Needs(0);
-    /// Hemispherical surface integrals ([`HemisphereScene`]).
+    /// Hemispherical surface integrals ([`HemisphereScene`](crate::testbed::HemisphereScene)).
     pub const SURFACE: Needs = Needs(1);
     /// A participating medium (fetches are counted).
     pub const MEDIUM: Needs = Needs(2);
@@ -20,7 +20,7 @@ impl Needs {
     pub const ENV_SEQUENCE: Needs = Needs(8);
     /// Area lights that can be sampled.
     pub const AREA_LIGHTS: Needs = Needs(16);
-    /// Pixel integrals over the image plane, sampled at chosen positions ([`ImagePlaneScene`]).
+    /// Pixel integrals over the image plane, sampled at chosen positions ([`ImagePlaneScene`](crate::testbed::ImagePlaneScene)).
     pub const IMAGE_PLANE: Needs = Needs(32);
     /// A generic integrand on a named domain ([`crate::integrand::Integrand`]).
     pub const INTEGRAND: Needs = Needs(64);
