@@ -171,7 +171,8 @@ fn the_binary_compares_saves_and_uses_baselines_and_refuses_bad_input() {
     let mut keys: Vec<&str> = json.as_object().expect("an object").keys().map(String::as_str).collect();
     let doc = listed("compare.json");
     let mut want: Vec<&str> = doc.split(',').collect();
-    (keys.sort(), want.sort());
+    keys.sort();
+    want.sort();
     assert_eq!(keys, want, "compare.json's fields");
 
     // Bad input: exit 2, one line naming the field or file, nothing written.
@@ -199,7 +200,7 @@ fn listed(name: &str) -> String {
     let doc = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/src/contract.md"))
         .expect("chapter");
     let after = doc.split_once(&format!("<!-- contract: {name} -->")).expect("a marker").1;
-    after.lines().skip(2).next().expect("a list").to_string()
+    after.lines().nth(2).expect("a list").to_string()
 }
 
 /// Every path below `dir`, sorted.

@@ -29,7 +29,7 @@ pub fn check_margins(m: Margins) -> Result<()> {
         if !(v.is_finite() && v > 0.0 && v <= max) {
             let e = mcbench_core::error::ConfigError::invalid(
                 field,
-                &v.to_string(),
+                v.to_string(),
                 format!("must be above 0 and at most {max}"),
             );
             return Err(e.into());
