@@ -20,6 +20,7 @@ pub mod media_smc;
 pub mod media_smc_post;
 pub mod particle_sweep;
 pub mod particle_sweep_post;
+pub mod planted;
 pub mod pmc_hi;
 pub mod pmc_hi_post;
 pub mod pmc_ip;

@@ -1,4 +1,4 @@
-//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, and the
+//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, `compare`, and the
 //! default quick suite. Every subcommand exits by the one table of [`crate::error`]: bad input is
 //! one line on stderr naming the field or file, exit code 2, and nothing written; a results folder
 //! that another run holds is exit code 3 (or a wait, with `--wait`).
@@ -97,6 +97,31 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         references: Option<PathBuf>,
     },
+    /// Compare two runs: per cell, the change from A to B in RMSE, efficiency, FoM and slope with
+    /// 95% intervals and verdicts (improved, regressed, no change, inconclusive).
+    Compare {
+        /// A (the before): a results folder (a run's `--results` root or one experiment's folder)
+        /// or a baseline's name.
+        a: String,
+        /// B (the after): the same.
+        b: String,
+        /// Results root whose `baselines` folder holds named baselines.
+        #[arg(long, value_name = "DIR", default_value = "results")]
+        results: PathBuf,
+        /// Output folder (default: `<results>/compare/<A>-vs-<B>`).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// No change: RMSE ratios B / A with a 95% interval within [1/(1+M), 1+M] (efficiency and
+        /// FoM ratios within the square of that band).
+        #[arg(long, value_name = "M", default_value_t = crate::compare::change::DEFAULT_MARGIN, allow_negative_numbers = true)]
+        margin: f64,
+        /// No change: slope differences with a 95% interval within ±M.
+        #[arg(long, value_name = "M", default_value_t = crate::compare::change::DEFAULT_SLOPE_MARGIN, allow_negative_numbers = true)]
+        slope_margin: f64,
+        /// Exit 1 when a row regressed.
+        #[arg(long)]
+        fail_on_regression: bool,
+    },
     /// Redraw the plots and report of a results folder.
     Plot {
         /// A results folder holding summary.csv and summary.json of a finished run.
@@ -191,6 +216,13 @@ struct RunArgs {
     /// Only these test beds: ids or `*` globs, comma separated.
     #[arg(long, value_name = "LIST")]
     testbeds: Option<String>,
+    /// Also copy the run's results to the baseline NAME (`<results>/baselines/NAME`).
+    #[arg(long, value_name = "NAME")]
+    save_baseline: Option<String>,
+    /// Compare the run with the baseline NAME after it (`mcbench compare`; written to
+    /// `<results>/compare/NAME-vs-latest`).
+    #[arg(long, value_name = "NAME")]
+    baseline: Option<String>,
 }
 
 impl RunArgs {
@@ -298,6 +330,11 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             Ok(())
         }
+        Some(Command::Compare { a, b, results, out, margin, slope_margin, fail_on_regression }) => {
+            let margins = crate::compare::Margins { ratio: margin, slope: slope_margin };
+            let args = crate::compare::command::CompareArgs { a, b, results, out, margins, fail_on_regression };
+            crate::compare::command::compare_command(&args)
+        }
         Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait, registry),
         Some(Command::Conformance { estimators, estimator_list, testbeds, results, references }) => {
             let only = Selection::new(estimator_list.as_deref(), testbeds.as_deref()).with_estimator_ids(&estimators);
@@ -364,6 +401,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         registry,
         integrals: args.integrals,
     };
+    let baseline = baseline_checks(args)?;
     // Everything every experiment of the call will read is checked before the first one writes.
     let mut checked = Vec::new();
     for ((def, plan), t) in prepared.iter().zip(&mut times) {
@@ -373,6 +411,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         });
         t.add(&crate::run::phases::take());
     }
+    let mut written = Vec::new();
     let started = Instant::now();
     for (((def, plan), checked), t) in prepared.iter().zip(checked).zip(&mut times) {
         let t0 = Instant::now();
@@ -399,6 +438,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         crate::output::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
         println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
         println!("time: {}", t.line());
+        written.push(out.results_dir.clone());
     }
     println!("\ntotal wall time {:.1} s", started.elapsed().as_secs_f64());
     if args.shard.is_none() {
@@ -408,7 +448,32 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
             println!("HTML report (open in a browser): {}", args.plots.join("index.html").display());
         }
     }
+    if let Some(a) = &baseline {
+        crate::compare::command::against_baseline(&args.results, a, &written, Default::default())?;
+    }
+    if let Some(name) = &args.save_baseline {
+        let dir = crate::compare::baseline::save(&args.results, name, &written)?;
+        println!("baseline {name} saved: {}", dir.display());
+    }
     Ok(())
+}
+
+/// The checks of `--baseline` and `--save-baseline` before a run writes anything: the baseline
+/// read, the name and folders usable, and no shard (a shard is not a finished run).
+fn baseline_checks(args: &RunArgs) -> Result<Option<crate::compare::load::Side>> {
+    if args.shard.is_some() && (args.baseline.is_some() || args.save_baseline.is_some()) {
+        let flag = if args.baseline.is_some() { "--baseline" } else { "--save-baseline" };
+        return Err(mcbench_core::error::ConfigError::invalid(
+            flag,
+            "with --shard",
+            "needs a whole run: compare or save after `mcbench merge`",
+        )
+        .into());
+    }
+    if let Some(name) = &args.save_baseline {
+        crate::compare::baseline::check_save(&args.results, name)?;
+    }
+    args.baseline.as_deref().map(|n| crate::compare::command::check_baseline(&args.results, n)).transpose()
 }
 
 /// `e` naming the `--config` file when it is about a claim and the claims came from that file.

@@ -23,6 +23,7 @@
 //! | [`analysis`] | metrics, slope fits, unbiasedness tests, speed-ups, claim checks, RMSE bands |
 //! | [`output`] | `summary.csv`/`summary.json`, `integrals.csv`, report, console, plots, HTML, listings |
 //! | [`unbiasedness`], [`calibration`], [`sensitivity`], [`conformance`] | the built-in experiments and the plug-in check |
+//! | [`compare`] | two runs compared: changes with intervals and verdicts, baselines |
 //! | [`registry`], [`plugins`], [`selection`] | names looked up, what a user's crate adds to built-in checks, the entries a run is limited to |
 //!
 //! ## Quick start: your own estimator, from your own crate
@@ -76,6 +77,7 @@
 pub mod analysis;
 pub mod calibration;
 pub mod cli;
+pub mod compare;
 pub mod config;
 pub mod conformance;
 pub mod error;

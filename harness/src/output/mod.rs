@@ -170,6 +170,10 @@ pub struct RunReport {
     /// `cache_ops` columns of summary.csv; empty in files written before they were counted).
     #[serde(default)]
     pub counts: Vec<CellCounts>,
+    /// Per (test bed, variant), its parameters and a digest of its reference, so that runs can be
+    /// compared only on the same integrals (empty in files written before it).
+    #[serde(default)]
+    pub beds: Vec<crate::compare::fingerprint::BedPrint>,
 }
 
 /// The adaptive methods' counted operations of one cell, per estimate

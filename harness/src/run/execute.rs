@@ -203,6 +203,7 @@ pub fn finish(
         rows,
         labels: plan.estimators.iter().map(|e| (e.name.clone(), e.entry.label.to_string())).collect(),
         diagnostics,
+        beds: plan.beds.iter().map(crate::compare::fingerprint::BedPrint::of).collect(),
     };
     if let Some(claims) = def.and_then(|d| d.claims) {
         report.paper = claims(&report);

@@ -89,6 +89,7 @@ pub fn setting_report(plan: &Plan, run: &RunResults, like: &RunReport) -> RunRep
         rows,
         labels: plan.estimators.iter().map(|e| (e.name.clone(), e.entry.label.to_string())).collect(),
         diagnostics,
+        beds: like.beds.clone(),
     }
 }
 

@@ -244,11 +244,24 @@ pub fn log_ratio(
     seed: u64,
     stat: impl Fn(&CellSample<'_>, &CellSample<'_>, f64) -> Option<f64>,
 ) -> Option<Bootstrap> {
+    log_ratio_paired(a, b, seed, true, stat)
+}
+
+/// [`log_ratio`], resampling the two cells jointly only when `pair` is true and their layouts
+/// agree: cells of two independent runs (different seeds) share no random numbers, so their blocks
+/// `k` are not pairs and are resampled independently.
+pub fn log_ratio_paired(
+    a: &RowBlocks,
+    b: &RowBlocks,
+    seed: u64,
+    pair: bool,
+    stat: impl Fn(&CellSample<'_>, &CellSample<'_>, f64) -> Option<f64>,
+) -> Option<Bootstrap> {
     if !(a.usable() && b.usable()) {
         return None;
     }
     let (na, nb) = (a.blocks.len(), b.blocks.len());
-    let paired = a.layout() == b.layout();
+    let paired = pair && a.layout() == b.layout();
     let sample = |rows, s| CellSample { rows, sums: s };
     let all = |r: &RowBlocks| sums(&r.blocks, 0..r.blocks.len());
     let eval = |sa: Sums, sb: Sums, z: f64| stat(&sample(a, sa), &sample(b, sb), z).filter(|v| v.is_finite());

@@ -149,6 +149,7 @@ pub fn synthetic_report() -> RunReport {
             mean: 4096.0,
         }],
         counts: Vec::new(),
+        beds: Vec::new(),
     }
 }
 
