@@ -130,7 +130,7 @@ fn claims_of_a_config_are_checked_before_anything_is_written() {
     assert_bad_input(d, &args, "reshape.toml: invalid claims[0].estimator = no_such: names no estimator");
     // The same sweep with its claims right runs (and names them in its summary).
     std::fs::write(d.join("right.toml"), format!("{sweep}{good}{}", ratio("budget = 16\n"))).expect("write");
-    let o = mcbench(d, &["run", "--config", "right.toml", "--no-plots"]);
+    let o = mcbench(d, &["run", "--config", "right.toml", "--no-plots", "--verbose"]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("lower error"));
 }
@@ -216,6 +216,15 @@ fn a_custom_sweep_runs_end_to_end_and_plots_can_be_redrawn() {
     ] {
         assert!(d.join(f).is_file(), "{f} missing");
     }
+    // One screen: the experiment's line (claims and tests counted by verdict), the totals, what
+    // did not hold, and where the report is; the tables only with --verbose.
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    let line = out.lines().find(|l| l.starts_with("tiny ")).unwrap_or_else(|| panic!("no line for tiny:\n{out}"));
+    assert!(line.contains("claims ") && line.contains("tests ") && line.contains(" pass"), "{line}");
+    assert!(out.contains("HTML report (open in a browser): plots/index.html"), "{out}");
+    assert!(out.lines().count() <= 20 && !out.contains("clamped_is0_cv0[clamp=1.5]"), "{out}");
+    let o = mcbench(d, &["run", "--config", "tiny.toml", "--threads", "2", "--verbose"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(String::from_utf8_lossy(&o.stdout).contains("clamped_is0_cv0[clamp=1.5]"));
     std::fs::remove_dir_all(d.join("plots")).expect("rm");
     let o = mcbench(d, &["plot", "results/tiny"]);

@@ -77,6 +77,9 @@ enum Command {
         /// The per-integral file: gz (integrals.csv.gz), csv (plain integrals.csv) or none
         #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
         integrals: IntegralsFormat,
+        /// Print the merged run's tables, not only its one-line summary.
+        #[arg(long, short = 'v')]
+        verbose: bool,
     },
     /// Run the conformance suite on estimators (every registered one when none is named): builds,
     /// finite output on the stability cases, determinism, its samplers' chi-square tests, and
@@ -223,6 +226,10 @@ struct RunArgs {
     /// `<results>/compare/NAME-vs-latest`).
     #[arg(long, value_name = "NAME")]
     baseline: Option<String>,
+    /// Print every experiment's tables (fits, tests, claims, skipped pairs) and the time per
+    /// phase, not only its one-line summary.
+    #[arg(long, short = 'v')]
+    verbose: bool,
 }
 
 impl RunArgs {
@@ -311,7 +318,18 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             Ok(())
         }
         Some(Command::Reference(args)) => reference(args, registry),
-        Some(Command::Merge { dirs, results, plots, threads, no_plots, wait, progress, references, integrals }) => {
+        Some(Command::Merge {
+            dirs,
+            results,
+            plots,
+            threads,
+            no_plots,
+            wait,
+            progress,
+            references,
+            integrals,
+            verbose,
+        }) => {
             let registry = &with_references(registry, &results, &references);
             let progress = Progress::new(progress);
             let opts = ExecOptions {
@@ -326,7 +344,15 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             };
             let t0 = Instant::now();
             let out = crate::run::merge::merge(&dirs, &opts)?;
-            crate::output::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
+            let seconds = t0.elapsed().as_secs_f64();
+            let tally = crate::output::console::print_experiment(&out.report, seconds, verbose);
+            let report = (!no_plots).then(|| out.plots_dir.join("index.html"));
+            crate::output::console::print_totals(
+                &[tally],
+                seconds,
+                crate::run::phases::process_seconds(),
+                report.as_deref(),
+            );
             println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             Ok(())
         }
@@ -413,6 +439,7 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
     }
     let mut written = Vec::new();
     let started = Instant::now();
+    let mut tallies = Vec::new();
     for (((def, plan), checked), t) in prepared.iter().zip(checked).zip(&mut times) {
         let t0 = Instant::now();
         if let Checked::Shard(pre) = checked {
@@ -435,19 +462,26 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         let out = execute::execute_checked(plan, *def, &opts, pre)?;
         progress.finish();
         t.add(&crate::run::phases::take());
-        crate::output::console::print_summary(&out.report, t0.elapsed().as_secs_f64());
-        println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
-        println!("time: {}", t.line());
+        tallies.push(crate::output::console::print_experiment(&out.report, t0.elapsed().as_secs_f64(), args.verbose));
+        if args.verbose {
+            println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
+            println!("time: {}", t.line());
+        }
         written.push(out.results_dir.clone());
     }
-    println!("\ntotal wall time {:.1} s", started.elapsed().as_secs_f64());
-    if args.shard.is_none() {
+    let wall = started.elapsed().as_secs_f64();
+    if args.shard.is_some() {
+        println!("\ntotal wall time {wall:.1} s");
+        return Ok(());
+    }
+    if args.verbose {
         let names: Vec<&str> = prepared.iter().map(|(_, p)| p.sweep.experiment.as_str()).collect();
         print!("{}", crate::run::phases::table(&names, &times));
-        if !args.no_plots {
-            println!("HTML report (open in a browser): {}", args.plots.join("index.html").display());
-        }
     }
+    let cpu: f64 = times.iter().map(|t| t.total().1).sum();
+    let report = (!args.no_plots).then(|| args.plots.join("index.html"));
+    crate::output::console::print_totals(&tallies, wall, cpu, report.as_deref());
+    println!("results: {}", args.results.display());
     if let Some(a) = &baseline {
         crate::compare::command::against_baseline(&args.results, a, &written, Default::default())?;
     }
