@@ -6,6 +6,7 @@
 
 use mcbench::error::Result;
 use mcbench::output::{Claim, RunReport};
+use mcbench::output::query::Query;
 use mcbench::registry::PostContext;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -38,10 +39,7 @@ struct StructureRow {
 }
 
 fn diag(r: &RunReport, variant: &str, estimator: &str, budget: u64, name: &str) -> Option<f64> {
-    r.diagnostics
-        .iter()
-        .find(|d| d.variant == variant && d.estimator == estimator && d.budget == budget && d.name == name)
-        .map(|d| d.mean)
+    Query::new(&r.diagnostics).variant(variant).estimator(estimator).at(budget).iter().find(|d| d.name == name).map(|d| d.mean)
 }
 
 /// Writes `structure.csv`, adds the Table 1 and reference-precision entries to the `paper` block.

@@ -1,6 +1,7 @@
 //! The console summary of a finished run (every run prints a summary table): fits with
 //! their unbiasedness verdicts, the paper's claims beside ours, and what was skipped.
 
+use crate::output::query::Query;
 use crate::output::report::{markdown_table, sig};
 use crate::verdict::Verdict;
 
@@ -15,12 +16,11 @@ pub fn print_summary(r: &crate::output::RunReport, seconds: f64) {
         .iter()
         .map(|f| {
             let find = |prefix: &str| {
-                r.tests.iter().find(|t| {
-                    t.testbed == f.testbed
-                        && t.variant == f.variant
-                        && t.estimator == f.estimator
-                        && t.test.starts_with(prefix)
-                })
+                Query::new(&r.tests)
+                    .bed((&f.testbed, &f.variant))
+                    .estimator(&f.estimator)
+                    .iter()
+                    .find(|t| t.test.starts_with(prefix))
             };
             let (holm, pooled) = (find("holm"), find("pooled"));
             let p = |t: Option<&crate::analysis::TestRow>| {
