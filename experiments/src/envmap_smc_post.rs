@@ -108,7 +108,8 @@ fn claim(testbed: &str, text: &str, paper: Option<f64>, ours: Option<f64>, held:
 /// Independent pixel sequences behind a diagnostic of `estimator` on the mixed variant: one per
 /// pixel and repetition (`integrals` counts pixels x frames).
 fn sequences(report: &RunReport, estimator: &str, frames: usize) -> Option<f64> {
-    let d = Query::new(&report.diagnostics).variant("mixed").estimator(estimator).iter().find(|d| d.name == "resampled")?;
+    let d =
+        Query::new(&report.diagnostics).variant("mixed").estimator(estimator).iter().find(|d| d.name == "resampled")?;
     let row = report.query().variant("mixed").estimator(estimator).at(d.budget).first()?;
     Some((row.integrals * row.reps) as f64 / frames.max(1) as f64)
 }

@@ -5,8 +5,8 @@
 //! largest budget must be at least 3x the reference's RMS standard error.
 
 use mcbench::error::Result;
-use mcbench::output::{Claim, RunReport};
 use mcbench::output::query::Query;
+use mcbench::output::{Claim, RunReport};
 use mcbench::registry::PostContext;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -39,7 +39,13 @@ struct StructureRow {
 }
 
 fn diag(r: &RunReport, variant: &str, estimator: &str, budget: u64, name: &str) -> Option<f64> {
-    Query::new(&r.diagnostics).variant(variant).estimator(estimator).at(budget).iter().find(|d| d.name == name).map(|d| d.mean)
+    Query::new(&r.diagnostics)
+        .variant(variant)
+        .estimator(estimator)
+        .at(budget)
+        .iter()
+        .find(|d| d.name == name)
+        .map(|d| d.mean)
 }
 
 /// Writes `structure.csv`, adds the Table 1 and reference-precision entries to the `paper` block.

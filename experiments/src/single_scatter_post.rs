@@ -6,8 +6,8 @@
 
 use crate::single_scatter::{ranking, IDS, NOISE_FREE, PAPER_BUDGETS};
 use mcbench::error::Result;
-use mcbench::output::Claim;
 use mcbench::output::query::Query;
+use mcbench::output::Claim;
 use mcbench::registry::PostContext;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -96,8 +96,11 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
                 }
             }
         }
-        let tests: Vec<_> =
-            Query::new(&report.tests).testbed(tb).iter().filter(|t| t.test == "combined" && t.claim == "unbiased").collect();
+        let tests: Vec<_> = Query::new(&report.tests)
+            .testbed(tb)
+            .iter()
+            .filter(|t| t.test == "combined" && t.claim == "unbiased")
+            .collect();
         if !tests.is_empty() {
             let flagged: Vec<String> = tests
                 .iter()

@@ -283,6 +283,4 @@ mod tests {
         assert!(close(sidak_alpha(1e-15, 3), 1e-15 / 3.0, 1e-9));
         assert_eq!(sidak_alpha(0.01, 0), 0.01);
     }
-
-
 }

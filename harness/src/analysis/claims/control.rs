@@ -1,8 +1,8 @@
 //! Claims decided by the unbiasedness tests: an estimator is unbiased, a biased control is flagged.
 
 use crate::analysis::TestRow;
-use crate::output::{Claim, RunReport};
 use crate::output::query::Query;
+use crate::output::{Claim, RunReport};
 use crate::verdict::Verdict;
 
 /// The test that decides unbiasedness for one (variant, estimator): its `combined` row (with

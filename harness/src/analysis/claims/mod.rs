@@ -18,8 +18,8 @@ pub use slope::{
 };
 
 use crate::analysis::{Fit, SpeedUp, SpeedUpOutcome};
-use crate::output::{Claim, RunReport};
 use crate::output::query::Query;
+use crate::output::{Claim, RunReport};
 use crate::plan::cost_model::Regime;
 use crate::verdict::Verdict;
 
@@ -58,9 +58,7 @@ pub fn speedup_claim(
     claim: &str,
     regime: Regime,
 ) -> Claim {
-    let found = |all: &[SpeedUp]| {
-        Query::new(all).bed(tb).estimator(estimator).first().cloned()
-    };
+    let found = |all: &[SpeedUp]| Query::new(all).bed(tb).estimator(estimator).first().cloned();
     let s = match baseline {
         None => found(&report.speedups),
         Some(b) => found(&crate::analysis::speedups(&report.rows, &report.fits, b, &report.meta.cost_model)),

@@ -13,8 +13,8 @@ use super::markup::{esc, table, Cell};
 use super::png::Rgb8;
 use crate::error::Result;
 use crate::output::integrals::IntegralRow;
-use crate::output::query::Query;
 use crate::output::plot::heatmap::{colour, Fill, Scale};
+use crate::output::query::Query;
 use crate::output::report::sig;
 use std::fmt::Write as _;
 
