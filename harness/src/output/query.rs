@@ -25,10 +25,10 @@
 
 use crate::analysis::metrics::SummaryRow;
 use crate::analysis::{Fit, SpeedUp, TestRow};
-use crate::output::integrals::IntegralRow;
 use crate::output::{CellCounts, Diagnostic, RunReport};
 
 /// A row keyed by its cell: test bed, variant, estimator and, for rows of one budget, the budget.
+/// (Integral rows implement it beside their type, in [`crate::output::integrals`].)
 pub trait Keyed {
     /// Test bed id.
     fn testbed(&self) -> &str;
@@ -67,7 +67,6 @@ keyed!(SpeedUp, r => Some(r.budget));
 keyed!(Diagnostic, r => Some(r.budget));
 keyed!(CellCounts, r => Some(r.budget));
 keyed!(Fit, _r => None);
-keyed!(IntegralRow, _r => None);
 
 impl<T: Keyed> Keyed for &T {
     fn testbed(&self) -> &str {
@@ -204,6 +203,7 @@ impl RunReport {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::integrals::IntegralRow;
 
     fn row(testbed: &str, variant: &str, estimator: &str, budget: u64) -> CellCounts {
         CellCounts {
