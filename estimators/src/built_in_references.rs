@@ -4,6 +4,7 @@
 
 use mcbench_core::error::ConfigError;
 use mcbench_core::references::{ReferenceKey, ReferenceSource, StoredReference};
+use std::sync::OnceLock;
 
 /// Every stored reference of the built-in test beds: (file name, contents).
 static FILES: &[(&str, &str)] = &[
@@ -65,6 +66,16 @@ static FILES: &[(&str, &str)] = &[
     ),
 ];
 
+/// Each file of [`FILES`] parsed, at its first look-up (the parse error's text when it does not).
+static PARSED: [OnceLock<Result<StoredReference, String>>; FILES.len()] = [const { OnceLock::new() }; FILES.len()];
+
+/// The file named `name` parsed once for the process: `None` when no built-in file has that name.
+fn parsed(name: &str) -> Option<Result<&'static StoredReference, ConfigError>> {
+    let i = FILES.iter().position(|(n, _)| *n == name)?;
+    let parsed = PARSED[i].get_or_init(|| serde_json::from_str(FILES[i].1).map_err(|e| e.to_string()));
+    Some(parsed.as_ref().map_err(|e| ConfigError::invalid("built-in reference", name, e.clone())))
+}
+
 /// The built-in stored references, by their keys' file names.
 pub struct BuiltIn;
 
@@ -73,11 +84,9 @@ pub static BUILT_IN: BuiltIn = BuiltIn;
 
 impl ReferenceSource for BuiltIn {
     fn stored(&self, key: &ReferenceKey) -> Result<Option<StoredReference>, ConfigError> {
-        let name = key.file_name();
-        let Some((_, text)) = FILES.iter().find(|(n, _)| *n == name) else { return Ok(None) };
-        let stored: StoredReference =
-            serde_json::from_str(text).map_err(|e| ConfigError::invalid("built-in reference", &name, e.to_string()))?;
-        Ok(stored.matches(key).then_some(stored))
+        let Some(stored) = parsed(&key.file_name()) else { return Ok(None) };
+        let stored = stored?;
+        Ok(stored.matches(key).then(|| stored.clone()))
     }
     fn location(&self) -> String {
         "the references built into mcbench-papers".into()
@@ -111,5 +120,27 @@ mod tests {
             assert_eq!(&key.file_name(), name);
             assert!(BUILT_IN.stored(&key).expect("reads").is_some(), "{name}");
         }
+    }
+
+    /// A file is parsed once: two look-ups of one key return the same data, read from the one
+    /// parsed value.
+    #[test]
+    fn a_file_is_parsed_once_and_every_look_up_returns_its_data() {
+        let (name, text) = FILES[0];
+        let first = parsed(name).expect("built in").expect("parses");
+        let second = parsed(name).expect("built in").expect("parses");
+        assert!(std::ptr::eq(first, second), "the second look-up parsed {name} again");
+        let fresh: StoredReference = serde_json::from_str(text).expect("parses");
+        assert_eq!(*first, fresh);
+        let key = ReferenceKey {
+            testbed: fresh.testbed.clone(),
+            variant: fresh.variant.clone(),
+            params: fresh.params.clone(),
+            default: name.matches('_').count() == 1,
+        };
+        let (a, b) = (BUILT_IN.stored(&key).expect("reads"), BUILT_IN.stored(&key).expect("reads"));
+        assert_eq!(a.as_ref(), Some(&fresh));
+        assert_eq!(a, b);
+        assert!(parsed("no-such-file.json").is_none());
     }
 }

@@ -7,6 +7,7 @@
 use crate::envmap_smc::{m_values, p_values};
 use mcbench::error::{HarnessError, Result};
 use mcbench::output::plot::{write_panels, Figure, Panels, Series};
+use mcbench::output::query::Query;
 use mcbench::output::{Claim, RunReport};
 use mcbench::plan::Plan;
 use mcbench::registry::PostContext;
@@ -107,11 +108,9 @@ fn claim(testbed: &str, text: &str, paper: Option<f64>, ours: Option<f64>, held:
 /// Independent pixel sequences behind a diagnostic of `estimator` on the mixed variant: one per
 /// pixel and repetition (`integrals` counts pixels x frames).
 fn sequences(report: &RunReport, estimator: &str, frames: usize) -> Option<f64> {
-    let d = report
-        .diagnostics
-        .iter()
-        .find(|d| d.variant == "mixed" && d.estimator == estimator && d.name == "resampled")?;
-    let row = report.rows.iter().find(|r| r.variant == "mixed" && r.estimator == estimator && r.budget == d.budget)?;
+    let d =
+        Query::new(&report.diagnostics).variant("mixed").estimator(estimator).iter().find(|d| d.name == "resampled")?;
+    let row = report.query().variant("mixed").estimator(estimator).at(d.budget).first()?;
     Some((row.integrals * row.reps) as f64 / frames.max(1) as f64)
 }
 
@@ -271,10 +270,11 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
 
     // (c) Share of pixels resampled per propagated frame (frame 1 notes nothing, hence F / (F - 1)).
     let share = |name: &str| {
-        report
-            .diagnostics
+        Query::new(&report.diagnostics)
+            .variant("mixed")
+            .estimator(name)
             .iter()
-            .find(|d| d.variant == "mixed" && d.estimator == name && d.name == "resampled")
+            .find(|d| d.name == "resampled")
             .map(|d| d.mean * frames as f64 / (frames - 1) as f64)
     };
     let mut fig_c = Vec::new();
@@ -307,7 +307,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
     ));
     report.paper.push(bridges_halve(report, frames, (one, five)));
     if let Some(d) =
-        report.diagnostics.iter().find(|d| d.variant == "mixed" && d.estimator == "smc_adaptive" && d.name == "bridges")
+        Query::new(&report.diagnostics).variant("mixed").estimator("smc_adaptive").iter().find(|d| d.name == "bridges")
     {
         let mean = d.mean * frames as f64 / (frames - 1) as f64;
         report.paper.push(claim(

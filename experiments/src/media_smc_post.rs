@@ -5,6 +5,7 @@
 //! largest budget must be at least 3x the reference's RMS standard error.
 
 use mcbench::error::Result;
+use mcbench::output::query::Query;
 use mcbench::output::{Claim, RunReport};
 use mcbench::registry::PostContext;
 use serde::Serialize;
@@ -38,9 +39,12 @@ struct StructureRow {
 }
 
 fn diag(r: &RunReport, variant: &str, estimator: &str, budget: u64, name: &str) -> Option<f64> {
-    r.diagnostics
+    Query::new(&r.diagnostics)
+        .variant(variant)
+        .estimator(estimator)
+        .at(budget)
         .iter()
-        .find(|d| d.variant == variant && d.estimator == estimator && d.budget == budget && d.name == name)
+        .find(|d| d.name == name)
         .map(|d| d.mean)
 }
 

@@ -30,7 +30,7 @@ fn name(id: &str, s: f64) -> String {
 }
 
 fn row<'a>(r: &'a RunReport, tb: &str, est: &str, budget: u64) -> Option<&'a mcbench::analysis::metrics::SummaryRow> {
-    r.rows.iter().find(|x| x.testbed == tb && x.estimator == est && x.budget == budget)
+    r.query().testbed(tb).estimator(est).at(budget).first()
 }
 
 /// The FoM ratio `a / b` at `budget`, when both cells ran.

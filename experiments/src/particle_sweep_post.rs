@@ -8,6 +8,7 @@ use crate::particle_sweep::{IDS, SIGMAS};
 use mcbench::analysis::metrics::SummaryRow;
 use mcbench::error::Result;
 use mcbench::output::plot::{write_panels, Figure, Line, Panels, Series};
+use mcbench::output::query::Query;
 use mcbench::registry::PostContext;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -62,15 +63,15 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
         .collect();
     results.write_csv("fom.csv", &rows)?;
     let Some(dir) = plots else { return Ok(Vec::new()) };
-    let budget = report.rows.iter().map(|r| r.budget).max().unwrap_or(0);
+    let budget = report.query().largest_budget().unwrap_or(0);
     let mut panels = Vec::new();
     for tb in ["eq21-medium", "perlin-medium"] {
-        let rows: Vec<&SummaryRow> = report.rows.iter().filter(|r| r.testbed == tb && r.budget == budget).collect();
+        let rows: Vec<&SummaryRow> = report.query().testbed(tb).at(budget).iter().collect();
         let mut series = Vec::new();
         for (style, model) in IDS.iter().enumerate() {
             let name = names.named_estimator(model).unwrap_or_else(|| model.to_string());
             if *model == "delta_tracking" {
-                let f = rows.iter().find(|r| r.estimator == *model).and_then(|r| r.fom);
+                let f = Query::new(&rows).estimator(model).first().and_then(|r| r.fom);
                 let points = f.map(|f| vec![(SIGMAS[0], f), (SIGMAS[SIGMAS.len() - 1], f)]).unwrap_or_default();
                 let label = format!("{name} (majorant 1, no σ_samp)");
                 series.push(Series::new(label, style, points).with_line(Line::Dashed).without_markers());

@@ -103,7 +103,7 @@ fn table2(report: &RunReport) -> Vec<Table2Row<'_>> {
             image_seconds_wall: None,
         });
     }
-    for r in report.rows.iter().filter(|r| r.testbed == "checker-direct") {
+    for r in report.query().testbed("checker-direct") {
         rows.push(Table2Row {
             source: "ours",
             image: "checker-direct",

@@ -6,6 +6,7 @@
 
 use crate::{pmc_ip_post, ExperimentDef};
 use mcbench::analysis::metrics::SummaryRow;
+use mcbench::output::query::Query;
 use mcbench::output::{Claim, RunReport};
 
 /// The name of PMC-IP 4+6+6 (the initial image takes 4 spp).
@@ -20,7 +21,7 @@ pub const RESOLUTION: f64 = 48.0;
 
 /// The row of an estimator at a budget on a variant.
 pub fn row<'a>(r: &'a RunReport, variant: &str, estimator: &str, budget: u64) -> Option<&'a SummaryRow> {
-    r.rows.iter().find(|x| x.variant == variant && x.estimator == estimator && x.budget == budget)
+    r.query().variant(variant).estimator(estimator).at(budget).first()
 }
 
 /// "PMC-IP is unbiased" (paper 003 §4.2): held when the per-pixel Holm-Welch test against the
@@ -30,7 +31,7 @@ pub fn row<'a>(r: &'a RunReport, variant: &str, estimator: &str, budget: u64) ->
 /// sampler too says more about the repetitions than about the estimator.
 fn unbiased_claim(r: &RunReport, variant: &str, estimator: &str) -> Claim {
     let test = |e: &str, name: &str| {
-        r.tests.iter().find(|t| t.variant == variant && t.estimator == e && t.test == name).map(|t| t.p_value)
+        Query::new(&r.tests).variant(variant).estimator(e).iter().find(|t| t.test == name).map(|t| t.p_value)
     };
     let p = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2e}"));
     let decisive = mcbench::analysis::claims::decisive_test(&r.tests, variant, estimator, "");

@@ -43,10 +43,7 @@ pub const CONTROL: &str = "ray_marching[step=5]";
 
 /// RMSE of an estimator at a budget on a test bed (single-scatter variant).
 pub fn rmse(r: &RunReport, tb: &str, est: &str, budget: u64) -> Option<f64> {
-    r.rows
-        .iter()
-        .find(|x| x.testbed == tb && x.variant == "single-scatter" && x.estimator == est && x.budget == budget)
-        .map(|x| x.rmse)
+    r.query().testbed(tb).variant("single-scatter").estimator(est).at(budget).first().map(|x| x.rmse)
 }
 
 /// The ids that ran on `tb` at `budget`, best (smallest RMSE) first.

@@ -6,6 +6,7 @@
 
 use crate::single_scatter::{ranking, IDS, NOISE_FREE, PAPER_BUDGETS};
 use mcbench::error::Result;
+use mcbench::output::query::Query;
 use mcbench::output::Claim;
 use mcbench::registry::PostContext;
 use serde::Serialize;
@@ -59,9 +60,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
         for budget in plan.sweep.budgets.iter().map(|b| b.amount) {
             let order = ranking(report, tb, budget);
             for id in IDS {
-                let Some(row) =
-                    report.rows.iter().find(|r| r.testbed == tb && r.estimator == *id && r.budget == budget)
-                else {
+                let Some(row) = report.query().testbed(tb).estimator(id).at(budget).first() else {
                     continue;
                 };
                 let rank = order.iter().position(|(i, _)| i == id).map_or(0, |p| p + 1);
@@ -97,8 +96,11 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
                 }
             }
         }
-        let tests: Vec<_> =
-            report.tests.iter().filter(|t| t.testbed == tb && t.test == "combined" && t.claim == "unbiased").collect();
+        let tests: Vec<_> = Query::new(&report.tests)
+            .testbed(tb)
+            .iter()
+            .filter(|t| t.test == "combined" && t.claim == "unbiased")
+            .collect();
         if !tests.is_empty() {
             let flagged: Vec<String> = tests
                 .iter()
@@ -120,11 +122,11 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
                 ..Default::default()
             });
         }
-        for t in report.tests.iter().filter(|t| {
-            t.testbed == tb
-                && t.test.starts_with("holm")
-                && (t.estimator == "ray_marching" || t.estimator == NOISE_FREE)
-        }) {
+        for t in Query::new(&report.tests)
+            .testbed(tb)
+            .iter()
+            .filter(|t| t.test.starts_with("holm") && (t.estimator == "ray_marching" || t.estimator == NOISE_FREE))
+        {
             claims.push(Claim {
                 testbed: format!("{tb}/single-scatter"),
                 claim: format!("paper 002 Fig. 12: ray marching (one ray spending the budget) is biased: {} flagged by the Holm test", t.estimator),

@@ -1,7 +1,8 @@
 //! Statistics for the convergence harness (book: statistics.md, slope-fits.md).
 //!
 //! - [`moments`]: compensated sums and exactly mergeable running mean/variance;
-//! - [`hypothesis`]: one-sample t, z and Welch tests, Holm–Bonferroni, Šidák, detectable bias;
+//! - [`hypothesis`]: one-sample t, z and Welch tests, Holm–Bonferroni, Šidák;
+//! - [`power`]: the smallest shift a test detects (detectable bias), the t-test's skewness limit;
 //! - [`chi_square`]: chi-square goodness of fit with merged low-expectation cells, histograms, and
 //!   the shared [`StatsError`];
 //! - [`regression`]: least-squares line and power-law (log-log) fits with a 95% slope interval.
@@ -11,6 +12,7 @@
 pub mod chi_square;
 pub mod hypothesis;
 pub mod moments;
+pub mod power;
 pub mod regression;
 
 pub use chi_square::{chi_square_gof, histogram, ChiSquare, StatsError, MIN_EXPECTED_COUNT};

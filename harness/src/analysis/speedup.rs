@@ -5,6 +5,7 @@ use super::{group, Fit, SlopeOutcome};
 use crate::analysis::claims::bootstrap::{self, Bootstrap};
 use crate::analysis::claims::Ratio;
 use crate::analysis::metrics::SummaryRow;
+use crate::output::query::Query;
 use crate::plan::cost_model::{CostModel, RayCostCurve, Regime};
 use serde::{Deserialize, Serialize};
 
@@ -186,10 +187,10 @@ pub fn speedups(rows: &[SummaryRow], fits: &[Fit], baseline: &str, model: &CostM
         if last.estimator == baseline {
             continue;
         }
-        let same = |r: &&SummaryRow| r.testbed == last.testbed && r.variant == last.variant && r.estimator == baseline;
+        let bed = (last.testbed.as_str(), last.variant.as_str());
         let (Some(fit), Some(base)) = (
-            fits.iter().find(|f| f.testbed == last.testbed && f.variant == last.variant && f.estimator == baseline),
-            rows.iter().filter(same).find(|r| r.budget == last.budget),
+            Query::new(fits).bed(bed).estimator(baseline).first(),
+            Query::new(rows).bed(bed).estimator(baseline).at(last.budget).first(),
         ) else {
             continue;
         };

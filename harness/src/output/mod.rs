@@ -7,6 +7,7 @@ pub mod html;
 pub mod integrals;
 pub mod listing;
 pub mod plot;
+pub mod query;
 pub mod report;
 
 use crate::analysis::metrics::SummaryRow;

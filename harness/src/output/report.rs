@@ -335,7 +335,7 @@ fn results_section(out: &mut String, report: &RunReport, plots_dir: &Path, resul
          diagnostics per cell are in summary.json (`diagnostics`).\n\n"
     );
     let rows = groups.iter().take(GROUP_ROWS).map(|(t, v)| {
-        let rows: Vec<_> = report.rows.iter().filter(|r| &r.testbed == t && &r.variant == v).collect();
+        let rows: Vec<_> = report.query().testbed(t).variant(v).iter().collect();
         let mut estimators: Vec<&str> = rows.iter().map(|r| r.estimator.as_str()).collect();
         estimators.dedup();
         let mut budgets: Vec<u64> = rows.iter().map(|r| r.budget).collect();

@@ -123,8 +123,8 @@ pub(super) fn ceiling(
                 }
                 _ => return None,
             };
-            let last = budget.or_else(|| report.rows.iter().map(|r| r.budget).max())?;
-            let at = |name: &str| report.rows.iter().find(|r| r.estimator == name && r.budget == last);
+            let last = budget.or_else(|| report.query().largest_budget())?;
+            let at = |name: &str| report.query().estimator(name).at(last).first();
             let (m, b) = (at(estimator)?, at(base)?);
             let work = |r: &SummaryRow| error(r) * r.rays.max(f64::MIN_POSITIVE);
             let v = work(b) / work(m);

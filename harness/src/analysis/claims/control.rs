@@ -1,13 +1,14 @@
 //! Claims decided by the unbiasedness tests: an estimator is unbiased, a biased control is flagged.
 
 use crate::analysis::TestRow;
+use crate::output::query::Query;
 use crate::output::{Claim, RunReport};
 use crate::verdict::Verdict;
 
 /// The test that decides unbiasedness for one (variant, estimator): its `combined` row (with
 /// `suffix` appended to the name), whose verdict is `pass`, `inconclusive` or `biased`.
 pub fn decisive_test<'a>(tests: &'a [TestRow], variant: &str, estimator: &str, suffix: &str) -> Option<&'a TestRow> {
-    tests.iter().find(|t| t.variant == variant && t.estimator == estimator && t.test == format!("combined{suffix}"))
+    Query::new(tests).variant(variant).estimator(estimator).iter().find(|t| t.test == format!("combined{suffix}"))
 }
 
 /// The verdict of a claim that an estimator is unbiased, from its deciding test row: `held` on
@@ -30,7 +31,7 @@ pub fn unbiased_verdict(t: &TestRow) -> (Option<bool>, Verdict, String) {
 /// small control bias is not a test without teeth.
 pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
     let mut variants: Vec<&str> = Vec::new();
-    for t in report.tests.iter().filter(|t| t.estimator == control) {
+    for t in Query::new(&report.tests).estimator(control) {
         if !variants.contains(&t.variant.as_str()) {
             variants.push(&t.variant);
         }

@@ -18,13 +18,14 @@ pub use slope::{
 };
 
 use crate::analysis::{Fit, SpeedUp, SpeedUpOutcome};
+use crate::output::query::Query;
 use crate::output::{Claim, RunReport};
 use crate::plan::cost_model::Regime;
 use crate::verdict::Verdict;
 
 /// The fit of an estimator on a test bed, if the run has one.
 pub fn fit<'a>(report: &'a RunReport, testbed: &str, variant: &str, estimator: &str) -> Option<&'a Fit> {
-    report.fits.iter().find(|f| f.testbed == testbed && f.variant == variant && f.estimator == estimator)
+    Query::new(&report.fits).testbed(testbed).variant(variant).estimator(estimator).first()
 }
 
 pub(crate) fn not_measured(testbed: &str, claim: &str, paper: f64, why: String) -> Claim {
@@ -57,9 +58,7 @@ pub fn speedup_claim(
     claim: &str,
     regime: Regime,
 ) -> Claim {
-    let found = |all: &[SpeedUp]| {
-        all.iter().find(|s| s.testbed == tb.0 && s.variant == tb.1 && s.estimator == estimator).cloned()
-    };
+    let found = |all: &[SpeedUp]| Query::new(all).bed(tb).estimator(estimator).first().cloned();
     let s = match baseline {
         None => found(&report.speedups),
         Some(b) => found(&crate::analysis::speedups(&report.rows, &report.fits, b, &report.meta.cost_model)),
@@ -166,9 +165,7 @@ pub fn diagnostic_claim(
     claim: &str,
 ) -> Claim {
     let (estimator, budget, name) = at;
-    let d = report.diagnostics.iter().find(|d| {
-        d.testbed == tb.0 && d.variant == tb.1 && d.estimator == estimator && d.budget == budget && d.name == name
-    });
+    let d = Query::new(&report.diagnostics).bed(tb).estimator(estimator).at(budget).iter().find(|d| d.name == name);
     match d {
         None => not_measured(tb.0, claim, paper, format!("no `{name}` diagnostic of {estimator} at budget {budget}")),
         Some(d) => Claim {
@@ -196,9 +193,11 @@ pub fn reference_precision(plan: &crate::plan::Plan, report: &RunReport) -> Vec<
         let n = (r.std_err.len() * 3).max(1) as f64;
         let ref_rms = (r.std_err.iter().flat_map(|s| s.0).map(|x| x * x).sum::<f64>() / n).sqrt();
         let min_rmse = report
-            .rows
+            .query()
+            .testbed(&b.spec.id)
+            .variant(&b.variant)
+            .at(last)
             .iter()
-            .filter(|row| row.testbed == b.spec.id && row.variant == b.variant && row.budget == last)
             .map(|row| row.rmse)
             .fold(f64::INFINITY, f64::min);
         out.push(Claim {

@@ -39,7 +39,7 @@ pub fn metric_of(metric: RatioMetric, r: &SummaryRow) -> Option<f64> {
 
 /// The largest budget any row of `tb` has (the default budget of a claim that names none).
 pub fn largest_budget(report: &RunReport, tb: (&str, &str)) -> Option<u64> {
-    report.rows.iter().filter(|r| r.testbed == tb.0 && r.variant == tb.1).map(|r| r.budget).max()
+    report.query().bed(tb).largest_budget()
 }
 
 /// The first estimator named twice in `names`, if any (a claim comparing it with itself).

@@ -242,10 +242,7 @@ impl Ratio {
 
 /// The row of `estimator` on `tb` at `budget`.
 pub fn row<'a>(report: &'a RunReport, tb: (&str, &str), estimator: &str, budget: u64) -> Option<&'a SummaryRow> {
-    report
-        .rows
-        .iter()
-        .find(|r| r.testbed == tb.0 && r.variant == tb.1 && r.estimator == estimator && r.budget == budget)
+    report.query().bed(tb).estimator(estimator).at(budget).first()
 }
 
 /// What a ratio claim compares and how it is judged.

@@ -8,11 +8,8 @@ use crate::verdict::Verdict;
 
 /// The log-log slope between the last two budgets of a series (the local order at the right end).
 pub fn last_segment_slope(report: &RunReport, testbed: &str, variant: &str, estimator: &str) -> Option<f64> {
-    let rows: Vec<_> = report
-        .rows
-        .iter()
-        .filter(|r| r.testbed == testbed && r.variant == variant && r.estimator == estimator && r.rmse > 0.0)
-        .collect();
+    let rows: Vec<_> =
+        report.query().testbed(testbed).variant(variant).estimator(estimator).iter().filter(|r| r.rmse > 0.0).collect();
     let [.., a, b] = rows.as_slice() else { return None };
     Some((b.rmse / a.rmse).ln() / (b.budget as f64 / a.budget as f64).ln())
 }

@@ -6,6 +6,7 @@
 
 pub mod tally;
 
+use crate::output::query::Query;
 use crate::output::report::sig;
 use crate::output::RunReport;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, ColumnConstraint, ContentArrangement, Table};
@@ -125,10 +126,10 @@ pub fn tables(r: &RunReport, seconds: f64, width: usize) -> String {
         .fits
         .iter()
         .map(|f| {
-            let decision = r
-                .tests
+            let decision = Query::new(&r.tests)
+                .bed((&f.testbed, &f.variant))
+                .estimator(&f.estimator)
                 .iter()
-                .filter(|t| t.testbed == f.testbed && t.variant == f.variant && t.estimator == f.estimator)
                 .find(|t| t.test == "combined");
             vec![
                 format!("{}/{}", f.testbed, f.variant),

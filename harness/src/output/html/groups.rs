@@ -86,14 +86,14 @@ pub(super) fn figures(
 
 /// The cells of one group at its largest budget.
 fn cells(b: &mut String, report: &RunReport, testbed: &str, variant: &str) {
-    let rows: Vec<_> = report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
-    let Some(last) = rows.iter().map(|r| r.budget).max() else { return };
-    let last_rows: Vec<_> = rows.iter().filter(|r| r.budget == last).collect();
+    let on_bed = report.query().testbed(testbed).variant(variant);
+    let (Some(first), Some(last)) = (on_bed.first(), on_bed.largest_budget()) else { return };
+    let last_rows: Vec<_> = on_bed.at(last).iter().collect();
     let _ = writeln!(
         b,
         "<details><summary>The {} cells at the largest budget ({last} {}); every budget in summary.csv</summary>",
         last_rows.len(),
-        esc(&rows[0].budget_kind)
+        esc(&first.budget_kind)
     );
     let table_rows = last_rows
         .iter()

@@ -14,6 +14,7 @@ use super::png::Rgb8;
 use crate::error::Result;
 use crate::output::integrals::IntegralRow;
 use crate::output::plot::heatmap::{colour, Fill, Scale};
+use crate::output::query::Query;
 use crate::output::report::sig;
 use std::fmt::Write as _;
 
@@ -75,7 +76,7 @@ pub fn pixel_maps(rows: &[IntegralRow]) -> Vec<PixelGroup> {
     }
     keys.into_iter()
         .filter_map(|(t, v)| {
-            let rows: Vec<&IntegralRow> = rows.iter().filter(|r| r.testbed == t && r.variant == v).collect();
+            let rows: Vec<&IntegralRow> = Query::new(rows).testbed(t).variant(v).iter().collect();
             group(t, v, &rows)
         })
         .collect()
@@ -92,7 +93,7 @@ fn group(testbed: &str, variant: &str, rows: &[&IntegralRow]) -> Option<PixelGro
     let estimators = first_seen(rows.iter().map(|r| r.estimator.as_str()))
         .into_iter()
         .map(|e| {
-            let mine: Vec<&&IntegralRow> = rows.iter().filter(|r| r.estimator == e).collect();
+            let mine: Vec<&&IntegralRow> = Query::new(rows).estimator(e).iter().collect();
             maps_of(e, &mine, width, height, frames)
         })
         .collect();

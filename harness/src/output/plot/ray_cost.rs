@@ -6,6 +6,7 @@
 use super::figure::{Figure, Guide, Line, Series};
 use super::sanitize;
 use crate::analysis::{speedups, SpeedUp};
+use crate::output::query::Query;
 use crate::output::RunReport;
 
 /// Points per curve.
@@ -51,7 +52,7 @@ pub fn panel(
     display: &dyn Fn(&str) -> String,
 ) -> Option<Figure> {
     let (all, claimed) = pairs(report);
-    let mine: Vec<&SpeedUp> = all.iter().filter(|s| s.testbed == testbed && s.variant == variant).collect();
+    let mine: Vec<&SpeedUp> = Query::new(&all).testbed(testbed).variant(variant).iter().collect();
     let main = mine.first().map(|s| s.baseline.clone())?;
     let budget = mine.first().map(|s| s.budget)?;
     let mut series = Vec::new();

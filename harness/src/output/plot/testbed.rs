@@ -8,6 +8,7 @@ use super::figure::{Figure, Guide, Panels, Series};
 use super::names::DisplayNames;
 use super::{budget_axis_label, label_of, ray_cost};
 use crate::analysis::metrics::SummaryRow;
+use crate::output::query::Query;
 use crate::output::RunReport;
 
 /// The note under a legend with bands.
@@ -33,7 +34,7 @@ pub fn budget_unit(kind: &str) -> &str {
 /// that is a fit over fewer budgets).
 pub fn legend(report: &RunReport, names: &DisplayNames, testbed: &str, variant: &str, name: &str) -> String {
     let mut label = names.estimator(name, Some(label_of(report, name)));
-    let fit = report.fits.iter().find(|f| f.testbed == testbed && f.variant == variant && f.estimator == name);
+    let fit = Query::new(&report.fits).testbed(testbed).variant(variant).estimator(name).first();
     if fit.is_some_and(|f| f.outcome == crate::analysis::SlopeOutcome::Exact) {
         label.push_str(": exact at every budget");
     }
@@ -70,12 +71,12 @@ pub fn figure(
     estimators: &[&str],
     names: &DisplayNames,
 ) -> Option<Panels> {
-    let rows: Vec<&SummaryRow> = report.rows.iter().filter(|r| r.testbed == testbed && r.variant == variant).collect();
+    let rows: Vec<&SummaryRow> = report.query().testbed(testbed).variant(variant).iter().collect();
     let kind = rows.first().map(|r| r.budget_kind.as_str()).unwrap_or("samples");
     let budget = budget_axis_label(kind);
     let (mut rmse, mut eff, mut time) = (Vec::new(), Vec::new(), Vec::new());
     for (style, name) in estimators.iter().enumerate() {
-        let mut mine: Vec<&&SummaryRow> = rows.iter().filter(|r| r.estimator == *name).collect();
+        let mut mine: Vec<&&SummaryRow> = Query::new(&rows).estimator(name).iter().collect();
         if mine.is_empty() {
             continue;
         }
