@@ -105,7 +105,14 @@ fn main() {
 fn table(pairs: u64, counts: &BTreeMap<&'static str, [u64; 4]>, hits: [u64; 4], seconds: f64) -> String {
     let [bias_hits, bias_rmse_hits, var_hits, var_eff_hits] = hits;
     let mut out = String::new();
-    out.push_str(&format!("{pairs} seed pairs, margins: RMSE ±5%, efficiencies and FoM ±10.25%, slopes ±0.1\n"));
+    let m = Margins::default();
+    out.push_str(&format!(
+        "{pairs} seed pairs, margins: RMSE ±{:.1}%, FoM ±{:.2}%, efficiencies (CPU time) ±{:.1}%, slopes ±{}\n",
+        100.0 * m.of(Metric::Rmse),
+        100.0 * m.of(Metric::Fom),
+        100.0 * m.of(Metric::EfficiencyMse),
+        m.slope
+    ));
     out.push_str("| metric | rows | false improved | false regressed | no change |\n|---|---|---|---|---|\n");
     let pct = |n: u64, d: u64| format!("{:.1}%", 100.0 * n as f64 / d.max(1) as f64);
     for (m, c) in counts {

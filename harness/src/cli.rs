@@ -121,6 +121,10 @@ enum Command {
         /// No change: slope differences with a 95% interval within ±M.
         #[arg(long, value_name = "M", default_value_t = crate::compare::change::DEFAULT_SLOPE_MARGIN, allow_negative_numbers = true)]
         slope_margin: f64,
+        /// The rows that divide by CPU time (the efficiencies): the drift of CPU time between
+        /// runs allowed on top of their band, as a factor 1 + M.
+        #[arg(long, value_name = "M", default_value_t = crate::compare::change::DEFAULT_TIME_MARGIN, allow_negative_numbers = true)]
+        time_margin: f64,
         /// Exit 1 when a row regressed.
         #[arg(long)]
         fail_on_regression: bool,
@@ -356,8 +360,8 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             Ok(())
         }
-        Some(Command::Compare { a, b, results, out, margin, slope_margin, fail_on_regression }) => {
-            let margins = crate::compare::Margins { ratio: margin, slope: slope_margin };
+        Some(Command::Compare { a, b, results, out, margin, slope_margin, time_margin, fail_on_regression }) => {
+            let margins = crate::compare::Margins { ratio: margin, slope: slope_margin, time: time_margin };
             let args = crate::compare::command::CompareArgs { a, b, results, out, margins, fail_on_regression };
             crate::compare::command::compare_command(&args)
         }

@@ -23,6 +23,10 @@ use serde::{Deserialize, Serialize};
 /// The default margin of "no change" for RMSE ratios: within ±5% (`[1/1.05, 1.05]`); efficiency
 /// and FoM ratios, which scale as 1 / MSE, within its square ([`Metric::margin`]).
 pub const DEFAULT_MARGIN: f64 = 0.05;
+/// The default drift of CPU time between two runs of the same code that the timing rows allow
+/// (a factor 1.25 on top of their band): measured on a 2-core machine under changing load, CPU
+/// time per estimate moved by 10-15% between runs, which the bootstrap within a run cannot see.
+pub const DEFAULT_TIME_MARGIN: f64 = 0.25;
 /// The default margin of "no change" for convergence slopes: a difference within ±0.1.
 pub const DEFAULT_SLOPE_MARGIN: f64 = 0.1;
 /// The two-sided level of the intervals.

@@ -25,7 +25,9 @@ pub struct CompareArgs {
 
 /// Refuses margins that are not positive finite numbers of a sensible size.
 pub fn check_margins(m: Margins) -> Result<()> {
-    for (field, v, max) in [("--margin", m.ratio, 10.0), ("--slope-margin", m.slope, 10.0)] {
+    for (field, v, max) in
+        [("--margin", m.ratio, 10.0), ("--slope-margin", m.slope, 10.0), ("--time-margin", m.time, 10.0)]
+    {
         if !(v.is_finite() && v > 0.0 && v <= max) {
             let e = mcbench_core::error::ConfigError::invalid(
                 field,

@@ -60,13 +60,14 @@ pub fn page(c: &Comparison) -> String {
     body.push_str(&format!(
         "<p>A: <code>{}</code><br>B: <code>{}</code><br>Experiments: {}. No change: an RMSE ratio B / A whose 95% interval lies within [1/{:.3}, {:.3}] (efficiency and FoM ratios within the square of that band), a slope difference within ±{}. \
          Improved or regressed: the interval excludes no change and does not lie within that margin. \
-         Rows marked CPU time depend on the machines and their load.</p>\n",
+         Rows marked CPU time depend on the machines and their load: their band is widened by the factor {:.3} for the drift of CPU time between runs.</p>\n",
         esc(&c.a_dir),
         esc(&c.b_dir),
         esc(&c.experiments.join(", ")),
         1.0 + c.margin,
         1.0 + c.margin,
-        c.slope_margin
+        c.slope_margin,
+        1.0 + c.time_margin
     ));
     let counts: Vec<(String, usize)> = c.counts().into_iter().map(|(v, n)| (v.word().to_string(), n)).collect();
     body.push_str(&format!("<p>{} rows: {}</p>\n", c.changes.len(), markup::count_badges(&counts)));
@@ -100,6 +101,7 @@ mod tests {
             b_dir: "r2".into(),
             margin: 0.1,
             slope_margin: 0.1,
+            time_margin: 0.25,
             experiments: vec!["x".into()],
             notes: vec!["a & b".into()],
             changes: vec![],

@@ -73,11 +73,31 @@ pub struct Margins {
     pub ratio: f64,
     /// Slope differences within `±slope` are no change.
     pub slope: f64,
+    /// The drift of CPU time between two runs of the same code allowed on top of `ratio` for the
+    /// rows that divide by CPU time: their band is widened by the factor `1 + time`.
+    pub time: f64,
 }
 
 impl Default for Margins {
     fn default() -> Self {
-        Margins { ratio: change::DEFAULT_MARGIN, slope: change::DEFAULT_SLOPE_MARGIN }
+        Margins {
+            ratio: change::DEFAULT_MARGIN,
+            slope: change::DEFAULT_SLOPE_MARGIN,
+            time: change::DEFAULT_TIME_MARGIN,
+        }
+    }
+}
+
+impl Margins {
+    /// The margin of no change of `metric`'s ratio ([`Metric::margin`], widened by the CPU-time
+    /// drift [`Margins::time`] for the timing rows).
+    pub fn of(&self, metric: Metric) -> f64 {
+        let m = metric.margin(self.ratio);
+        if metric.timing() {
+            (1.0 + m) * (1.0 + self.time) - 1.0
+        } else {
+            m
+        }
     }
 }
 
@@ -96,6 +116,8 @@ pub struct Comparison {
     pub margin: f64,
     /// The margin of no change for slope differences.
     pub slope_margin: f64,
+    /// The CPU-time drift the timing rows allow ([`Margins::time`]).
+    pub time_margin: f64,
     /// Experiments compared.
     pub experiments: Vec<String>,
     /// Notes (experiments or cells in one run only, pairing, timing).
@@ -140,6 +162,7 @@ pub fn compare(a: &Side, b: &Side, margins: Margins) -> Result<Comparison> {
         b_dir: b.dir.display().to_string(),
         margin: margins.ratio,
         slope_margin: margins.slope,
+        time_margin: margins.time,
         experiments: common.into_iter().cloned().collect(),
         notes,
         changes,
@@ -221,7 +244,7 @@ fn experiment_changes(a: &Experiment, b: &Experiment, m: Margins, notes: &mut Ve
                 Some(i) => {
                     (c.change, c.change_lo, c.change_hi, c.paired, c.method) =
                         (i.change, i.lo, i.hi, i.paired, i.method);
-                    c.verdict = change::decide_ratio(i.lo, i.hi, metric.margin(m.ratio), metric.higher_is_better());
+                    c.verdict = change::decide_ratio(i.lo, i.hi, m.of(metric), metric.higher_is_better());
                 }
                 None => c.note = "no interval: the metric is not defined on every resample".into(),
             }

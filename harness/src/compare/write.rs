@@ -62,13 +62,14 @@ pub fn place(c: &Change) -> String {
 pub fn summary(c: &Comparison) -> String {
     let counts: Vec<String> = c.counts().iter().map(|(v, n)| format!("{n} {}", v.word())).collect();
     let mut s = format!(
-        "compare {} -> {}: {} rows: {} (no change: ratios within ±{}%, slopes within ±{})\n",
+        "compare {} -> {}: {} rows: {} (no change: ratios within ±{}%, slopes within ±{}, CPU-time rows x{} wider)\n",
         c.a,
         c.b,
         c.changes.len(),
         counts.join(", "),
         c.margin * 100.0,
-        c.slope_margin
+        c.slope_margin,
+        1.0 + c.time_margin
     );
     let regressed: Vec<&Change> = c.changes.iter().filter(|r| r.verdict == ChangeVerdict::Regressed).collect();
     if !regressed.is_empty() {
@@ -119,6 +120,7 @@ mod tests {
             b_dir: "r/new".into(),
             margin: 0.1,
             slope_margin: 0.1,
+            time_margin: 0.25,
             experiments: vec!["x".into()],
             notes: vec![],
             changes,

@@ -14,6 +14,10 @@ pub use tally::Tally;
 
 /// Width of the experiment-name column of the one-line summaries.
 const NAME_WIDTH: usize = 15;
+/// The claims that did not hold listed at the end of a run; the rest are counted.
+const MOST_CLAIMS: usize = 30;
+/// The contradicting unbiasedness decisions listed at the end of a run; the rest are counted.
+const MOST_CONTRADICTING: usize = 5;
 
 /// The width tables are fitted to: the terminal's, else `COLUMNS`, else 120 characters.
 pub fn terminal_width() -> usize {
@@ -54,19 +58,25 @@ pub fn totals(tallies: &[Tally], wall_seconds: f64, cpu_seconds: f64, width: usi
     tallies.iter().for_each(|t| all.add(t));
     let line = format!("{} in {wall_seconds:.1} s ({cpu_seconds:.1} CPU-s): ", all.experiment);
     out.push_str(&format!("\n{}\n", cut(&(line + &all.claims_text() + "; " + &all.tests_text()), width)));
-    let list = |out: &mut String, title: &str, lines: Vec<&String>| {
+    let list = |out: &mut String, title: &str, lines: Vec<&String>, most: usize, rest: &str| {
         if !lines.is_empty() {
             out.push_str(&format!("{title} ({}):\n", lines.len()));
-            for l in lines {
+            for l in lines.iter().take(most) {
                 out.push_str(&format!("  {}\n", cut(l, width.saturating_sub(2))));
+            }
+            if lines.len() > most {
+                out.push_str(&format!("  ... and {} more {rest}\n", lines.len() - most));
             }
         }
     };
-    list(&mut out, "claims that did not hold", tallies.iter().flat_map(|t| &t.not_held).collect());
+    let not_held = tallies.iter().flat_map(|t| &t.not_held).collect();
+    list(&mut out, "claims that did not hold", not_held, MOST_CLAIMS, "(claims.csv)");
     list(
         &mut out,
         "unbiasedness decisions that contradict the estimator's registered claim",
         tallies.iter().flat_map(|t| &t.contradicting).collect(),
+        MOST_CONTRADICTING,
+        "(tests.csv: the combined rows with agrees = false and verdict pass or biased)",
     );
     if all.inconclusive > 0 {
         out.push_str(&cut(
@@ -220,6 +230,11 @@ mod tests {
         assert!(text.contains("claims that did not hold (2):"), "{text}");
         assert!(text.contains("inconclusive test: "), "{text}");
         assert!(text.lines().all(|l| l.chars().count() <= 80), "{text}");
+        let mut many = Tally::of(&r, 1.0);
+        many.contradicting = (0..9).map(|i| format!("row {i}")).collect();
+        let text = totals(&[many], 1.0, 1.0, 200);
+        assert!(text.contains("(9):\n  row 0\n") && text.contains("  ... and 4 more (tests.csv"), "{text}");
+        assert!(!text.contains("row 5"), "{text}");
         let quiet = totals(&[], 0.0, 0.0, 80);
         assert_eq!(quiet.lines().filter(|l| !l.is_empty()).count(), 1, "nothing to list: one line\n{quiet}");
     }
