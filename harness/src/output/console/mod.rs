@@ -19,15 +19,19 @@ const MOST_CLAIMS: usize = 30;
 /// The contradicting unbiasedness decisions listed at the end of a run; the rest are counted.
 const MOST_CONTRADICTING: usize = 5;
 
-/// The width tables are fitted to: the terminal's, else `COLUMNS`, else 120 characters.
+/// The width lines are cut to and tables fitted to: the terminal's, else `COLUMNS`, else (output
+/// to a file or a pipe) [`OFF_TERMINAL_WIDTH`].
 pub fn terminal_width() -> usize {
     let term = console::Term::stdout();
     term.size_checked()
         .map(|(_, w)| w as usize)
         .or_else(|| std::env::var("COLUMNS").ok().and_then(|c| c.parse().ok()))
         .filter(|w| *w >= 40)
-        .unwrap_or(120)
+        .unwrap_or(OFF_TERMINAL_WIDTH)
 }
+
+/// The width off a terminal: wide enough that a log keeps whole claim lines.
+pub const OFF_TERMINAL_WIDTH: usize = 200;
 
 /// Prints one experiment's run that took `seconds`: its line, and with `verbose` its tables
 /// first. Returns what was counted, for [`print_totals`].
@@ -54,7 +58,8 @@ pub fn print_totals(tallies: &[Tally], wall_seconds: f64, cpu_seconds: f64, repo
 /// The text of [`print_totals`] without the report line, each line cut to `width`.
 pub fn totals(tallies: &[Tally], wall_seconds: f64, cpu_seconds: f64, width: usize) -> String {
     let mut out = String::new();
-    let mut all = Tally { experiment: format!("{} experiments", tallies.len()), ..Tally::default() };
+    let n = tallies.len();
+    let mut all = Tally { experiment: format!("{n} experiment{}", if n == 1 { "" } else { "s" }), ..Tally::default() };
     tallies.iter().for_each(|t| all.add(t));
     let line = format!("{} in {wall_seconds:.1} s ({cpu_seconds:.1} CPU-s): ", all.experiment);
     out.push_str(&format!("\n{}\n", cut(&(line + &all.claims_text() + "; " + &all.tests_text()), width)));
