@@ -2,7 +2,7 @@
 //! variant, estimator, budget) present in both, the change from A to B in RMSE, the two
 //! efficiencies, FoM and the convergence slope, each with a 95% interval and a typed verdict
 //! ([`change`]), and a row for each unbiasedness verdict that changed. Runs of different test-bed
-//! parameters or references are refused ([`fingerprint`]). [`write`] writes `compare.csv`,
+//! parameters or references are refused ([`fingerprint`]). [`mod@write`] writes `compare.csv`,
 //! `compare.json` and `compare.html` and prints the summary; [`baseline`] keeps named copies of a
 //! run's results to compare against.
 
