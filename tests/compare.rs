@@ -5,34 +5,11 @@
 //! The planted changes are the versions of `planted_mc` in `experiments::planted`; a run is one
 //! in-process call of the CLI over a registry holding one version.
 
-use experiments::planted::{BIASED, CONFIG, NOISY, PLAIN};
+use experiments::planted::{run, BIASED, NOISY, PLAIN};
 use mcbench::compare::change::{ChangeVerdict, Metric};
 use mcbench::compare::{Change, Comparison};
-use mcbench::EstimatorEntry;
 use std::path::Path;
 use std::process::{Command, Output};
-
-/// Runs the sweep with `entry` as `planted_mc` at `seed` into `<dir>/<name>`.
-fn run(dir: &Path, name: &str, entry: &'static EstimatorEntry, seed: u64) {
-    let config = dir.join("cmp.toml");
-    std::fs::write(&config, CONFIG).expect("config");
-    let registry = experiments::planted::registry(entry);
-    let results = dir.join(name);
-    let args = [
-        "mcbench",
-        "run",
-        "--config",
-        config.to_str().expect("utf-8"),
-        "--seed",
-        &seed.to_string(),
-        "--no-plots",
-        "--integrals",
-        "none",
-        "--results",
-        results.to_str().expect("utf-8"),
-    ];
-    assert_eq!(mcbench::cli::main_with_args(registry, args), 0, "run {name}");
-}
 
 fn mcbench(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mcbench")).current_dir(dir).args(args).output().expect("binary runs")

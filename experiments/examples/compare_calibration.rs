@@ -10,33 +10,11 @@
 //! `cargo run --release -p experiments --example compare_calibration -- [pairs] [folder]`
 //! (default 50 pairs, in a temporary folder that is removed at the end).
 
-use experiments::planted::{self, BIASED, CONFIG, NOISY, PLAIN};
+use experiments::planted::{run, BIASED, NOISY, PLAIN};
 use mcbench::compare::change::{ChangeVerdict, Metric};
 use mcbench::compare::{compare, load, Comparison, Margins};
-use mcbench::EstimatorEntry;
 use std::collections::BTreeMap;
 use std::path::Path;
-
-fn run(dir: &Path, name: &str, entry: &'static EstimatorEntry, seed: u64) {
-    let config = dir.join("cmp.toml");
-    std::fs::write(&config, CONFIG).expect("config");
-    let results = dir.join(name);
-    let (c, r) = (config.to_string_lossy().to_string(), results.to_string_lossy().to_string());
-    let args = [
-        "mcbench",
-        "run",
-        "--config",
-        &c,
-        "--seed",
-        &seed.to_string(),
-        "--no-plots",
-        "--integrals",
-        "none",
-        "--results",
-        &r,
-    ];
-    assert_eq!(mcbench::cli::main_with_args(planted::registry(entry), args), 0, "run {name} failed");
-}
 
 fn side(dir: &Path, name: &str) -> load::Side {
     load::read_side(name, &dir.join(name)).expect("reads")

@@ -80,3 +80,17 @@ planted!(
 pub fn registry(version: &'static EstimatorEntry) -> Registry {
     crate::registry().with_estimator(version)
 }
+
+/// Runs [`CONFIG`] in process with `version` as `planted_mc` at `seed` into `<dir>/<name>` (the
+/// config written to `<dir>/cmp.toml`; no plots, no per-integral file). Panics when the run fails:
+/// for the comparison's test and calibration.
+pub fn run(dir: &std::path::Path, name: &str, version: &'static EstimatorEntry, seed: u64) {
+    let config = dir.join("cmp.toml");
+    std::fs::write(&config, CONFIG).expect("config");
+    let results = dir.join(name);
+    let (c, r) = (config.to_string_lossy().to_string(), results.to_string_lossy().to_string());
+    let seed = seed.to_string();
+    let args =
+        ["mcbench", "run", "--config", &c, "--seed", &seed, "--no-plots", "--integrals", "none", "--results", &r];
+    assert_eq!(mcbench::cli::main_with_args(registry(version), args), 0, "run {name} failed");
+}

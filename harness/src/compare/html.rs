@@ -28,14 +28,7 @@ fn rows(changes: &[&Change]) -> Vec<(String, Vec<Cell>)> {
                     Cell::num(&number(c.b)),
                     Cell::num(&describe(c)),
                     Cell::html(markup::badge(c.verdict.word())),
-                    Cell::text(
-                        &[c.method.as_str(), c.note.as_str()]
-                            .iter()
-                            .filter(|s| !s.is_empty())
-                            .copied()
-                            .collect::<Vec<_>>()
-                            .join("; "),
-                    ),
+                    Cell::text(&crate::output::report::join_present(&[c.method.as_str(), c.note.as_str()])),
                 ],
             )
         })

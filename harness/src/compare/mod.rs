@@ -249,12 +249,7 @@ fn experiment_changes(a: &Experiment, b: &Experiment, m: Margins, notes: &mut Ve
                 None => c.note = "no interval: the metric is not defined on every resample".into(),
             }
             if metric.timing() {
-                c.note = [c.note.as_str(), TIMING_NOTE]
-                    .iter()
-                    .filter(|s| !s.is_empty())
-                    .copied()
-                    .collect::<Vec<_>>()
-                    .join("; ");
+                c.note = crate::output::report::join_present(&[c.note.as_str(), TIMING_NOTE]);
             }
             out.push(c);
         }

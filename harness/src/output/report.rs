@@ -10,7 +10,7 @@ pub mod digest;
 mod format;
 pub mod tables;
 
-pub use format::{count, interval, markdown_table, md_target, md_text, opt, relative_path, shorten, sig};
+pub use format::{count, interval, join_present, markdown_table, md_target, md_text, opt, relative_path, shorten, sig};
 pub use tables::write_tables;
 
 use crate::error::Result;

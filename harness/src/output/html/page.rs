@@ -141,14 +141,7 @@ fn claims(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
                 Cell::num(&opt(c.our_value)),
                 Cell::num(&interval(c.interval)),
                 Cell::html(badge(c.verdict().as_str())),
-                Cell::text(
-                    &[c.pair.as_str(), c.regime.as_str()]
-                        .iter()
-                        .filter(|s| !s.is_empty())
-                        .copied()
-                        .collect::<Vec<_>>()
-                        .join("; "),
-                ),
+                Cell::text(&crate::output::report::join_present(&[c.pair.as_str(), c.regime.as_str()])),
                 Cell::html(note_html(&note)),
             ];
             (verdict_class(c.verdict().as_str()), cells)

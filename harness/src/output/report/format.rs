@@ -76,6 +76,11 @@ pub fn md_text(text: &str) -> String {
     out
 }
 
+/// The non-empty `parts` joined by `"; "` (a note made of optional pieces).
+pub fn join_present(parts: &[&str]) -> String {
+    parts.iter().filter(|s| !s.is_empty()).copied().collect::<Vec<_>>().join("; ")
+}
+
 /// A GitHub-flavoured markdown table with padded columns (readable as plain text too). Rows
 /// shorter than the header are padded with empty cells; every cell is escaped ([`md_text`]).
 pub fn markdown_table(header: &[&str], rows: &[Vec<String>]) -> String {
