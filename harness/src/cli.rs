@@ -349,7 +349,7 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             let t0 = Instant::now();
             let out = crate::run::merge::merge(&dirs, &opts)?;
             let seconds = t0.elapsed().as_secs_f64();
-            let tally = crate::output::console::print_experiment(&out.report, seconds, verbose);
+            let tally = crate::output::console::print_experiment(&out.report, seconds, verbose, registry);
             let report = (!no_plots).then(|| out.plots_dir.join("index.html"));
             crate::output::console::print_totals(
                 &[tally],
@@ -466,7 +466,12 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         let out = execute::execute_checked(plan, *def, &opts, pre)?;
         progress.finish();
         t.add(&crate::run::phases::take());
-        tallies.push(crate::output::console::print_experiment(&out.report, t0.elapsed().as_secs_f64(), args.verbose));
+        tallies.push(crate::output::console::print_experiment(
+            &out.report,
+            t0.elapsed().as_secs_f64(),
+            args.verbose,
+            registry,
+        ));
         if args.verbose {
             println!("results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             println!("time: {}", t.line());

@@ -9,6 +9,7 @@ pub mod tally;
 use crate::output::query::Query;
 use crate::output::report::sig;
 use crate::output::RunReport;
+use crate::registry::Registry;
 use comfy_table::{presets::UTF8_FULL_CONDENSED, ColumnConstraint, ContentArrangement, Table};
 pub use tally::Tally;
 
@@ -35,8 +36,8 @@ pub const OFF_TERMINAL_WIDTH: usize = 200;
 
 /// Prints one experiment's run that took `seconds`: its line, and with `verbose` its tables
 /// first. Returns what was counted, for [`print_totals`].
-pub fn print_experiment(r: &RunReport, seconds: f64, verbose: bool) -> Tally {
-    let tally = Tally::of(r, seconds);
+pub fn print_experiment(r: &RunReport, seconds: f64, verbose: bool, registry: &Registry) -> Tally {
+    let tally = Tally::of(r, seconds, registry);
     if verbose {
         print!("{}", tables(r, seconds, terminal_width()));
     }
@@ -227,15 +228,15 @@ mod tests {
         r.paper[0].verdict = Some(crate::verdict::Verdict::NotHeld);
         r.tests[0].test = "combined".into();
         r.tests[0].verdict = "inconclusive".into();
-        let t = Tally::of(&r, 2.0);
+        let t = Tally::of(&r, 2.0, &Registry::empty());
         let text = totals(&[t.clone(), t], 4.0, 3.5, 80);
         assert!(text.contains("2 experiments in 4.0 s (3.5 CPU-s): claims 2 not held; tests 0 pass"), "{text}");
-        let wide = totals(&[Tally::of(&r, 2.0)], 2.0, 1.0, 200);
+        let wide = totals(&[Tally::of(&r, 2.0, &Registry::empty())], 2.0, 1.0, 200);
         assert!(wide.contains("(paper -0.940, ours -0.900)"), "{wide}");
         assert!(text.contains("claims that did not hold (2):"), "{text}");
         assert!(text.contains("inconclusive test: "), "{text}");
         assert!(text.lines().all(|l| l.chars().count() <= 80), "{text}");
-        let mut many = Tally::of(&r, 1.0);
+        let mut many = Tally::of(&r, 1.0, &Registry::empty());
         many.contradicting = (0..9).map(|i| format!("row {i}")).collect();
         let text = totals(&[many], 1.0, 1.0, 200);
         assert!(text.contains("(9):\n  row 0\n") && text.contains("  ... and 4 more (tests.csv"), "{text}");
