@@ -170,6 +170,8 @@ fn the_binary_compares_saves_and_uses_baselines_and_refuses_bad_input() {
     let o = mcbench(d, &["run", "--config", "other.toml", "--no-plots", "--results", "other"]);
     assert_eq!(o.status.code(), Some(0));
     bad(&["compare", "results/tiny", "other/tiny"], "gradient-plane");
+    // A run whose test bed differs from the baseline's is refused before it writes anything.
+    bad(&["run", "--config", "other.toml", "--no-plots", "--baseline", "before"], "test bed gradient-plane/default");
 }
 
 /// The list after `<!-- contract: NAME -->` in the contract chapter.

@@ -432,6 +432,14 @@ fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Result<()> {
         integrals: args.integrals,
     };
     let baseline = baseline_checks(args)?;
+    if let (Some(a), Some(name)) = (&baseline, &args.baseline) {
+        for (_, plan) in &prepared {
+            if let Some(e) = a.experiments.get(&plan.sweep.experiment) {
+                let planned: Vec<_> = plan.beds.iter().map(crate::compare::fingerprint::BedPrint::of).collect();
+                crate::compare::fingerprint::check_planned(name, e, &planned)?;
+            }
+        }
+    }
     // Everything every experiment of the call will read is checked before the first one writes.
     let mut checked = Vec::new();
     for ((def, plan), t) in prepared.iter().zip(&mut times) {

@@ -68,8 +68,40 @@ fn prints(report: &crate::output::RunReport) -> Vec<BedPrint> {
 /// Refuses two runs of one experiment that measured a (test bed, variant) of both with different
 /// parameters, integrals or references: one line naming B's summary and the test bed.
 pub fn check(a: &super::load::Experiment, b: &super::load::Experiment) -> crate::error::Result<()> {
-    let (pa, pb) = (prints(&a.report), prints(&b.report));
-    for x in &pa {
+    match difference(&prints(&a.report), &prints(&b.report)) {
+        None => Ok(()),
+        Some((bed, what)) => Err(crate::error::HarnessError::bad_file(
+            b.dir.join("summary.json"),
+            format!(
+                "test bed {bed} differs from the one in {} ({what}): runs of different test beds or references are not compared",
+                a.dir.display()
+            ),
+        )),
+    }
+}
+
+/// Before a run with `--baseline NAME`: refuses (exit 2, nothing written) a planned experiment
+/// whose test beds `planned` differ from those of the baseline's run of it, `a` (parameters,
+/// integrals or references), so that a run that could not be compared does not start.
+pub fn check_planned(name: &str, a: &super::load::Experiment, planned: &[BedPrint]) -> crate::error::Result<()> {
+    match difference(&prints(&a.report), planned) {
+        None => Ok(()),
+        Some((bed, what)) => Err(mcbench_core::error::ConfigError::invalid(
+            "--baseline",
+            name,
+            format!(
+                "test bed {bed} of experiment {} differs from the baseline's ({what}): runs of different test beds or references are not compared",
+                a.report.meta.experiment
+            ),
+        )
+        .into()),
+    }
+}
+
+/// The first (test bed, variant) of both `pa` and `pb` whose parameters, integrals or references
+/// differ, as `testbed/variant` and what differs.
+fn difference(pa: &[BedPrint], pb: &[BedPrint]) -> Option<(String, String)> {
+    for x in pa {
         let Some(y) = pb.iter().find(|y| y.testbed == x.testbed && y.variant == x.variant) else { continue };
         let what = if x.testbed_params != y.testbed_params {
             Some(format!("parameters {} and {}", x.testbed_params, y.testbed_params))
@@ -81,18 +113,10 @@ pub fn check(a: &super::load::Experiment, b: &super::load::Experiment) -> crate:
             None
         };
         if let Some(what) = what {
-            return Err(crate::error::HarnessError::bad_file(
-                b.dir.join("summary.json"),
-                format!(
-                    "test bed {}/{} differs from the one in {} ({what}): runs of different test beds or references are not compared",
-                    x.testbed,
-                    x.variant,
-                    a.dir.display()
-                ),
-            ));
+            return Some((format!("{}/{}", x.testbed, x.variant), what));
         }
     }
-    Ok(())
+    None
 }
 
 #[cfg(test)]
