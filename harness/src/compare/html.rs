@@ -1,6 +1,6 @@
-//! `compare.html`: one self-contained page (inline style, no script, no network) in the report's
-//! frame: what was compared and how, the counts per verdict, the changed rows (regressed, then
-//! improved), and every row.
+//! `compare.html`: one self-contained page (inline style, the report's inline table script that
+//! sorts and filters the tables, no network) in the report's frame: what was compared and how, the
+//! counts per verdict, the changed rows (regressed, then improved), and every row.
 
 use super::change::ChangeVerdict;
 use super::write::describe;
@@ -101,6 +101,9 @@ mod tests {
         };
         let p = super::page(&c);
         assert!(p.contains("&lt;old&gt;") && p.contains("a &amp; b") && !p.contains("<old>"));
-        assert!(!p.contains("http://") && !p.contains("https://") && !p.contains("<script"));
+        assert!(!p.contains("http://") && !p.contains("https://"));
+        let explore = crate::output::html::explore::SCRIPT_ID;
+        assert_eq!(p.matches("<script").count(), 1, "only the table script");
+        assert_eq!(p.matches(&format!("<script id=\"{explore}\">")).count(), 1, "the table script once");
     }
 }
