@@ -2,7 +2,7 @@
 //! sorts and filters the tables, no network) in the report's frame: what was compared and how, the
 //! counts per verdict, the changed rows (regressed, then improved), and every row.
 
-use super::change::ChangeVerdict;
+use super::change::{ChangeVerdict, Metric};
 use super::write::describe;
 use super::{Change, Comparison};
 use crate::output::html::markup::{self, esc, Cell};
@@ -26,7 +26,10 @@ fn rows(changes: &[&Change]) -> Vec<(String, Vec<Cell>)> {
                     Cell::text(&format!("{}{timing}", c.metric.name())),
                     Cell::num(&number(c.a)),
                     Cell::num(&number(c.b)),
-                    Cell::num(&describe(c)),
+                    match c.metric {
+                        Metric::Slope | Metric::Unbiasedness => Cell::num(&describe(c)),
+                        _ => markup::interval_cell(&describe(c), Some([c.change_lo, c.change_hi])),
+                    },
                     Cell::html(markup::badge(c.verdict.word())),
                     Cell::text(&crate::output::report::join_present(&[c.method.as_str(), c.note.as_str()])),
                 ],

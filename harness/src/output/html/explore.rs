@@ -1,6 +1,7 @@
 //! The one inline script of every report page: each table with a header becomes sortable by a
 //! click on a header (numbers, percentages and `1.2e-3` by value, text by its words, empty and `-`
-//! cells last in either direction; stable; an arrow marks the sorted column), and each table of
+//! cells last in either direction; a cell of the `num` class by its first number, as in
+//! `x2.5 [1.2, 4.8]`; stable; an arrow marks the sorted column), and each table of
 //! more than [`FILTER_ROWS`] rows gets a text box above it that hides the rows not containing the
 //! text, with a count of the rows shown. Without the script the tables are plain tables.
 
@@ -16,7 +17,7 @@ const SOURCE: &str = r#"(function () {
   function key(cell) {
     var t = cell ? cell.textContent.trim() : '';
     if (t === '' || t === '-' || t === '\u2013') return null;
-    var lead = t.replace(/^\[/, '').split(/[\s\u00b1\[,;]/)[0];
+    var lead = t.replace(/^[\[x\u00d7]/, '').split(/[\s\u00b1\[,;]/)[0];
     if (NUM.test(t) || (cell.classList.contains('num') && NUM.test(lead))) {
       var n = parseFloat((NUM.test(t) ? t : lead).replace(/,/g, ''));
       if (!isNaN(n)) return n;

@@ -33,6 +33,9 @@ pub struct ClaimLine {
     pub interval: Option<[f64; 2]>,
     /// The verdict.
     pub verdict: Verdict,
+    /// The p-value of a claim judged by a test (absent in pages drawn before it).
+    #[serde(default)]
+    pub p_value: Option<f64>,
 }
 
 impl From<&Claim> for ClaimLine {
@@ -44,6 +47,7 @@ impl From<&Claim> for ClaimLine {
             our_value: c.our_value,
             interval: c.interval,
             verdict: c.verdict(),
+            p_value: c.p_value,
         }
     }
 }
@@ -162,12 +166,14 @@ fn claims_table(o: &Overview) -> String {
     let rows = shown
         .iter()
         .map(|c| {
-            let ours = format!("{} {}", opt(c.our_value), interval(c.interval));
+            let value = if c.p_value.is_some() && c.our_value == c.p_value { None } else { c.our_value };
+            let ours = format!("{} {}", opt(value), interval(c.interval));
             let cells = vec![
                 Cell::text(&c.claim),
                 Cell::text(&c.testbed),
                 Cell::num(&opt(c.paper_value)),
                 interval_cell(ours.trim(), c.interval),
+                Cell::num(&c.p_value.map_or_else(|| "-".to_string(), |p| format!("{p:.2e}"))),
                 Cell::html(badge(c.verdict.as_str())),
             ];
             (verdict_class(c.verdict.as_str()), cells)
@@ -183,7 +189,7 @@ fn claims_table(o: &Overview) -> String {
         );
     }
     if !shown.is_empty() {
-        out.push_str(&table(&["claim", "testbed", "paper", "ours (95% interval)", "verdict"], rows));
+        out.push_str(&table(&["claim", "testbed", "paper", "ours (95% interval)", "p-value", "verdict"], rows));
     }
     out
 }

@@ -9,6 +9,7 @@
 //! result files, the per-integral rows of the largest budget); nothing in them is specific to
 //! one experiment.
 
+mod contents;
 pub mod estimators;
 pub mod explore;
 mod groups;

@@ -82,7 +82,7 @@ pub fn render(report: &RunReport, ctx: &Context<'_>) -> crate::error::Result<Str
     tests(&mut rest, report, ctx);
     skipped(&mut rest, report);
     files(&mut rest, ctx);
-    b.push_str(&contents(report, ctx, &sections));
+    b.push_str(&super::contents::render(report, ctx.figures.len(), &sections));
     b.push_str(&rest);
     b.push_str(&super::index::embed(&super::Overview::of(report, ctx.figures.len()))?);
     let mut nav = vec![("../index.html".to_string(), "all experiments".to_string())];
@@ -92,34 +92,6 @@ pub fn render(report: &RunReport, ctx: &Context<'_>) -> crate::error::Result<Str
     nav.extend(sections);
     nav.extend([("#skipped".to_string(), "skipped".to_string()), ("#files".to_string(), "files".to_string())]);
     Ok(page(&format!("mcbench: {}", m.experiment), &nav, &b))
-}
-
-/// The table of contents: each section with what it holds in a few words (the verdict counts of
-/// the claims and tests, the number of figures, fits and skipped pairs).
-fn contents(report: &RunReport, ctx: &Context<'_>, sections: &[(String, String)]) -> String {
-    let mut toc = String::from("<div class=\"toc\" id=\"contents\"><b>Contents</b>\n<ol>\n");
-    let beds: Vec<String> = sections.iter().map(|(h, t)| format!("<a href=\"{h}\">{}</a>", esc(t))).collect();
-    let _ = writeln!(
-        toc,
-        "<li><a href=\"#figures\">Figures</a> ({}){}</li>",
-        ctx.figures.len(),
-        if beds.is_empty() { String::new() } else { format!(": {}", beds.join(", ")) }
-    );
-    let claims = count_badges(&digest::claim_counts(&report.paper));
-    let _ = writeln!(toc, "<li><a href=\"#claims\">Claims</a> {claims}</li>");
-    let _ = writeln!(
-        toc,
-        "<li><a href=\"#fits\">Convergence fits and speed-ups</a> ({} fits, {} speed-ups)</li>",
-        report.fits.len(),
-        report.speedups.len()
-    );
-    let deciding = digest::deciding(&report.tests);
-    let tests = count_badges(&digest::tally(deciding.iter().map(|t| t.verdict.as_str()), &digest::TEST_VERDICTS));
-    let _ = writeln!(toc, "<li><a href=\"#tests\">Unbiasedness tests</a> {tests}</li>");
-    let _ =
-        writeln!(toc, "<li><a href=\"#skipped\">What did not run</a> ({} pairs skipped)</li>", report.skipped.len());
-    toc.push_str("<li><a href=\"#files\">Files</a></li>\n</ol></div>\n");
-    toc
 }
 
 fn meta(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
