@@ -88,11 +88,13 @@ fn render(estimator: &str, rows: &[(&str, &EstimatorLine)]) -> String {
     let experiments: std::collections::BTreeSet<&str> = rows.iter().map(|(e, _)| *e).collect();
     let _ = writeln!(
         body,
-        "<p class=\"muted\">Where {} ran under this plots root: {} test beds and variants in {} experiments, each at \
+        "<p class=\"muted\">Where {} ran under this plots root: {} (test bed, variant) {} in {} experiment{}, each at \
          its largest budget (every budget is in the experiment's summary.csv).</p>",
         esc(estimator),
         rows.len(),
-        experiments.len()
+        if rows.len() == 1 { "pair" } else { "pairs" },
+        experiments.len(),
+        if experiments.len() == 1 { "" } else { "s" }
     );
     let cells = rows
         .iter()
