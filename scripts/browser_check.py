@@ -8,13 +8,18 @@ For each page (loaded from disk as a file:// URL):
   the browser (a resource that failed to load is one);
 - no network: the page requests nothing but file:, data: and about: URLs;
 - every relative link (a[href], link[href]) and image source (img[src], script[src]) resolves
-  to an existing file or folder, and every in-page anchor (#id) to an element with that id.
+  to an existing file or folder, and every in-page anchor (#id) to an element with that id;
+- the tables work: a click on a header sorts the rows (a column of numbers ascending, an arrow on
+  the header) and a second click reverses them, and a table of more than 20 rows has a filter box
+  that hides the rows without its text, says how many are shown, and shows them all when cleared.
 
 Chromium runs with the flags a closed network needs and a fresh profile, and is driven through
 the DevTools protocol over a pipe (--remote-debugging-pipe: no port, no extra Python package).
 Prints one line per problem (`page: what`) and exits 1 when there is any, 2 when Chromium cannot
 be started. `--self-test` first checks that the checker catches a planted script error, broken
-link, broken image, missing anchor, network request and blank page, and passes a good page.
+link, broken image, missing anchor, network request and blank page, and the report's table script
+(read from harness/src/output/html/explore.rs) with its sort or its filter broken, and passes a
+good page and a table with the working script.
 
 Usage: python3 scripts/browser_check.py [--chromium PATH] [--screenshots DIR] [--self-test] PAGE...
 """
@@ -56,6 +61,60 @@ REFERENCES_JS = """JSON.stringify([].concat(
   [...document.querySelectorAll('img[src]')].map(e => ['image', e.getAttribute('src')]),
   [...document.querySelectorAll('script[src]')].map(e => ['script', e.getAttribute('src')]),
   [...document.querySelectorAll('[id]')].map(e => ['id', e.id])))"""
+
+# Every table with a header row: a click on the first header over a column of at least two distinct
+# values must sort it (a column of plain numbers ascending) with an arrow on the header, and a
+# second click must reverse it; a table of more than FILTER_ROWS rows must have a filter box above
+# it that, given a cell's text, hides the rows without it and counts the rows shown, and shows every
+# row again when cleared. Returns the problems and how many tables were sorted and filtered.
+FILTER_ROWS = 20
+TABLES_JS = """(() => {
+  const problems = []; let sorted = 0, filtered = 0;
+  const rowsOf = t => [...t.tBodies[0].rows];
+  const column = (t, i) => rowsOf(t).map(r => r.cells[i] ? r.cells[i].textContent.trim() : '');
+  const tables = [...document.querySelectorAll('table')].filter(t => t.tHead && t.tHead.rows.length && t.tBodies.length);
+  tables.forEach((t, n) => {
+    const ths = [...t.tHead.rows[0].cells];
+    const name = 'table ' + (n + 1) + ' (' + ths.slice(0, 3).map(h => h.textContent.trim()).join(', ') + ')';
+    const rows = rowsOf(t).length;
+    const i = ths.findIndex((h, i) => new Set(column(t, i).filter(v => v !== '' && v !== '-')).size > 1);
+    if (i >= 0) {
+      const head = '"' + ths[i].textContent.trim() + '"';
+      ths[i].click();
+      const once = column(t, i);
+      const arrow = getComputedStyle(ths[i], '::after').content;
+      ths[i].click();
+      const twice = column(t, i);
+      if (once.join('\\n') === twice.join('\\n')) problems.push(name + ': a second click on ' + head + ' did not reverse the rows');
+      if (!/[\\u25b2\\u25bc]/.test(arrow)) problems.push(name + ': no arrow on the sorted header ' + head);
+      const nums = once.map(v => /^-?\\d+(\\.\\d+)?(e[-+]?\\d+)?$/i.test(v) ? Number(v) : NaN);
+      if (nums.every(x => !isNaN(x)) && nums.some((x, k) => k > 0 && x < nums[k - 1]))
+        problems.push(name + ': a click on ' + head + ' did not sort its numbers ascending: ' + once.slice(0, 5).join(', '));
+      sorted++;
+    }
+    if (rows > """ + str(FILTER_ROWS) + """) {
+      const at = t.parentElement.classList.contains('scroll') ? t.parentElement : t;
+      const box = at.previousElementSibling, input = box && box.querySelector('input');
+      if (!input) { problems.push(name + ': ' + rows + ' rows and no filter box above it'); return; }
+      const lower = r => r.textContent.toLowerCase();
+      let q = null;
+      for (const r of rowsOf(t)) for (const c of r.cells) {
+        const w = c.textContent.trim().toLowerCase();
+        if (q === null && w && rowsOf(t).some(x => !lower(x).includes(w))) q = w;
+      }
+      if (q === null) return;
+      input.value = q; input.dispatchEvent(new Event('input'));
+      const shown = rowsOf(t).filter(r => !r.hidden && getComputedStyle(r).display !== 'none').length;
+      const want = rowsOf(t).filter(r => lower(r).includes(q)).length;
+      if (shown !== want) problems.push(name + ': filtering on "' + q + '" shows ' + shown + ' rows, ' + want + ' contain it');
+      if (!box.textContent.includes(shown + ' of ' + rows + ' rows')) problems.push(name + ': the filter box does not say "' + shown + ' of ' + rows + ' rows": ' + box.textContent);
+      input.value = ''; input.dispatchEvent(new Event('input'));
+      if (rowsOf(t).some(r => r.hidden)) problems.push(name + ': clearing the filter did not show every row');
+      filtered++;
+    }
+  });
+  return JSON.stringify({problems: problems, sorted: sorted, filtered: filtered});
+})()"""
 
 
 class BrowserError(Exception):
@@ -233,6 +292,19 @@ def reference_problems(browser: Browser, session: str, page: Path) -> list[str]:
     return out
 
 
+TABLES_CHECKED = {"sorted": 0, "filtered": 0}
+
+
+def table_problems(browser: Browser, session: str) -> list[str]:
+    result = browser.call("Runtime.evaluate", {"expression": TABLES_JS, "returnByValue": True}, session)
+    if "exceptionDetails" in result:
+        return [f"the table check failed: {result['exceptionDetails'].get('text', 'exception')}"]
+    found = json.loads(result["result"]["value"])
+    TABLES_CHECKED["sorted"] += found["sorted"]
+    TABLES_CHECKED["filtered"] += found["filtered"]
+    return found["problems"]
+
+
 def check(browser: Browser, pages: list[Path], screenshots: Path | None) -> list[str]:
     blank_session, blank = load(browser, "about:blank")
     problems = []
@@ -244,6 +316,7 @@ def check(browser: Browser, pages: list[Path], screenshots: Path | None) -> list
         session, shot = load(browser, page.as_uri())
         what = [f"console: {m}" for m in console_errors(browser.events, session)]
         what += reference_problems(browser, session, page)
+        what += table_problems(browser, session)
         if len(shot) <= len(blank) * 2:
             what.append(f"the screenshot ({len(shot)} bytes) is no larger than twice a blank page's ({len(blank)} bytes)")
         if screenshots:
@@ -252,6 +325,18 @@ def check(browser: Browser, pages: list[Path], screenshots: Path | None) -> list
             (screenshots / name).write_bytes(shot)
         problems += [f"{page}: {w}" for w in what]
     return problems
+
+
+def report_table_script() -> tuple[str, str]:
+    """The report's table script and its style, as the Rust source holds them
+    (harness/src/output/html/explore.rs)."""
+    source = (Path(__file__).resolve().parent.parent / "harness/src/output/html/explore.rs").read_text()
+
+    def constant(name: str) -> str:
+        start = source.index(f'const {name}: &str = r#"') + len(f'const {name}: &str = r#"')
+        return source[start : source.index('"#;', start)]
+
+    return constant("SOURCE").replace("@ROWS@", str(FILTER_ROWS)), constant("STYLE")
 
 
 def self_test(chromium: str) -> int:
@@ -268,11 +353,25 @@ def self_test(chromium: str) -> int:
         )
         (d / "bad.html").write_text(bad)
         (d / "blank.html").write_text("<!DOCTYPE html><html><body></body></html>")
+        script, style = report_table_script()
+        broken = {"broken sort": ("body.appendChild(x[2])", "void x"), "broken filter": ("r.hidden = !keep", "void keep")}
+        for what, (part, replacement) in broken.items():
+            if part not in script:
+                print(f"browser_check self-test: the report's table script has no {part!r} to break for the {what}")
+                return 1
+        table = "<table><thead><tr><th>name</th><th>value</th></tr></thead><tbody>" + "".join(
+            f"<tr><td>row {k}</td><td class='num'>{(k * 7) % 25 + 0.5}</td></tr>" for k in range(25)
+        ) + "</tbody></table>"
+        for name, text in [("tables", script), *((what, script.replace(*b)) for what, b in broken.items())]:
+            page = f"<!DOCTYPE html><html><head><style>{style}</style></head><body>{body}<div class='scroll'>{table}</div><script>{text}</script></body></html>"
+            (d / f"{name.replace(' ', '-')}.html").write_text(page)
         browser = Browser(chromium)
         try:
-            good = check(browser, [d / "good.html"], None)
+            good = check(browser, [d / "good.html", d / "tables.html"], None)
             bad_found = check(browser, [d / "bad.html"], None)
             blank_found = check(browser, [d / "blank.html"], None)
+            sort_found = check(browser, [d / "broken-sort.html"], None)
+            filter_found = check(browser, [d / "broken-filter.html"], None)
         finally:
             browser.close()
     expected = {
@@ -287,12 +386,19 @@ def self_test(chromium: str) -> int:
     failures += [f"missed the planted {what}" for what, needle in expected.items() if not any(needle in p for p in bad_found)]
     if not any("screenshot" in p for p in blank_found):
         failures.append("missed the blank page")
+    if not any("did not reverse the rows" in p or "did not sort" in p for p in sort_found):
+        failures.append(f"missed the broken sort (found: {sort_found})")
+    if not any("filtering on" in p for p in filter_found):
+        failures.append(f"missed the broken filter (found: {filter_found})")
     for f in failures:
         print(f"browser_check self-test: {f}")
     if failures:
         print("browser_check self-test: what was found on the bad page:\n  " + "\n  ".join(bad_found))
         return 1
-    print(f"browser_check self-test: ok ({len(expected)} planted faults and a blank page caught, the good page passed)")
+    print(
+        f"browser_check self-test: ok ({len(expected)} planted faults, a blank page, a broken table sort and a broken "
+        "filter caught; the good pages passed)"
+    )
     return 0
 
 
@@ -311,6 +417,7 @@ def main() -> int:
             return 1
         if not args.pages:
             return 0
+        TABLES_CHECKED.update(sorted=0, filtered=0)
         browser = Browser(args.chromium)
         try:
             problems = check(browser, args.pages, args.screenshots)
@@ -323,7 +430,10 @@ def main() -> int:
         print(p)
     if problems:
         return 1
-    print(f"browser_check: {len(args.pages)} pages render with no console error, no network and no broken link")
+    print(
+        f"browser_check: {len(args.pages)} pages render with no console error, no network and no broken link; "
+        f"{TABLES_CHECKED['sorted']} tables sort and {TABLES_CHECKED['filtered']} filter"
+    )
     return 0
 
 

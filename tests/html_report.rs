@@ -1,8 +1,10 @@
 //! The HTML report without a browser (scripts/browser_check.py opens the same pages in headless
 //! Chromium in CI): a small run writes an experiment page and the plots root's index, every
-//! relative link and image source on them resolves, nothing comes from the network, the pages
-//! and the summary stay small, a second experiment keeps the first one's row in the root index,
-//! and `mcbench plot` redraws the pages (with the per-pixel maps) from the results folder alone.
+//! relative link and image source on them resolves, nothing comes from the network, each page
+//! runs its one table script only, the figures come before the long tables, the estimator pages
+//! resolve too, the pages and the summary stay small, a second experiment keeps the first one's
+//! row in the root index, and `mcbench plot` redraws the pages (with the per-pixel maps) from the
+//! results folder alone.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -53,7 +55,9 @@ fn assert_resolves(page: &Path) {
     }
     let scripts = html.matches("<script").count();
     let data = html.matches("<script type=\"application/json\"").count();
-    assert_eq!(scripts, data, "{}: the pages run no script (a data block only)", page.display());
+    let tables = html.matches("<script id=\"mcbench-explore\">").count();
+    assert_eq!(tables, 1, "{}: the table script once", page.display());
+    assert_eq!(scripts, data + 1, "{}: no script but the table script (and a data block)", page.display());
 }
 
 #[test]
@@ -83,6 +87,16 @@ fn a_run_writes_pages_whose_links_resolve_and_the_root_keeps_every_experiment() 
     ] {
         assert!(html.contains(needle), "the page lacks {needle}");
     }
+    // The figures come before the long tables; estimator names link to the estimator pages the root
+    // index wrote, and the root shows a thumbnail of the experiment's first figure.
+    assert!(html.find("<h2 id=\"figures\"").expect("figures") < html.find("<h2 id=\"claims\"").expect("claims"));
+    assert!(html.contains("href=\"../estimators/is1_cv2.html\""), "estimator names link to their pages");
+    for id in ["is0_cv0", "is1_cv2"] {
+        let estimator = d.join(format!("plots/estimators/{id}.html"));
+        assert_resolves(&estimator);
+        assert!(read(&estimator).contains("href=\"../browser-check/index.html\""), "{id}'s page lists the run");
+    }
+    assert!(read(&root).contains("<img class=\"thumb\" src=\"browser-check/"), "the root shows a thumbnail");
     let md = read(&d.join("plots/browser-check/report.md"));
     assert!(md.len() < 100_000 && md.contains("[index.html](index.html)"));
     // The long tables are result files, listed in the folder's commit.

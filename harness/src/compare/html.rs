@@ -1,8 +1,8 @@
-//! `compare.html`: one self-contained page (inline style, no script, no network) in the report's
-//! frame: what was compared and how, the counts per verdict, the changed rows (regressed, then
-//! improved), and every row.
+//! `compare.html`: one self-contained page (inline style, the report's inline table script that
+//! sorts and filters the tables, no network) in the report's frame: what was compared and how, the
+//! counts per verdict, the changed rows (regressed, then improved), and every row.
 
-use super::change::ChangeVerdict;
+use super::change::{ChangeVerdict, Metric};
 use super::write::describe;
 use super::{Change, Comparison};
 use crate::output::html::markup::{self, esc, Cell};
@@ -26,7 +26,10 @@ fn rows(changes: &[&Change]) -> Vec<(String, Vec<Cell>)> {
                     Cell::text(&format!("{}{timing}", c.metric.name())),
                     Cell::num(&number(c.a)),
                     Cell::num(&number(c.b)),
-                    Cell::num(&describe(c)),
+                    match c.metric {
+                        Metric::Slope | Metric::Unbiasedness => Cell::num(&describe(c)),
+                        _ => markup::interval_cell(&describe(c), Some([c.change_lo, c.change_hi])),
+                    },
                     Cell::html(markup::badge(c.verdict.word())),
                     Cell::text(&crate::output::report::join_present(&[c.method.as_str(), c.note.as_str()])),
                 ],
@@ -101,6 +104,9 @@ mod tests {
         };
         let p = super::page(&c);
         assert!(p.contains("&lt;old&gt;") && p.contains("a &amp; b") && !p.contains("<old>"));
-        assert!(!p.contains("http://") && !p.contains("https://") && !p.contains("<script"));
+        assert!(!p.contains("http://") && !p.contains("https://"));
+        let explore = crate::output::html::explore::SCRIPT_ID;
+        assert_eq!(p.matches("<script").count(), 1, "only the table script");
+        assert_eq!(p.matches(&format!("<script id=\"{explore}\">")).count(), 1, "the table script once");
     }
 }

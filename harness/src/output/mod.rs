@@ -124,6 +124,10 @@ pub struct Claim {
     /// resolve it).
     #[serde(default)]
     pub reason: String,
+    /// The p-value the verdict rests on, for a claim judged by a test (the largest p-value of a
+    /// control's rows, which `our_value` holds too); shown in a column of its own by the HTML page.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub p_value: Option<f64>,
 }
 
 impl Claim {

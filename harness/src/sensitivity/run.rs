@@ -191,5 +191,6 @@ fn outcome_claim(part: &Part, rows: &[&SettingRow], outcome: &Outcome) -> Claim 
         pair: row.map(|r| r.pair.clone()).unwrap_or_default(),
         regime: row.map(|r| r.regime.clone()).unwrap_or_default(),
         reason: format!("{}: {}", outcome.kind(), part.open),
+        p_value: None,
     }
 }

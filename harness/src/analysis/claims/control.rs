@@ -103,6 +103,7 @@ pub fn control_flagged(report: &RunReport, control: &str) -> Claim {
         ),
         paper_value: None,
         our_value: (!decisive.is_empty()).then_some(max_p),
+        p_value: (!decisive.is_empty()).then_some(max_p),
         held: verdict.held(),
         note: if missed.is_empty() {
             format!("flagged on all {} variants (largest p shown): {}", decisive.len(), used.join("; "))

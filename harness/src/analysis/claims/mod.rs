@@ -89,6 +89,7 @@ pub fn speedup_claim(
             reason: "exact: the method's error is round-off, which no budget of the baseline reaches, so the \
                      speed-up is unbounded and above any finite factor"
                 .into(),
+            p_value: None,
         };
     }
     let value = s.in_regime(regime);
@@ -139,6 +140,7 @@ pub fn speedup_claim(
         pair: format!("{estimator} vs {}", s.baseline),
         regime: regime.name().into(),
         reason,
+        p_value: None,
     }
 }
 

@@ -99,7 +99,7 @@ fn cells(b: &mut String, report: &RunReport, testbed: &str, variant: &str) {
         .iter()
         .map(|r| {
             let cells = vec![
-                Cell::text(&label(report, &r.estimator)),
+                super::page::estimator_cell(report, &r.estimator),
                 Cell::num(&sig(r.rmse, 4)),
                 Cell::num(&format!("{} ± {}", sig(r.bias, 3), sig(r.bias_se, 3))),
                 Cell::num(&sig(r.variance, 4)),
@@ -107,12 +107,22 @@ fn cells(b: &mut String, report: &RunReport, testbed: &str, variant: &str) {
                 Cell::num(&count(r.fetches)),
                 Cell::num(&sig(r.cpu_seconds, 4)),
                 Cell::num(&opt(r.efficiency)),
+                Cell::num(&opt(r.efficiency_mse)),
             ];
             (String::new(), cells)
         })
         .collect();
-    let header =
-        ["estimator", "rmse", "bias ± se", "variance", "samples", "fetches", "CPU s per estimate", "efficiency"];
+    let header = [
+        "estimator",
+        "rmse",
+        "bias ± se",
+        "variance",
+        "samples",
+        "fetches",
+        "CPU s per estimate",
+        "efficiency 1/(variance × CPU s)",
+        "efficiency 1/(MSE × CPU s)",
+    ];
     b.push_str(&table(&header, table_rows));
     b.push_str("</details>\n");
 }

@@ -3,7 +3,8 @@
 //! `<script type="application/json">` element, which a browser does not run), so a run of one
 //! experiment keeps the others' rows and no extra file is written.
 
-use super::markup::{badge, count_badges, esc, page, table, url, verdict_class, Cell};
+use super::estimators::EstimatorLine;
+use super::markup::{badge, count_badges, esc, interval_cell, page, table, url, verdict_class, Cell};
 use crate::error::{HarnessError, Result};
 use crate::output::report::{digest, interval, opt, sig};
 use crate::output::{Claim, RunReport, Verdict};
@@ -32,6 +33,9 @@ pub struct ClaimLine {
     pub interval: Option<[f64; 2]>,
     /// The verdict.
     pub verdict: Verdict,
+    /// The p-value of a claim judged by a test (absent in pages drawn before it).
+    #[serde(default)]
+    pub p_value: Option<f64>,
 }
 
 impl From<&Claim> for ClaimLine {
@@ -43,6 +47,7 @@ impl From<&Claim> for ClaimLine {
             our_value: c.our_value,
             interval: c.interval,
             verdict: c.verdict(),
+            p_value: c.p_value,
         }
     }
 }
@@ -71,6 +76,10 @@ pub struct Overview {
     pub failing_tests: usize,
     /// Figures on the page.
     pub figures: usize,
+    /// Per (test bed, variant) and estimator, its cell at the largest budget (for the estimator
+    /// pages; empty in pages drawn before them).
+    #[serde(default)]
+    pub estimators: Vec<EstimatorLine>,
 }
 
 impl Overview {
@@ -89,6 +98,7 @@ impl Overview {
             tests: digest::tally(deciding.iter().map(|t| t.verdict.as_str()), &digest::TEST_VERDICTS),
             failing_tests: deciding.iter().filter(|t| digest::is_failing(t)).count(),
             figures,
+            estimators: super::estimators::lines(report),
         }
     }
 }
@@ -156,12 +166,14 @@ fn claims_table(o: &Overview) -> String {
     let rows = shown
         .iter()
         .map(|c| {
-            let ours = format!("{} {}", opt(c.our_value), interval(c.interval));
+            let value = if c.p_value.is_some() && c.our_value == c.p_value { None } else { c.our_value };
+            let ours = format!("{} {}", opt(value), interval(c.interval));
             let cells = vec![
                 Cell::text(&c.claim),
                 Cell::text(&c.testbed),
                 Cell::num(&opt(c.paper_value)),
-                Cell::num(ours.trim()),
+                interval_cell(ours.trim(), c.interval),
+                Cell::num(&c.p_value.map_or_else(|| "-".to_string(), |p| format!("{p:.2e}"))),
                 Cell::html(badge(c.verdict.as_str())),
             ];
             (verdict_class(c.verdict.as_str()), cells)
@@ -177,7 +189,7 @@ fn claims_table(o: &Overview) -> String {
         );
     }
     if !shown.is_empty() {
-        out.push_str(&table(&["claim", "testbed", "paper", "ours (95% interval)", "verdict"], rows));
+        out.push_str(&table(&["claim", "testbed", "paper", "ours (95% interval)", "p-value", "verdict"], rows));
     }
     out
 }
@@ -209,8 +221,10 @@ pub fn render_root(root: &Path) -> String {
                             write!(tests, " <span class=\"badge v-fail\">{} against the claim</span>", o.failing_tests);
                     }
                     let commit: String = o.git_commit.chars().take(10).collect();
+                    let thumb = super::thumbs::thumbnail(root, name, &format!("{name}/index.html"));
                     let cells = vec![
                         Cell::html(page_link(name, &dir)),
+                        Cell::html(thumb.unwrap_or_default()),
                         Cell::text(&o.mode),
                         Cell::num(&o.seed.to_string()),
                         Cell::text(&commit),
@@ -226,13 +240,23 @@ pub fn render_root(root: &Path) -> String {
                         Cell::html(page_link(name, &dir)),
                         Cell::html(format!("<span class=\"muted\">{}</span>", esc(why))),
                     ];
-                    cells.extend((0..6).map(|_| Cell::text("")));
+                    cells.extend((0..7).map(|_| Cell::text("")));
                     (String::new(), cells)
                 }
             }
         })
         .collect();
-    let header = ["experiment", "mode", "seed", "commit", "claims", "tests (deciding rows)", "figures", "wall time"];
+    let header = [
+        "experiment",
+        "first figure",
+        "mode",
+        "seed",
+        "commit",
+        "claims",
+        "tests (deciding rows)",
+        "figures",
+        "wall time",
+    ];
     body.push_str(&table(&header, rows));
     for (name, e) in &found {
         if let Entry::Read(o) = e {
@@ -241,15 +265,50 @@ pub fn render_root(root: &Path) -> String {
             body.push_str(if claims.is_empty() { "<p class=\"muted\">No claims.</p>\n" } else { &claims });
         }
     }
-    let nav: Vec<(String, String)> = found.iter().map(|(n, _)| (format!("#{}", url(n)), n.clone())).collect();
+    let mut estimators: Vec<(&str, &str)> = found
+        .iter()
+        .filter_map(|(_, e)| if let Entry::Read(o) = e { Some(&o.estimators) } else { None })
+        .flatten()
+        .map(|l| (l.estimator.as_str(), l.label.as_str()))
+        .collect();
+    estimators.sort();
+    estimators.dedup_by(|a, b| a.0 == b.0);
+    if !estimators.is_empty() {
+        let _ = writeln!(
+            body,
+            "<h2 id=\"estimators\">Estimators</h2>\n<p class=\"muted\">A page per estimator: every experiment and test \
+             bed where it ran, its RMSE, efficiencies and unbiasedness verdict.</p>\n<p>{}</p>",
+            estimators
+                .iter()
+                .map(|(id, label)| format!(
+                    "<a href=\"{}/{}\">{}</a>",
+                    super::estimators::FOLDER,
+                    url(&super::estimators::file_name(id)),
+                    esc(label)
+                ))
+                .collect::<Vec<_>>()
+                .join(" &middot; ")
+        );
+    }
+    let mut nav: Vec<(String, String)> = found.iter().map(|(n, _)| (format!("#{}", url(n)), n.clone())).collect();
+    if !estimators.is_empty() {
+        nav.push(("#estimators".into(), "estimators".into()));
+    }
     page("mcbench results", &nav, &body)
 }
 
-/// Writes `<root>/index.html` (atomically), holding the root's lock meanwhile so that runs of two
-/// experiments into the same root write it one after the other.
+/// Writes `<root>/index.html` and the estimator pages under `<root>/estimators/` (atomically),
+/// holding the root's lock meanwhile so that runs of two experiments into the same root write them
+/// one after the other.
 pub fn write_root_index(root: &Path) -> Result<PathBuf> {
     let _lock = crate::store::folder::FolderLock::acquire(root, true, &[])?;
     let path = root.join("index.html");
+    let found = entries(root);
+    let lines: Vec<(&str, &[EstimatorLine])> = found
+        .iter()
+        .filter_map(|(n, e)| if let Entry::Read(o) = e { Some((n.as_str(), o.estimators.as_slice())) } else { None })
+        .collect();
+    super::estimators::write_pages(root, &lines)?;
     crate::output::write_atomic(&path, render_root(root).as_bytes())?;
     Ok(path)
 }
@@ -272,6 +331,7 @@ mod tests {
         std::fs::create_dir_all(root.join("surface-smc")).expect("folder");
         let page = format!("<p>x</p>{}", embed(&Overview::of(&report, 4)).expect("data"));
         std::fs::write(root.join("surface-smc/index.html"), page).expect("page");
+        std::fs::write(root.join("surface-smc/fig.svg"), "<svg width=\"200\" height=\"100\">").expect("figure");
         std::fs::create_dir_all(root.join("old")).expect("old");
         std::fs::write(root.join("old/report.md"), "x").expect("report");
         std::fs::create_dir_all(root.join("unrelated")).expect("other");
@@ -286,6 +346,7 @@ mod tests {
         assert!(html.contains("1 held</span> <span class=\"badge v-inconclusive\">1 inconclusive"));
         assert!(html.contains("a &lt;second&gt; claim") && html.contains("1 against the claim"));
         assert!(html.contains("2 experiment folders"));
+        assert!(html.contains("<a href=\"surface-smc/index.html\"><img class=\"thumb\" src=\"surface-smc/fig.svg\" width=\"160\" height=\"80\""), "{html}");
     }
 
     #[test]

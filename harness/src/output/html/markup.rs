@@ -1,5 +1,6 @@
-//! HTML building blocks of the pages: escaping, tables, verdict badges, the page frame and its
-//! style sheet (inline: a page needs no other file and no network).
+//! HTML building blocks of the pages: escaping, tables, verdict badges, the page frame with its
+//! style sheet and its one script ([`super::explore`]), both inline: a page needs no other file and
+//! no network.
 
 use std::fmt::Write as _;
 
@@ -83,6 +84,32 @@ impl Cell {
     }
 }
 
+/// A positive interval whose upper end is more than this many times its lower end is marked wide.
+pub const WIDE_FACTOR: f64 = 10.0;
+
+/// Whether `[lo, hi]` is a positive interval spanning more than a factor of [`WIDE_FACTOR`].
+pub fn is_wide(lo: f64, hi: f64) -> bool {
+    lo > 0.0 && hi > WIDE_FACTOR * lo
+}
+
+/// An interval's `text` as a number cell; a wide one ([`is_wide`]) carries a visible mark whose
+/// title says why it matters.
+pub fn interval_cell(text: &str, bounds: Option<[f64; 2]>) -> Cell {
+    match bounds {
+        Some([lo, hi]) if is_wide(lo, hi) => Cell {
+            html: format!(
+                "{} <span class=\"wide\" title=\"a wide interval: its upper end is {} times its lower end (more than \
+                 {WIDE_FACTOR}), so this run pins the value down only to within that factor; more repetitions narrow \
+                 it\">\u{26a0} wide</span>",
+                esc(text),
+                crate::output::report::sig(hi / lo, 3)
+            ),
+            class: "num",
+        },
+        _ => Cell::num(text),
+    }
+}
+
 /// A table with a header row; `row_class` gives each row's class (e.g. its verdict's).
 pub fn table(header: &[&str], rows: Vec<(String, Vec<Cell>)>) -> String {
     let mut out = String::from("<div class=\"scroll\"><table>\n<thead><tr>");
@@ -117,14 +144,17 @@ pub fn page(title: &str, nav: &[(String, String)], body: &str) -> String {
         out,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>\n{STYLE}</style>\n</head>\n<body>\n<nav>",
-        esc(title)
+         <title>{}</title>\n<style>\n{STYLE}{}</style>\n</head>\n<body>\n<nav>",
+        esc(title),
+        super::explore::STYLE
     );
     let links: Vec<String> = nav.iter().map(|(h, t)| format!("<a href=\"{h}\">{}</a>", esc(t))).collect();
     out.push_str(&links.join(" "));
     out.push_str("</nav>\n<main>\n");
     out.push_str(body);
-    out.push_str("</main>\n</body>\n</html>\n");
+    out.push_str("</main>\n");
+    out.push_str(&super::explore::script());
+    out.push_str("</body>\n</html>\n");
     out
 }
 
@@ -165,9 +195,13 @@ figure { margin: 0; background: #fff; border: 1px solid #d9dee6; padding: 6px; }
 figure.wide { grid-column: 1 / -1; }
 figure img { width: 100%; height: auto; display: block; }
 figcaption { font-size: 12px; color: #4f5766; margin-top: 3px; }
+img.thumb { display: block; border: 1px solid #d9dee6; background: #fff; }
 img.px { image-rendering: pixelated; border: 1px solid #b9c0cb; display: block; }
 .bar { display: inline-block; width: 160px; height: 11px; border: 1px solid #b9c0cb; vertical-align: middle; margin: 0 5px; }
 details { margin: 6px 0; }
+span.wide { color: #8a4b00; background: #fbe7c6; border-radius: 6px; padding: 0 4px; font-size: 12px; cursor: help; }
+div.toc { background: #fff; border: 1px solid #d9dee6; padding: 6px 12px; }
+div.toc ol { margin: 4px 0; padding-left: 22px; }
 summary { cursor: pointer; color: #1f5fa8; }
 "#;
 
@@ -186,5 +220,17 @@ mod tests {
         let p = page("T & t", &[("index.html".into(), "home".into())], "<p>x</p>");
         assert!(p.starts_with("<!DOCTYPE html>") && p.contains("<title>T &amp; t</title>"));
         assert!(!p.contains("http://") && !p.contains("https://"), "no network");
+        let wide = table(&["i"], vec![(String::new(), vec![interval_cell("[3.58, 116]", Some([3.58, 116.0]))])]);
+        assert!(
+            wide.contains("[3.58, 116] <span class=\"wide\" title=\"a wide interval") && wide.contains("\u{26a0} wide")
+        );
+        for (lo, hi) in [(1.0, 2.0), (1.0, 10.0), (-3.0, 116.0), (0.0, 5.0)] {
+            let t = table(&["i"], vec![(String::new(), vec![interval_cell("x", Some([lo, hi]))])]);
+            assert!(!t.contains("wide"), "[{lo}, {hi}] is not marked: {t}");
+        }
+        assert!(is_wide(1.0, f64::INFINITY) && !is_wide(f64::NAN, 5.0));
+        let script = format!("<script id=\"{}\">", super::super::explore::SCRIPT_ID);
+        assert_eq!(p.matches(&script).count(), 1, "the table script once");
+        assert!(p.find(&script) > p.find("</main>"), "after the tables it works on");
     }
 }

@@ -1,6 +1,7 @@
 //! The run's HTML report: `<plots>/<experiment>/index.html`, one self-contained page per
 //! experiment (an inline style sheet, figures as `<img>` of the SVG files beside it, per-pixel
-//! maps as inline PNG images; no script, no font or file from the network), and
+//! maps as inline PNG images, one inline script that makes the tables sortable and filterable
+//! ([`explore`]); no font or file from the network), and
 //! `<plots>/index.html`, which lists every experiment folder under the plots root with its
 //! headline verdicts. Every run that draws plots writes both, and so does `mcbench plot`.
 //!
@@ -8,12 +9,16 @@
 //! result files, the per-integral rows of the largest budget); nothing in them is specific to
 //! one experiment.
 
+mod contents;
+pub mod estimators;
+pub mod explore;
 mod groups;
 pub mod index;
 pub mod markup;
 pub mod page;
 pub mod pixel_maps;
 pub mod png;
+pub mod thumbs;
 
 pub use index::{write_root_index, Overview};
 
@@ -115,7 +120,9 @@ mod tests {
         let plots = OutputDir::new(&plots_dir);
         crate::output::report::write_report(&report, &figures, &plots_dir, &results_dir).expect("report.md");
         write_page(&report, &plots, &results_dir, &read_integrals(&results_dir).expect("read back")).expect("page");
+        write_root_index(&dir.path().join("plots")).expect("root index and estimator pages");
         let html = std::fs::read_to_string(plots_dir.join(PAGE)).expect("page");
+        assert!(html.contains("href=\"../estimators/is1_cv2.html\""), "estimator names link to their pages");
         for f in &figures {
             let name = f.file_name().and_then(|n| n.to_str()).expect("name");
             assert!(!name.ends_with(".svg") || html.contains(&format!("src=\"{name}\"")), "{name} not shown");
@@ -138,11 +145,59 @@ mod tests {
                 }
                 assert!(!target.contains("://"), "no network: {target}");
                 let path = plots_dir.join(target.split('#').next().expect("path"));
-                assert!(path.exists() || target == "../index.html", "{target} does not resolve");
+                assert!(path.exists(), "{target} does not resolve");
             }
         }
+        let at = |needle: &str| html.find(needle).unwrap_or_else(|| panic!("the page lacks {needle}"));
+        assert!(at("id=\"contents\"") < at("<h2 id=\"figures\""), "the contents come first");
+        assert!(at("<img src=") < at("<h2 id=\"claims\""), "figures before the long tables");
+        assert!(at("<h2 id=\"claims\"") < at("<h2 id=\"tests\""));
+        let script = format!("<script id=\"{}\">", explore::SCRIPT_ID);
+        assert_eq!(html.matches(&script).count(), 1, "the table script once");
         let overview = index::read_overview(&html).expect("the page carries its headline");
         assert_eq!((overview.experiment.as_str(), overview.figures), ("surface-smc", figures.len() / 2 + 1));
+    }
+
+    #[test]
+    fn p_values_have_their_own_column_and_wide_intervals_are_marked() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let mut report = synthetic_report();
+        let base = report.paper[0].clone();
+        report.paper.push(crate::output::Claim {
+            claim: "a control is flagged".into(),
+            our_value: Some(3.1e-7),
+            p_value: Some(3.1e-7),
+            ..base.clone()
+        });
+        report.paper.push(crate::output::Claim {
+            claim: "a ratio".into(),
+            our_value: Some(20.0),
+            interval: Some([3.58, 116.0]),
+            ..base.clone()
+        });
+        report.paper.push(crate::output::Claim {
+            claim: "a narrow ratio".into(),
+            our_value: Some(1.5),
+            interval: Some([1.0, 2.0]),
+            ..base
+        });
+        let ctx = page::Context { plots_dir: dir.path(), results_dir: dir.path(), figures: &[], maps: &[] };
+        let html = page::render(&report, &ctx).expect("page");
+        let claims =
+            &html[html.find("<h2 id=\"claims\"").expect("claims")..html.find("<h2 id=\"fits\"").expect("fits")];
+        let row = |text: &str| {
+            let at = claims.find(text).unwrap_or_else(|| panic!("no row {text}"));
+            claims[at..].split("</tr>").next().expect("row").to_string()
+        };
+        assert!(claims.contains("<th>ours</th><th>95% interval</th><th>p-value</th>"), "{claims}");
+        let control = row("a control is flagged");
+        assert_eq!(control.matches("3.10e-7").count(), 1, "the p-value once, in its column: {control}");
+        assert!(
+            control.contains("<td class=\"num\">-</td><td class=\"num\"></td><td class=\"num\">3.10e-7</td>"),
+            "{control}"
+        );
+        assert!(row("a ratio").contains("[3.580, 116.0] <span class=\"wide\" title=\""), "{}", row("a ratio"));
+        assert!(!row("a narrow ratio").contains("wide"), "{}", row("a narrow ratio"));
     }
 
     #[test]

@@ -1,9 +1,10 @@
-//! An experiment's `index.html`: the run's metadata, the claims with their verdicts and intervals,
-//! fits and speed-ups, the tests summarised (verdict counts, the rows against their claim and the
-//! inconclusive ones), every figure of the plots folder with a section per test bed
-//! (its figures, per-pixel maps and cells), what did not run, and links to every result file.
+//! An experiment's `index.html`: the run's metadata and a table of contents, every figure of the
+//! plots folder with a section per test bed (its figures, per-pixel maps and cells), then the
+//! claims with their verdicts and intervals, fits and speed-ups, the tests summarised (verdict
+//! counts, the rows against their claim and the inconclusive ones), what did not run, and links to
+//! every result file.
 
-use super::markup::{badge, count_badges, esc, page, table, url, verdict_class, Cell};
+use super::markup::{badge, count_badges, esc, interval_cell, page, table, url, verdict_class, Cell};
 use super::pixel_maps::PixelGroup;
 use crate::analysis::TestRow;
 use crate::output::plot::label_of;
@@ -40,6 +41,16 @@ pub(super) fn label(report: &RunReport, id: &str) -> String {
     }
 }
 
+/// An estimator's cell: its label linking to its page under the plots root's `estimators/` when it
+/// has cells in this run (the root index writes a page for each), else its label.
+pub(super) fn estimator_cell(report: &RunReport, id: &str) -> Cell {
+    if report.rows.iter().any(|r| r.estimator == id) {
+        Cell::html(super::estimators::link_from_experiment(id, &label(report, id)))
+    } else {
+        Cell::text(&label(report, id))
+    }
+}
+
 fn link(ctx: &Context<'_>, file: &Path, text: &str) -> String {
     format!("<a href=\"{}\">{}</a>", url(&relative_path(ctx.plots_dir, file)), esc(text))
 }
@@ -53,25 +64,29 @@ fn table_link(ctx: &Context<'_>, name: &str) -> String {
     }
 }
 
-/// The page's HTML.
+/// The page's HTML: a table of contents at the top, then the figures (with a section per test bed),
+/// then the long tables (claims, fits, tests), what did not run and the files.
 pub fn render(report: &RunReport, ctx: &Context<'_>) -> crate::error::Result<String> {
     let m = &report.meta;
     let mut b = format!("<h1>{}</h1>\n", esc(&m.experiment));
     let _ = writeln!(
         b,
         "<p class=\"muted\">A run of mcbench: the claims, fits and tests it judged, every figure it drew and the files it \
-         wrote. The summary in markdown: <a href=\"report.md\">report.md</a>.</p>"
+         wrote. The summary in markdown: <a href=\"report.md\">report.md</a>. Click a table's header to sort it.</p>"
     );
     meta(&mut b, report, ctx);
-    claims(&mut b, report, ctx);
-    fits(&mut b, report);
-    tests(&mut b, report, ctx);
-    let sections = super::groups::figures(&mut b, report, ctx)?;
-    skipped(&mut b, report);
-    files(&mut b, ctx);
+    let mut rest = String::new();
+    let sections = super::groups::figures(&mut rest, report, ctx)?;
+    claims(&mut rest, report, ctx);
+    fits(&mut rest, report);
+    tests(&mut rest, report, ctx);
+    skipped(&mut rest, report);
+    files(&mut rest, ctx);
+    b.push_str(&super::contents::render(report, ctx.figures.len(), &sections));
+    b.push_str(&rest);
     b.push_str(&super::index::embed(&super::Overview::of(report, ctx.figures.len()))?);
     let mut nav = vec![("../index.html".to_string(), "all experiments".to_string())];
-    for (id, text) in [("claims", "claims"), ("fits", "fits"), ("tests", "tests"), ("figures", "figures")] {
+    for (id, text) in [("figures", "figures"), ("claims", "claims"), ("fits", "fits"), ("tests", "tests")] {
         nav.push((format!("#{id}"), text.to_string()));
     }
     nav.extend(sections);
@@ -96,13 +111,21 @@ fn meta(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
             if m.reproducible { "yes: the same seed gives the same results" } else { "no (time budgets)" }.into(),
         ),
     ];
+    let _ = writeln!(
+        b,
+        "<details class=\"run\"><summary>{} mode, {} repetitions, seed {}, {} s of wall time: the run's details</summary>",
+        esc(&m.mode),
+        m.reps,
+        m.seed,
+        sig(m.wall_seconds, 3)
+    );
     b.push_str("<dl class=\"meta\">\n");
     for (k, v) in items {
         let _ = writeln!(b, "<dt>{}</dt><dd>{}</dd>", esc(k), esc(&v));
     }
     let folder = relative_path(ctx.plots_dir, ctx.results_dir);
     let _ = writeln!(b, "<dt>results folder</dt><dd>{}</dd>", link(ctx, ctx.results_dir, &folder));
-    b.push_str("</dl>\n");
+    b.push_str("</dl></details>\n");
     if !m.notes.is_empty() {
         let n = m.notes.len();
         let _ = writeln!(
@@ -138,8 +161,9 @@ fn claims(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
                 Cell::text(&c.claim),
                 Cell::text(&c.testbed),
                 Cell::num(&opt(c.paper_value)),
-                Cell::num(&opt(c.our_value)),
-                Cell::num(&interval(c.interval)),
+                Cell::num(&if c.p_value.is_some() && c.our_value == c.p_value { "-".into() } else { opt(c.our_value) }),
+                interval_cell(&interval(c.interval), c.interval),
+                Cell::num(&c.p_value.map_or_else(|| "-".to_string(), |p| format!("{p:.2e}"))),
                 Cell::html(badge(c.verdict().as_str())),
                 Cell::text(&crate::output::report::join_present(&[c.pair.as_str(), c.regime.as_str()])),
                 Cell::html(note_html(&note)),
@@ -147,7 +171,8 @@ fn claims(b: &mut String, report: &RunReport, ctx: &Context<'_>) {
             (verdict_class(c.verdict().as_str()), cells)
         })
         .collect();
-    let header = ["claim", "testbed", "paper", "ours", "95% interval", "verdict", "pair; cost regime", "note"];
+    let header =
+        ["claim", "testbed", "paper", "ours", "95% interval", "p-value", "verdict", "pair; cost regime", "note"];
     b.push_str(&table(&header, rows));
 }
 
@@ -173,7 +198,7 @@ fn fits(b: &mut String, report: &RunReport) {
                 let exact = f.outcome == crate::analysis::SlopeOutcome::Exact;
                 let cells = vec![
                     Cell::text(&format!("{} / {}", f.testbed, f.variant)),
-                    Cell::text(&label(report, &f.estimator)),
+                    estimator_cell(report, &f.estimator),
                     Cell::num(&if exact { "exact at every budget".into() } else { format!("{:.3}", f.slope) }),
                     Cell::num(&if exact {
                         "-".into()
@@ -199,21 +224,24 @@ fn fits(b: &mut String, report: &RunReport) {
                 let measured = crate::plan::cost_model::Regime::Measured;
                 let cells = vec![
                     Cell::text(&format!("{} / {}", s.testbed, s.variant)),
-                    Cell::text(&label(report, &s.estimator)),
+                    estimator_cell(report, &s.estimator),
                     Cell::text(&s.baseline),
                     Cell::num(&s.budget.to_string()),
                     Cell::num(&if unbounded { "unbounded".into() } else { sig(s.sample_ratio, 4) }),
                     Cell::num(&sig(s.overhead, 4)),
-                    Cell::num(&if unbounded {
-                        s.describe(measured)
+                    if unbounded {
+                        Cell::num(&s.describe(measured))
                     } else {
-                        format!(
-                            "{} [{}, {}]",
-                            s.describe(measured),
-                            sig(s.speedup_ci_low, 3),
-                            sig(s.speedup_ci_high, 3)
+                        interval_cell(
+                            &format!(
+                                "{} [{}, {}]",
+                                s.describe(measured),
+                                sig(s.speedup_ci_low, 3),
+                                sig(s.speedup_ci_high, 3)
+                            ),
+                            Some([s.speedup_ci_low, s.speedup_ci_high]),
                         )
-                    }),
+                    },
                     Cell::num(&s.describe(crate::plan::cost_model::Regime::Renderer)),
                 ];
                 (String::new(), cells)
@@ -243,7 +271,7 @@ fn test_table(report: &RunReport, rows: &[&TestRow]) -> String {
             let p = if t.p_value.is_nan() { "-".to_string() } else { format!("{:.2e}", t.p_value) };
             let cells = vec![
                 Cell::text(&format!("{} / {}", t.testbed, t.variant)),
-                Cell::text(&label(report, &t.estimator)),
+                estimator_cell(report, &t.estimator),
                 Cell::text(&t.test),
                 Cell::num(&t.budget.to_string()),
                 Cell::num(&sig(t.statistic, 4)),

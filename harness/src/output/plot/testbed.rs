@@ -1,10 +1,11 @@
 //! The figure of one (test bed, variant) of a run: (a) RMSE against the budget with its bootstrap
-//! band and a slope -1/2 guide, (b) efficiency against the budget, (c) RMSE against CPU seconds
+//! band and a slope -1/2 guide, (b) efficiency against the budget (1/(variance x CPU s) solid, the
+//! MSE-based 1/(MSE x CPU s) dashed in the same colour, apart where the estimator is biased), (c) RMSE against CPU seconds
 //! per estimate and, with speed-ups, (d) the speed-up against the cost of a ray. One series per
 //! estimator in the same colour in every panel, its legend entry naming it and its fitted
 //! convergence slope.
 
-use super::figure::{Figure, Guide, Panels, Series};
+use super::figure::{Figure, Guide, Key, Line, Panels, Series};
 use super::names::DisplayNames;
 use super::{budget_axis_label, label_of, ray_cost};
 use crate::analysis::metrics::SummaryRow;
@@ -98,13 +99,19 @@ pub fn figure(
             style,
             points(&|r| r.efficiency.and_then(|e| positive(r.budget as f64, e))),
         ));
+        let mse_based = points(&|r| r.efficiency_mse.and_then(|e| positive(r.budget as f64, e)));
+        if mse_based.len() >= 2 {
+            eff.push(Series { markers: false, ..Series::new("", style, mse_based).with_line(Line::Dashed) });
+        }
         time.push(Series::new(label, style, points(&|r| positive(r.metric_seconds(), r.rmse))));
     }
-    if rmse.iter().chain(&eff).all(|s| s.points.len() < 2) {
+    // The MSE-based twins (dashed) alone do not make a figure.
+    if rmse.iter().chain(eff.iter().filter(|s| s.line == Line::Solid)).all(|s| s.points.len() < 2) {
         return None;
     }
     let mut a = Figure::new(format!("(a) RMSE vs {budget}"), budget.clone(), "RMSE", rmse);
     a.guides.extend(half_slope(&a.series));
+    let twins = eff.iter().any(|s| s.line == Line::Dashed);
     let b = Figure::new(format!("(b) efficiency vs {budget}"), budget.clone(), "efficiency 1/(variance × CPU s)", eff);
     let c = Figure::new("(c) RMSE vs CPU time", "CPU seconds per estimate", "RMSE", time);
     let banded = a.series.iter().any(|s| !s.band.is_empty());
@@ -119,7 +126,14 @@ pub fn figure(
     Some(Panels {
         title: format!("{}: {}", report.meta.experiment, names.testbed(testbed, variant)),
         panels,
-        keys: Vec::new(),
+        keys: if twins {
+            vec![
+                Key { label: "(b) solid: 1/(variance × CPU s)".into(), line: Line::Solid, marker: true },
+                Key { label: "(b) dashed: 1/(MSE × CPU s)".into(), line: Line::Dashed, marker: false },
+            ]
+        } else {
+            Vec::new()
+        },
         note: if banded { BAND_NOTE.to_string() } else { String::new() },
     })
 }

@@ -179,6 +179,18 @@ fn one_figure_of_panels_per_test_bed_as_svg_and_png() {
     assert!(svg.contains("IS1 + CV2: slope -0.90 ["), "legend slope missing");
     assert!(!svg.contains("right end"), "three budgets: the right end is the whole fit");
     assert!(svg.contains("slope -1/2 (guide)") && svg.contains("break-even (speed-up 1)"));
+    // Panel (b) draws the MSE-based efficiency dashed beside the variance-based one, and says so.
+    assert!(svg.contains("(b) solid: 1/(variance × CPU s)") && svg.contains("(b) dashed: 1/(MSE × CPU s)"));
+    let panels =
+        super::testbed::figure(&report, "gradient-plane", "default", &["is0_cv0", "is1_cv2"], &DisplayNames::NONE)
+            .expect("figure");
+    let b = &panels.panels[1];
+    let dashed: Vec<_> = b.series.iter().filter(|s| s.line == Line::Dashed).collect();
+    assert_eq!(dashed.len(), 2, "one MSE-based twin per estimator");
+    let mse: Vec<f64> =
+        report.rows.iter().filter(|r| r.estimator == "is1_cv2").filter_map(|r| r.efficiency_mse).collect();
+    let twin = dashed.iter().find(|s| s.style == 1).expect("is1_cv2's twin");
+    assert_eq!(twin.points.iter().map(|p| p.1).collect::<Vec<_>>(), mse, "its points are efficiency_mse");
     // No band columns in the rows: no band, no note.
     assert!(!svg.contains("Shaded: 90%"));
     let names: Vec<String> =

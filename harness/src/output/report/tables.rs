@@ -27,6 +27,7 @@ struct ClaimRow<'a> {
     regime: &'a str,
     reason: &'a str,
     note: &'a str,
+    p_value: Option<f64>,
 }
 
 impl<'a> From<&'a Claim> for ClaimRow<'a> {
@@ -43,6 +44,7 @@ impl<'a> From<&'a Claim> for ClaimRow<'a> {
             regime: &c.regime,
             reason: &c.reason,
             note: &c.note,
+            p_value: c.p_value,
         }
     }
 }
@@ -99,6 +101,7 @@ const CLAIM_HEADER: &[&str] = &[
     "regime",
     "reason",
     "note",
+    "p_value",
 ];
 
 #[cfg(test)]
