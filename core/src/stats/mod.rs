@@ -17,7 +17,7 @@ pub mod regression;
 
 pub use chi_square::{chi_square_gof, histogram, ChiSquare, StatsError, MIN_EXPECTED_COUNT};
 pub use hypothesis::{
-    detectable_shift, detectable_shift_any, detectable_shift_t, holm_bonferroni, one_sample_t, sidak_alpha, t_quantile,
+    detectable_shift, detectable_shift_any, detectable_shift_t, holm_bonferroni, holm_bonferroni_finite, one_sample_t, sidak_alpha, t_quantile,
     t_test, t_test_skewness_limit, welch, z_test, TestOutcome,
 };
 pub use moments::{Moments, NeumaierSum};
