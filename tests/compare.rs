@@ -25,6 +25,7 @@ fn compare(dir: &Path, a: &str, b: &str) -> Comparison {
         out: Some(out.clone()),
         margins: Default::default(),
         fail_on_regression: false,
+        two_sample: None,
     };
     mcbench::compare::command::compare_command(&args).expect("compares");
     serde_json::from_slice(&std::fs::read(out.join("compare.json")).expect("compare.json")).expect("parses")
