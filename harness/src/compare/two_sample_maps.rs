@@ -15,10 +15,13 @@ use std::path::{Path, PathBuf};
 /// Pixels a tile has on a side.
 pub const TILE: usize = 8;
 
+/// The pixel (column, row) of each (test bed, variant, integral) of one experiment.
+type Places = HashMap<(String, String, usize), (usize, usize)>;
+
 /// Pixel places by experiment folder, read once each.
 #[derive(Default)]
 pub struct Geometry {
-    read: HashMap<PathBuf, HashMap<(String, String, usize), (usize, usize)>>,
+    read: HashMap<PathBuf, Places>,
 }
 
 impl Geometry {
