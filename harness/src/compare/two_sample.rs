@@ -176,6 +176,13 @@ fn cells<'a>(side: &'a Side, estimator: &str) -> Result<Found<'a>> {
     Ok(all.into_iter().filter(|(_, id, _)| id.2 == chosen).collect())
 }
 
+/// The test bed's parameters (every default filled in) of a cell: cells of one test bed and variant
+/// under other parameters measure other integrals and are not paired.
+fn params<'a>(side: &'a Side, experiment: &str, id: &super::load::CellId) -> Option<&'a str> {
+    let rows = &side.experiments.get(experiment)?.report.rows;
+    rows.iter().find(|r| &super::load::cell_id(r) == id).map(|r| r.testbed_params.as_str())
+}
+
 /// The two-sample test of `estimator_a` in `a` against `estimator_b` in `b`; an estimator with no
 /// stored cell in its run, or no shared (test bed, variant, budget), is refused (naming the flag).
 pub fn two_sample(a: &Side, b: &Side, estimator_a: &str, estimator_b: &str) -> Result<TwoSample> {
@@ -193,8 +200,10 @@ pub fn two_sample(a: &Side, b: &Side, estimator_a: &str, estimator_b: &str) -> R
     let mut pairs: Vec<_> = ca
         .iter()
         .flat_map(|x| cb.iter().map(move |y| (x, y)))
-        .filter(|((_, ia, ma), (_, ib, mb))| {
-            (&ia.0, &ia.1, &ia.3, ia.4) == (&ib.0, &ib.1, &ib.3, ib.4) && ma.per_integral.len() == mb.per_integral.len()
+        .filter(|((xa, ia, ma), (xb, ib, mb))| {
+            (&ia.0, &ia.1, &ia.3, ia.4) == (&ib.0, &ib.1, &ib.3, ib.4)
+                && ma.per_integral.len() == mb.per_integral.len()
+                && params(a, xa, ia) == params(b, xb, ib)
         })
         .collect();
     pairs.sort_by(|(x, y), (u, v)| (x.1, x.0, y.0).cmp(&(u.1, u.0, v.0)));
@@ -222,7 +231,7 @@ pub fn two_sample(a: &Side, b: &Side, estimator_a: &str, estimator_b: &str) -> R
     }
     if out.rows.is_empty() {
         let why = format!(
-            "{estimator_a} (in {}) and {estimator_b} (in {}) share no (test bed, variant, budget) with the same integrals",
+            "{estimator_a} (in {}) and {estimator_b} (in {}) share no (test bed, variant, budget) with the same test-bed parameters",
             a.label, b.label
         );
         return Err(ConfigError::invalid(FLAG, format!("{estimator_a} {estimator_b}"), why).into());
