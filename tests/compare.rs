@@ -25,6 +25,7 @@ fn compare(dir: &Path, a: &str, b: &str) -> Comparison {
         out: Some(out.clone()),
         margins: Default::default(),
         fail_on_regression: false,
+        two_sample: None,
     };
     mcbench::compare::command::compare_command(&args).expect("compares");
     serde_json::from_slice(&std::fs::read(out.join("compare.json")).expect("compare.json")).expect("parses")
@@ -93,6 +94,7 @@ fn same_code_reads_no_change_and_planted_bias_and_variance_read_regressed() {
         out: Some(d.join("fail")),
         margins: Default::default(),
         fail_on_regression: true,
+        two_sample: None,
     };
     let e = mcbench::compare::command::compare_command(&args("noisy")).expect_err("a regression fails");
     assert_eq!(e.exit_code(), 1, "{e}");

@@ -128,6 +128,10 @@ enum Command {
         /// Exit 1 when a row regressed.
         #[arg(long)]
         fail_on_regression: bool,
+        /// Test estimator EA of A against estimator EB of B without a reference (per shared test
+        /// bed, variant and budget: same, differ or inconclusive; written to two_sample.csv).
+        #[arg(long, num_args = 2, value_names = ["EA", "EB"])]
+        two_sample: Option<Vec<String>>,
     },
     /// Redraw the plots and report of a results folder.
     Plot {
@@ -360,9 +364,21 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             Ok(())
         }
-        Some(Command::Compare { a, b, results, out, margin, slope_margin, time_margin, fail_on_regression }) => {
+        Some(Command::Compare {
+            a,
+            b,
+            results,
+            out,
+            margin,
+            slope_margin,
+            time_margin,
+            fail_on_regression,
+            two_sample,
+        }) => {
             let margins = crate::compare::Margins { ratio: margin, slope: slope_margin, time: time_margin };
-            let args = crate::compare::command::CompareArgs { a, b, results, out, margins, fail_on_regression };
+            let two_sample = two_sample.and_then(|v| Some((v.first()?.clone(), v.get(1)?.clone())));
+            let args =
+                crate::compare::command::CompareArgs { a, b, results, out, margins, fail_on_regression, two_sample };
             crate::compare::command::compare_command(&args)
         }
         Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait, registry),

@@ -161,6 +161,15 @@ pub fn holm_bonferroni(p_values: &[f64]) -> Vec<f64> {
     adjusted
 }
 
+/// Holm–Bonferroni over the finite p-values only, returned in the input order: a `NaN` (no test)
+/// does not count towards `m` and comes back as `NaN`. For a family of which only some members
+/// could be tested (a claim over many cells or rows, some without a valid test).
+pub fn holm_bonferroni_finite(p_values: &[f64]) -> Vec<f64> {
+    let finite: Vec<f64> = p_values.iter().copied().filter(|p| !p.is_nan()).collect();
+    let mut holm = holm_bonferroni(&finite).into_iter();
+    p_values.iter().map(|p| if p.is_nan() { f64::NAN } else { holm.next().unwrap_or(f64::NAN) }).collect()
+}
+
 /// Šidák per-test level `1 - (1 - alpha)^(1/m)` for a family-wise level `alpha` over `m`
 /// independent tests, computed as `-expm1(ln_1p(-alpha) / m)` to stay accurate for tiny `alpha`.
 /// `m = 0` returns `alpha` unchanged.
@@ -263,6 +272,15 @@ mod tests {
         // Capped at 1.
         assert_eq!(holm_bonferroni(&[0.6, 0.7]), vec![1.0, 1.0]);
         assert!(holm_bonferroni(&[]).is_empty());
+    }
+
+    #[test]
+    fn holm_over_the_finite_values_only() {
+        let adj = holm_bonferroni_finite(&[f64::NAN, 0.01, 0.2]);
+        assert!(adj[0].is_nan());
+        // m = 2, not 3: 0.01 * 2 and 0.2 * 1 made monotone.
+        assert_eq!((adj[1], adj[2]), (0.02, 0.2));
+        assert_eq!(holm_bonferroni(&[0.01, 0.2]), adj[1..].to_vec());
     }
 
     #[test]

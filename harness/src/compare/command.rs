@@ -21,6 +21,8 @@ pub struct CompareArgs {
     pub margins: Margins,
     /// Exit 1 when a row regressed.
     pub fail_on_regression: bool,
+    /// `--two-sample EA EB`: estimator EA of A against estimator EB of B.
+    pub two_sample: Option<(String, String)>,
 }
 
 /// Refuses margins that are not positive finite numbers of a sensible size.
@@ -48,7 +50,8 @@ pub fn compare_command(args: &CompareArgs) -> Result<()> {
     let a = load::read_side(&la, &da)?;
     let b = load::read_side(&lb, &db)?;
     let out = args.out.clone().unwrap_or_else(|| write::default_out(&args.results, &la, &lb));
-    let c = finish(&a, &b, &out, args.margins)?;
+    let pair = args.two_sample.as_ref().map(|(x, y)| (x.as_str(), y.as_str()));
+    let c = finish_with(&a, &b, &out, args.margins, pair)?;
     let regressed = c.changes.iter().filter(|r| r.verdict == super::change::ChangeVerdict::Regressed).count();
     if args.fail_on_regression && regressed > 0 {
         return Err(HarnessError::Failed(format!("{regressed} rows regressed (--fail-on-regression)")));
@@ -58,10 +61,28 @@ pub fn compare_command(args: &CompareArgs) -> Result<()> {
 
 /// Compares, writes the files into `out` and prints the summary.
 pub fn finish(a: &Side, b: &Side, out: &Path, margins: Margins) -> Result<Comparison> {
+    finish_with(a, b, out, margins, None)
+}
+
+/// [`finish`], with the two-sample test of an estimator of A against one of B when `two_sample`
+/// names them (computed, and refused on bad input, before anything is written).
+pub fn finish_with(
+    a: &Side,
+    b: &Side,
+    out: &Path,
+    margins: Margins,
+    two_sample: Option<(&str, &str)>,
+) -> Result<Comparison> {
     write::check_out(out)?;
-    let c = super::compare(a, b, margins)?;
+    let mut c = super::compare(a, b, margins)?;
+    if let Some((x, y)) = two_sample {
+        c.two_sample = Some(super::two_sample::two_sample(a, b, x, y)?);
+    }
     write::write_files(out, &c)?;
     print!("{}", write::summary(&c));
+    if let Some(t) = &c.two_sample {
+        print!("{}", super::two_sample_html::console(t));
+    }
     println!("comparison: {}", out.join(write::FILES[2]).display());
     Ok(c)
 }

@@ -81,6 +81,7 @@ pub fn page(c: &Comparison) -> String {
             body.push_str(&markup::table(&HEADER, rows(&picked)));
         }
     }
+    body.push_str(&super::two_sample_html::section(c.two_sample.as_ref()));
     body.push_str("<h2>Every row</h2>\n");
     body.push_str(&markup::table(&HEADER, rows(&c.changes.iter().collect::<Vec<_>>())));
     markup::page(&format!("{} vs {}", c.b, c.a), &[], &body)
@@ -101,6 +102,7 @@ mod tests {
             experiments: vec!["x".into()],
             notes: vec!["a & b".into()],
             changes: vec![],
+            two_sample: None,
         };
         let p = super::page(&c);
         assert!(p.contains("&lt;old&gt;") && p.contains("a &amp; b") && !p.contains("<old>"));

@@ -17,6 +17,17 @@ pub const BASELINES: &str = "baselines";
 /// What identifies a cell across runs: test bed, variant, estimator, budget kind and amount.
 pub type CellId = (String, String, String, String, u64);
 
+/// What the two-sample test reads of a cell: per integral and channel the moments over the
+/// repetitions, and the moments of each repetition's sum over every integral and channel (the
+/// stored summed deviation from the reference: the same spread).
+#[derive(Clone, Debug, Default)]
+pub struct CellMoments {
+    /// Per integral, per channel.
+    pub per_integral: Vec<[mcbench_core::stats::Moments; 3]>,
+    /// Over repetitions, each repetition's summed deviation from the reference.
+    pub rep_sum: mcbench_core::stats::Moments,
+}
+
 /// One experiment of a side: its report and its cells with their blocks.
 #[derive(Debug)]
 pub struct Experiment {
@@ -26,6 +37,8 @@ pub struct Experiment {
     pub report: RunReport,
     /// The cells, by id.
     pub cells: HashMap<CellId, CellData>,
+    /// The cells' per-integral moments, by id (the two-sample test's input).
+    pub moments: HashMap<CellId, CellMoments>,
 }
 
 /// One side of a comparison: what was named, and its experiments by name.
@@ -108,6 +121,7 @@ pub fn read_experiment(dir: &Path) -> Result<Experiment> {
     let report = crate::output::read_results(dir)?;
     let store = crate::store::Store::open(&dir.join(crate::store::CELLS))?;
     let mut blocks: HashMap<CellId, Vec<crate::run::cell::RepBlock>> = HashMap::new();
+    let mut moments: HashMap<CellId, CellMoments> = HashMap::new();
     for record in store.records() {
         let cell = crate::store::packed::decode_cell(&record.payload)
             .map_err(|e| HarnessError::bad_file(store.path(), format!("record {}: {e}", record.name)))?;
@@ -133,6 +147,7 @@ pub fn read_experiment(dir: &Path) -> Result<Experiment> {
             .iter()
             .any(|r| cell_id(r) == id && r.reps == k.reps && cell.estimates == (r.reps * r.integrals) as u64);
         if matches {
+            moments.insert(id.clone(), CellMoments { per_integral: cell.moments, rep_sum: cell.rep_dev });
             blocks.insert(id, cell.blocks);
         }
     }
@@ -144,7 +159,7 @@ pub fn read_experiment(dir: &Path) -> Result<Experiment> {
             (cell_id(r), cell_data(r, b))
         })
         .collect();
-    Ok(Experiment { dir: dir.to_path_buf(), report, cells })
+    Ok(Experiment { dir: dir.to_path_buf(), report, cells, moments })
 }
 
 /// A row with its blocks, the offsets set so that all blocks give back the row's MSE and variance.

@@ -4,7 +4,8 @@
 //! ([`change`]), and a row for each unbiasedness verdict that changed. Runs of different test-bed
 //! parameters or references are refused ([`fingerprint`]). [`mod@write`] writes `compare.csv`,
 //! `compare.json` and `compare.html` and prints the summary; [`baseline`] keeps named copies of a
-//! run's results to compare against.
+//! run's results to compare against. With `--two-sample EA EB`, [`two_sample`] tests estimator EA of
+//! A against estimator EB of B without a reference (`two_sample.csv`, `two_sample_integrals.csv`).
 
 pub mod baseline;
 pub mod change;
@@ -12,6 +13,9 @@ pub mod command;
 pub mod fingerprint;
 pub mod html;
 pub mod load;
+pub mod two_sample;
+pub mod two_sample_html;
+pub mod two_sample_maps;
 pub mod write;
 
 use crate::error::{HarnessError, Result};
@@ -124,6 +128,9 @@ pub struct Comparison {
     pub notes: Vec<String>,
     /// The rows.
     pub changes: Vec<Change>,
+    /// Two estimators against each other (`--two-sample`), when asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub two_sample: Option<two_sample::TwoSample>,
 }
 
 impl Comparison {
@@ -166,6 +173,7 @@ pub fn compare(a: &Side, b: &Side, margins: Margins) -> Result<Comparison> {
         experiments: common.into_iter().cloned().collect(),
         notes,
         changes,
+        two_sample: None,
     })
 }
 

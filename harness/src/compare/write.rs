@@ -8,6 +8,9 @@ use std::path::{Path, PathBuf};
 
 /// The files a comparison writes.
 pub const FILES: [&str; 3] = ["compare.csv", "compare.json", "compare.html"];
+/// The files `--two-sample` adds.
+pub const TWO_SAMPLE_FILES: [&str; 4] =
+    ["two_sample.csv", "two_sample.json", "two_sample_integrals.csv", "two_sample_tiles.csv"];
 
 /// At most this many regressed rows are listed on the console.
 pub const LISTED: usize = 15;
@@ -32,9 +35,19 @@ pub fn write_files(out: &Path, c: &Comparison) -> Result<Vec<PathBuf>> {
     let csv = csv.into_inner().map_err(|e| HarnessError::write(out.join(FILES[0]), e))?;
     let json = serde_json::to_vec_pretty(c).map_err(|e| HarnessError::write(out.join(FILES[1]), e))?;
     let html = super::html::page(c);
+    let mut files: Vec<(&str, Vec<u8>)> = FILES.iter().copied().zip([csv, json, html.into_bytes()]).collect();
+    if let Some(t) = &c.two_sample {
+        let [rows, whole, per, tiles] = TWO_SAMPLE_FILES;
+        let fail = |name: &str, e: String| HarnessError::write(out.join(name), e);
+        files.push((rows, super::two_sample::csv_bytes(t).map_err(|e| fail(rows, e.to_string()))?));
+        files.push((whole, serde_json::to_vec_pretty(t).map_err(|e| fail(whole, e.to_string()))?));
+        files.push((per, super::two_sample::integrals_csv_bytes(t).map_err(|e| fail(per, e.to_string()))?));
+        let cut = super::two_sample_maps::tiles(t, &super::two_sample_maps::maps(t));
+        files.push((tiles, super::two_sample_maps::tiles_csv_bytes(&cut).map_err(|e| fail(tiles, e.to_string()))?));
+    }
     std::fs::create_dir_all(out).map_err(|e| HarnessError::write(out, e))?;
     let mut written = Vec::new();
-    for (name, bytes) in FILES.iter().zip([csv, json, html.into_bytes()]) {
+    for (name, bytes) in files {
         let path = out.join(name);
         crate::output::write_atomic(&path, &bytes)?;
         written.push(path);
@@ -124,6 +137,7 @@ mod tests {
             experiments: vec!["x".into()],
             notes: vec![],
             changes,
+            two_sample: None,
         }
     }
 

@@ -82,6 +82,31 @@ fn a_control_that_is_not_flagged_fails_its_claim() {
     assert_eq!(claims(&good).len(), 3 + 2);
 }
 
+/// The claim over all unbiased ids is family-wise: among 330 rows, one at p = 5e-4 is flagged by
+/// its own test (its row disagrees) but not after Holm over the 330; one at p = 1e-9 is.
+#[test]
+fn the_claim_over_unbiased_ids_is_family_wise() {
+    let headline = |odd: Row| {
+        let mut rows: Vec<Row> = (0..329).map(|i| row("unbiased", "pass", 0.5 + i as f64 * 1e-3)).collect();
+        rows.push(odd);
+        let all = claims(&rows);
+        assert!(all.last().is_some_and(|c| c.claim.starts_with("papers: every estimator they call unbiased")));
+        all.last().cloned().unwrap()
+    };
+    let chance = row("unbiased", "biased", 5e-4);
+    assert_eq!(chance.agrees, Some(false), "the row's own verdict stays");
+    let c = headline(chance);
+    assert_eq!(c.held, None, "{}", c.note);
+    assert!(c.note.contains("0 flagged after Holm-Bonferroni over the 330 rows"), "{}", c.note);
+    assert!(c.note.contains("alpha 0.001 flags 1 (e on t/v (p 5.00e-4))"), "{}", c.note);
+    let c = headline(row("unbiased", "biased", 1e-9));
+    assert_eq!(c.held, Some(false), "{}", c.note);
+    assert!(c.note.contains("1 flagged after Holm-Bonferroni") && c.note.contains("adjusted p 3.30e-7"), "{}", c.note);
+    let c = headline(row("unbiased", "pass", 0.9));
+    assert_eq!(c.held, Some(true), "{}", c.note);
+    assert!(c.note.contains("flags 0, where 0.33 would be flagged by chance"), "{}", c.note);
+}
+
 #[test]
 fn repetitions_for_a_tenth_of_a_percent() {
     assert_eq!(reps_for_target(0.01, 100, 1.0), Some(10_000.0));
