@@ -194,6 +194,7 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
             claim: format!("{} is {} (registry / paper)", r.estimator, r.paper_bias),
             paper_value: None,
             our_value: (!r.p_value.is_nan()).then_some(r.p_value),
+            p_value: (!r.p_value.is_nan()).then_some(r.p_value),
             held: r.agrees,
             note: format!("{} {}: {}", r.test, r.verdict, r.note),
             ..Default::default()

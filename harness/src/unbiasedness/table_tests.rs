@@ -78,6 +78,8 @@ fn a_control_that_is_not_flagged_fails_its_claim() {
     // The aggregate claim over unbiased ids fails on one flagged row.
     let all = claims(&[row("unbiased", "pass", 0.4), row("unbiased", "biased", 1e-8)]);
     assert_eq!(all.last().and_then(|c| c.held), Some(false));
+    // A row's claim carries its p-value in the column of its own.
+    assert_eq!((all[0].p_value, all[1].p_value), (Some(0.4), Some(1e-8)));
     // One `paper` entry per row, plus the aggregates.
     assert_eq!(claims(&good).len(), 3 + 2);
 }

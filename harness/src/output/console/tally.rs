@@ -12,7 +12,7 @@ use crate::output::report::sig;
 use crate::output::RunReport;
 use crate::registry::Registry;
 use crate::verdict::Verdict;
-use mcbench_core::stats::holm_bonferroni;
+use mcbench_core::stats::hypothesis::holm_bonferroni_finite;
 
 /// The unbiasedness decision of a cell is its `combined` test row (the Holm and pooled rows feed
 /// it and are not counted).
@@ -62,9 +62,11 @@ impl Tally {
             }
         }
         let decisions: Vec<&crate::analysis::TestRow> = report.tests.iter().filter(|r| r.test == DECISION).collect();
-        // Holm over the decisions of estimators registered unbiased, in their order.
+        // Holm over the tested decisions of estimators registered unbiased (as the unbiasedness
+        // experiment's headline claim), in their order.
         let unbiased: Vec<f64> = decisions.iter().filter(|r| r.claim == "unbiased").map(|r| r.p_value).collect();
-        let mut holm = holm_bonferroni(&unbiased).into_iter();
+        let tested = unbiased.iter().filter(|p| !p.is_nan()).count();
+        let mut holm = holm_bonferroni_finite(&unbiased).into_iter();
         for row in decisions {
             match row.verdict.as_str() {
                 "pass" => t.pass += 1,
@@ -76,9 +78,8 @@ impl Tally {
             let exempt = registry.exemption(id, &row.testbed, &row.variant).is_some();
             let family = match adjusted {
                 Some(q) if row.verdict == "biased" && q > row.alpha => format!(
-                    "; p {} at its own level, not significant after Holm over the {} decisions of unbiased estimators",
-                    sig(row.p_value, 2),
-                    unbiased.len()
+                    "; p {} at its own level, not significant after Holm over the {tested} decisions of unbiased estimators",
+                    sig(row.p_value, 2)
                 ),
                 _ => String::new(),
             };
