@@ -27,45 +27,55 @@ fn hit_fraction(side: usize) -> f64 {
     hits as f64 / n as f64
 }
 
+/// The four trackers on the Eq. 21 transmittance image at `side` x `side` pixels and a budget of
+/// `budget` fetches, 2 repetitions at `seed`, written below `dir`: the summary rows.
+fn run_trackers(
+    side: usize,
+    budget: u64,
+    seed: u64,
+    dir: &std::path::Path,
+) -> Vec<mcbench::analysis::metrics::SummaryRow> {
+    let registry = experiments::registry();
+    let sweep = Sweep {
+        experiment: "pilot".into(),
+        testbeds: vec![TestBedSpec {
+            id: "eq21-medium".into(),
+            variant: Some("transmittance".into()),
+            params: Params::new().with("resolution", side as f64),
+        }],
+        estimators: TRACKERS.iter().map(|id| EstimatorSpec::new(id)).collect(),
+        budgets: vec![Budget { kind: BudgetKind::Fetches, amount: budget }],
+        reps: 2,
+        seed,
+        mode: Mode::Quick,
+        baseline: None,
+        claims: Vec::new(),
+        bias_tolerance: None,
+        cost_model: Default::default(),
+    };
+    let plan = mcbench::plan::Plan::prepare(sweep, &registry).expect("valid sweep");
+    let opts = ExecOptions {
+        results_root: dir.join("results"),
+        plots_root: dir.join("plots"),
+        threads: Some(2),
+        observer: &Silent,
+        plots: false,
+        wait: false,
+        registry: &registry,
+        integrals: Default::default(),
+    };
+    execute(&plan, None, &opts).expect("run succeeds").report.rows
+}
+
 /// The sample count a fetch budget buys is the same at every seed: the pilot runs on its own seed.
 /// Drawn from the run's seed, delta tracking on the 16x16 Eq. 21 image at 10 fetches took 1.81
 /// samples per pixel (the image's mean) at seed 201 and 1.0 at seeds 210 and 212, where its MSE
 /// doubled.
 #[test]
 fn the_sample_count_of_a_fetch_budget_is_the_same_at_every_seed() {
-    let registry = experiments::registry();
-    let dir = tempfile::tempdir().expect("tempdir");
     let samples = |seed: u64| -> Vec<(String, f64)> {
-        let sweep = Sweep {
-            experiment: "pilot-seed".into(),
-            testbeds: vec![TestBedSpec {
-                id: "eq21-medium".into(),
-                variant: Some("transmittance".into()),
-                params: Params::new().with("resolution", 16.0),
-            }],
-            estimators: TRACKERS.iter().map(|id| EstimatorSpec::new(id)).collect(),
-            budgets: vec![Budget { kind: BudgetKind::Fetches, amount: 10 }],
-            reps: 2,
-            seed,
-            mode: Mode::Quick,
-            baseline: None,
-            claims: Vec::new(),
-            bias_tolerance: None,
-            cost_model: Default::default(),
-        };
-        let plan = mcbench::plan::Plan::prepare(sweep, &registry).expect("valid sweep");
-        let opts = ExecOptions {
-            results_root: dir.path().join(format!("results-{seed}")),
-            plots_root: dir.path().join("plots"),
-            threads: Some(2),
-            observer: &Silent,
-            plots: false,
-            wait: false,
-            registry: &registry,
-            integrals: Default::default(),
-        };
-        let out = execute(&plan, None, &opts).expect("run succeeds");
-        out.report.rows.iter().map(|r| (r.estimator.clone(), r.samples)).collect()
+        let dir = tempfile::tempdir().expect("tempdir");
+        run_trackers(16, 10, seed, dir.path()).iter().map(|r| (r.estimator.clone(), r.samples)).collect()
     };
     let first = samples(201);
     assert_eq!(first.len(), TRACKERS.len());
@@ -79,41 +89,12 @@ fn the_sample_count_of_a_fetch_budget_is_the_same_at_every_seed() {
 /// columns and the count from total samples over total fetches, 1.14-1.50).
 #[test]
 fn fetch_budgets_are_spent_within_ten_percent_at_every_resolution() {
-    let registry = experiments::registry();
     for side in [16usize, 32, 64] {
         let dir = tempfile::tempdir().expect("tempdir");
-        let sweep = Sweep {
-            experiment: "pilot".into(),
-            testbeds: vec![TestBedSpec {
-                id: "eq21-medium".into(),
-                variant: Some("transmittance".into()),
-                params: Params::new().with("resolution", side as f64),
-            }],
-            estimators: TRACKERS.iter().map(|id| EstimatorSpec::new(id)).collect(),
-            budgets: vec![Budget { kind: BudgetKind::Fetches, amount: BUDGET }],
-            reps: 2,
-            seed: 5,
-            mode: Mode::Quick,
-            baseline: None,
-            claims: Vec::new(),
-            bias_tolerance: None,
-            cost_model: Default::default(),
-        };
-        let plan = mcbench::plan::Plan::prepare(sweep, &registry).expect("valid sweep");
-        let opts = ExecOptions {
-            results_root: dir.path().join("results"),
-            plots_root: dir.path().join("plots"),
-            threads: Some(2),
-            observer: &Silent,
-            plots: false,
-            wait: false,
-            registry: &registry,
-            integrals: Default::default(),
-        };
-        let out = execute(&plan, None, &opts).expect("run succeeds");
+        let rows = run_trackers(side, BUDGET, 5, dir.path());
         let hit = hit_fraction(side);
-        assert_eq!(out.report.rows.len(), TRACKERS.len());
-        for row in &out.report.rows {
+        assert_eq!(rows.len(), TRACKERS.len());
+        for row in &rows {
             let spent = row.fetches / hit;
             let ratio = spent / BUDGET as f64;
             assert!(
