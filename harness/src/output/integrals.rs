@@ -71,22 +71,6 @@ pub struct IntegralRow {
     pub estimator_id: String,
 }
 
-impl crate::output::query::Keyed for IntegralRow {
-    fn testbed(&self) -> &str {
-        &self.testbed
-    }
-    fn variant(&self) -> &str {
-        &self.variant
-    }
-    fn estimator(&self) -> &str {
-        &self.estimator
-    }
-    /// An integral row holds every budget's mean: it matches no single budget.
-    fn budget(&self) -> Option<u64> {
-        None
-    }
-}
-
 /// The contract's columns (book: contract.md), in their order; the geometry columns and `estimator_id` follow.
 pub const COLUMNS: [&str; 11] = [
     "testbed",

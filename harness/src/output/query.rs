@@ -67,6 +67,8 @@ keyed!(SpeedUp, r => Some(r.budget));
 keyed!(Diagnostic, r => Some(r.budget));
 keyed!(CellCounts, r => Some(r.budget));
 keyed!(Fit, _r => None);
+// An integral row holds every budget's mean: it matches no single budget.
+keyed!(crate::output::integrals::IntegralRow, _r => None);
 
 impl<T: Keyed> Keyed for &T {
     fn testbed(&self) -> &str {
