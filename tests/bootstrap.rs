@@ -97,7 +97,7 @@ fn ratio_intervals_are_paired_bootstraps_that_rerun_identically_and_fall_back_wi
     let (a, b) = (at("is1_cv2"), at("is0_cv0"));
     for metric in [RatioMetric::Mse, RatioMetric::EfficiencyMse, RatioMetric::PEff, RatioMetric::PErr] {
         let r = Ratio::of(metric, a, b).expect("ratio");
-        assert_eq!(r.method(), "bootstrap over 32 blocks of repetitions, paired (expanded percentile, 2000 resamples)");
+        assert_eq!(r.method(), "bootstrap over 32 blocks of repetitions, paired (expanded percentile x1.25 for heavy tails, 2000 resamples)");
         let (lo, hi) = r.interval();
         assert!(lo < r.value && r.value < hi, "{metric:?}: {} outside [{lo}, {hi}]", r.value);
         // Same cells, same interval, to the bit.

@@ -31,7 +31,8 @@ fn quantile(reps: usize) -> f64 {
 /// when the two were cut into the same blocks), moves the baseline's fitted error at this budget by
 /// its own cell's resampled error (its point's noise, an upper bound for the fit's there), and
 /// draws the baseline's slope from a normal with its fitted standard error; the interval is the
-/// expanded percentile one of the log speed-up. Without blocks it is a delta-method one on the log scale over the
+/// expanded percentile one of the log speed-up, widened by the heavy-tail allowance
+/// ([`crate::analysis::claims::bootstrap::HEAVY_TAIL_ALLOWANCE`]). Without blocks it is a delta-method one on the log scale over the
 /// noise of the two errors (each budget's `mse_se`) and of the baseline's slope, with a Student's t
 /// quantile at one less degree of freedom than the method's repetitions, the seconds per estimate
 /// taken as exact. `interval_method` says which. The overhead is reported in CPU time (`measured`),
