@@ -177,3 +177,26 @@ pub fn measure(
         .collect();
     Ok(Measured { seeds: seeds.into_iter().collect::<Result<_>>()?, threshold })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Shrinking keeps every (integral, channel) mean and scales every deviation from it, hence
+    /// every standard error, by the factor.
+    #[test]
+    fn shrunk_keeps_the_means_and_scales_the_deviations() {
+        let reps: Vec<Vec<[f64; 3]>> =
+            (0..5).map(|r| vec![[r as f64, 2.0 * r as f64, 7.0], [1.0 - r as f64, 0.5, r as f64 * r as f64]]).collect();
+        let s = shrunk(&reps, 0.5);
+        for i in 0..2 {
+            for c in 0..3 {
+                let mean = |v: &[Vec<[f64; 3]>]| v.iter().map(|r| r[i][c]).sum::<f64>() / 5.0;
+                assert!((mean(&s) - mean(&reps)).abs() < 1e-12);
+                for r in 0..5 {
+                    assert!(((s[r][i][c] - mean(&s)) - 0.5 * (reps[r][i][c] - mean(&reps))).abs() < 1e-12);
+                }
+            }
+        }
+    }
+}

@@ -449,45 +449,5 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn calibration_md_escapes_names_and_claims() {
-        let r = Row {
-            testbed: "t<script>".into(),
-            variant: "v|w".into(),
-            estimator: "<img src=x onerror=alert(1)>".into(),
-            claim: "a & b".into(),
-            ..Row::default()
-        };
-        let md = markdown(&[r], "seeds <b>");
-        assert!(!md.contains('<') && !md.contains('>'), "{md}");
-        assert!(md.contains("| t&lt;script&gt;/v\\|w | &lt;img src=x onerror=alert(1)&gt; | a &amp; b |"), "{md}");
-        assert!(md.contains("seeds &lt;b&gt;"), "{md}");
-    }
-
-    #[test]
-    fn wilson_interval_matches_known_values() {
-        let (lo, hi) = wilson(10, 200);
-        assert!((lo - 0.0274).abs() < 5e-4 && (hi - 0.0898).abs() < 5e-4, "{lo} {hi}");
-        assert_eq!(wilson(0, 0), (0.0, 1.0));
-    }
-
-    #[test]
-    fn the_size_band_takes_the_interval_into_account() {
-        // 2 of 100: the interval [0.6%, 7.0%] meets [3.3%, 7.5%]; 0 of 400 does not; 30 of 100 does not.
-        assert!(within_band(2, 100));
-        assert!(!within_band(0, 400));
-        assert!(!within_band(30, 100));
-        assert!(within_band(5, 100));
-    }
-
-    #[test]
-    fn the_80_point_is_interpolated_in_log_bias() {
-        let grid = [0.01, 0.1, 1.0];
-        assert!((point_of(&grid, &[0.0, 0.6, 1.0], 0.8) - 10f64.powf(-0.5)).abs() < 1e-12);
-        assert_eq!(point_of(&grid, &[0.9, 1.0, 1.0], 0.8), 0.01);
-        assert!(point_of(&grid, &[0.0, 0.1, 0.2], 0.8).is_nan());
-    }
-}
+#[path = "table_tests.rs"]
+mod tests;
