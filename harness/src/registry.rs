@@ -131,7 +131,12 @@ pub struct Registry {
     pub(crate) exemptions: Vec<(&'static str, Exemption)>,
     /// Samplers added by the crate that registers them ([`crate::plugins`]).
     pub(crate) samplers: Vec<&'static SamplerEntry>,
+    /// The estimators and test beds before a selection narrowed them ([`crate::selection`]).
+    pub(crate) unselected: Option<Arc<Selected>>,
 }
+
+/// The estimators and test beds of a registry before a selection.
+pub(crate) type Selected = (Vec<&'static EstimatorEntry>, Vec<&'static TestBedEntry>);
 
 impl Default for Registry {
     fn default() -> Self {
@@ -145,6 +150,7 @@ impl Default for Registry {
             chain: Chain(vec![Arc::new(ReferenceDir::new(DEFAULT_REFERENCES))]),
             exemptions: Vec::new(),
             samplers: Vec::new(),
+            unselected: None,
         }
     }
 }
@@ -266,6 +272,19 @@ impl Registry {
     /// Every estimator, in registration order.
     pub fn estimators(&self) -> &[&'static EstimatorEntry] {
         &self.estimators
+    }
+
+    /// The same registry with the estimators and test beds it had before `--estimators` /
+    /// `--testbeds` narrowed it (itself when nothing did): what derived experiments whose items
+    /// depend on each other (the `calibration` families) are derived from before being narrowed.
+    pub fn unselected(&self) -> Registry {
+        let mut out = self.clone();
+        if let Some(full) = self.unselected.as_deref() {
+            out.estimators = full.0.clone();
+            out.test_beds = full.1.clone();
+            out.unselected = None;
+        }
+        out
     }
 
     /// Every test bed, in registration order.

@@ -100,6 +100,9 @@ impl Selection {
         check("--estimators", &self.estimators, &est_ids)?;
         check("--testbeds", &self.testbeds, &bed_ids)?;
         let mut out = registry.clone();
+        if out.unselected.is_none() {
+            out.unselected = Some(std::sync::Arc::new((registry.estimators.clone(), registry.test_beds.clone())));
+        }
         out.estimators.retain(|e| any(&self.estimators, e.id));
         out.test_beds.retain(|t| any(&self.testbeds, t.id));
         let mut notes = Vec::new();

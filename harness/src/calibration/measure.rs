@@ -64,6 +64,9 @@ pub struct SeedOutcome {
     pub firefly_flagged: bool,
     /// The firefly rejection's relative deviation from the reference in this cell.
     pub firefly_rel: f64,
+    /// The deciding row of the planted miscalibrated test ([`shrunk`] by
+    /// [`super::size::PLANTED_SE_FACTOR`]) with no injected bias.
+    pub planted: TestRow,
 }
 
 /// The seeds' outcomes of a family, and the firefly threshold used.
@@ -106,6 +109,20 @@ fn reps_range(plan: &Plan, from: u64, n: usize) -> Result<Vec<Vec<[f64; 3]>>> {
     (from..from + n as u64).map(|r| rep_estimates(plan, r)).collect()
 }
 
+/// The repetitions with every value moved towards its (integral, channel) mean over them by
+/// `factor`: the means are unchanged and every standard error (per integral and of the
+/// per-repetition sums) is `factor` times the original, so the same test on them is the test with
+/// its standard errors shrunk by `factor`, a planted miscalibration.
+pub fn shrunk(reps: &[Vec<[f64; 3]>], factor: f64) -> Vec<Vec<[f64; 3]>> {
+    let n = reps.len().max(1) as f64;
+    let width = reps.first().map_or(0, Vec::len);
+    let mean: Vec<[f64; 3]> =
+        (0..width).map(|i| std::array::from_fn(|c| reps.iter().map(|r| r[i][c]).sum::<f64>() / n)).collect();
+    reps.iter()
+        .map(|r| r.iter().zip(&mean).map(|(x, m)| std::array::from_fn(|c| m[c] + factor * (x[c] - m[c]))).collect())
+        .collect()
+}
+
 /// Measures `family` over `seeds` seeds from `seed` at the relative `tolerance`.
 pub fn measure(
     family: &Family,
@@ -134,13 +151,16 @@ pub fn measure(
                 let t: Vec<Vec<[f64; 3]>> = reps.iter().map(|v| v.iter().map(|x| f(*x)).collect()).collect();
                 guarded::cell_of(bed, &id, budget, seed, &t)
             };
-            let decide = |f: &dyn Fn([f64; 3]) -> [f64; 3]| {
-                let gate = Gate::from_cell(&cell(&pilot, f), "pilot", 1.0).with_group(group);
-                let rows = unbiasedness(&cell(&tested, f), reference, family.bias, Some(&gate), tolerance);
+            let decide_on = |tested: &[Vec<[f64; 3]>], pilot: &[Vec<[f64; 3]>], f: &dyn Fn([f64; 3]) -> [f64; 3]| {
+                let gate = Gate::from_cell(&cell(pilot, f), "pilot", 1.0).with_group(group);
+                let rows = unbiasedness(&cell(tested, f), reference, family.bias, Some(&gate), tolerance);
                 let ran = rows.iter().any(|t| t.test == "pooled_t" && !t.p_value.is_nan());
                 (rows.into_iter().find(|t| t.test == "combined").unwrap_or_default(), ran)
             };
+            let decide = |f: &dyn Fn([f64; 3]) -> [f64; 3]| decide_on(&tested, &pilot, f);
             let (null, pooled_ran) = decide(&|x| x);
+            let factor = super::size::PLANTED_SE_FACTOR;
+            let planted = decide_on(&shrunk(&tested, factor), &shrunk(&pilot, factor), &|x| x).0;
             let flagged =
                 grid.iter().map(|b| decide(&|x: [f64; 3]| x.map(|c| c * (1.0 + b))).0.verdict == "biased").collect();
             let fire = decide(&|x| drop_above(x, threshold)).0;
@@ -151,8 +171,32 @@ pub fn measure(
                 flagged,
                 firefly_flagged: fire.verdict == "biased",
                 firefly_rel: fire_cell.rep_dev.mean() / ref_sum,
+                planted,
             })
         })
         .collect();
     Ok(Measured { seeds: seeds.into_iter().collect::<Result<_>>()?, threshold })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Shrinking keeps every (integral, channel) mean and scales every deviation from it, hence
+    /// every standard error, by the factor.
+    #[test]
+    fn shrunk_keeps_the_means_and_scales_the_deviations() {
+        let reps: Vec<Vec<[f64; 3]>> =
+            (0..5).map(|r| vec![[r as f64, 2.0 * r as f64, 7.0], [1.0 - r as f64, 0.5, r as f64 * r as f64]]).collect();
+        let s = shrunk(&reps, 0.5);
+        for i in 0..2 {
+            for c in 0..3 {
+                let mean = |v: &[Vec<[f64; 3]>]| v.iter().map(|r| r[i][c]).sum::<f64>() / 5.0;
+                assert!((mean(&s) - mean(&reps)).abs() < 1e-12);
+                for r in 0..5 {
+                    assert!(((s[r][i][c] - mean(&s)) - 0.5 * (reps[r][i][c] - mean(&reps))).abs() < 1e-12);
+                }
+            }
+        }
+    }
 }

@@ -15,6 +15,7 @@
 //! first case at one seed; the analysis ([`post`]) measures every family.
 
 pub mod measure;
+pub mod size;
 pub mod table;
 pub mod wrap;
 
@@ -61,41 +62,68 @@ pub fn experiment() -> Experiment {
     }
 }
 
-/// The row families of a registry in a mode (see the module docs).
+/// The row families of a registry in a mode (see the module docs): derived from the registry
+/// before any `--estimators` / `--testbeds` selection ([`Registry::unselected`]) and then narrowed
+/// to the selected estimators and test beds, so a family is the same (the same case, samples,
+/// repetitions, seeds and streams) whichever other families run, and the table can be completed in
+/// pieces.
 pub fn families(registry: &Registry, mode: Mode) -> Vec<Family> {
+    let full = registry.unselected();
     let mut out = Vec::new();
-    for part in crate::unbiasedness::parts(registry, mode) {
+    // Every unbiased estimator's cheapest case (samples x repetitions x integrals, then registry
+    // order), for the estimators no case's first-unbiased rule reaches.
+    let mut cheapest: Vec<(u64, Family)> = Vec::new();
+    for part in crate::unbiasedness::parts(&full, mode) {
         for bed in &part.sweep.testbeds {
             let one = Sweep { testbeds: vec![bed.clone()], ..part.sweep.clone() };
-            let Ok((plans, _)) = crate::unbiasedness::run::prepare_valid(one, registry) else { continue };
+            let Ok((plans, _)) = crate::unbiasedness::run::prepare_valid(one, &full) else { continue };
             let mut unbiased = 0;
             for plan in &plans {
+                let integrals = plan.beds.first().map_or(1, |b| b.bed.integrals()) as u64;
                 for &(_, ei) in &plan.pairs {
                     let e = &plan.estimators[ei];
                     let variant = bed.variant.clone().unwrap_or_default();
+                    let family = Family {
+                        bed: bed.clone(),
+                        estimator: e.spec.clone(),
+                        samples: part.samples,
+                        reps: part.sweep.reps,
+                        bias: e.entry.bias,
+                    };
                     let take = match e.entry.bias {
                         Bias::Unbiased if unbiased < unbiased_per_case(mode) => {
                             unbiased += 1;
                             true
                         }
                         Bias::Biased => {
-                            crate::unbiasedness::run::exemption(registry, &e.spec.id, &bed.id, &variant).is_none()
+                            crate::unbiasedness::run::exemption(&full, &e.spec.id, &bed.id, &variant).is_none()
                         }
                         _ => false,
                     };
+                    if e.entry.bias == Bias::Unbiased {
+                        let cost = part.samples * part.sweep.reps as u64 * integrals;
+                        match cheapest.iter_mut().find(|(_, f)| f.estimator.id == e.spec.id) {
+                            Some(c) if cost < c.0 => *c = (cost, family.clone()),
+                            Some(_) => {}
+                            None => cheapest.push((cost, family.clone())),
+                        }
+                    }
                     if take {
-                        out.push(Family {
-                            bed: bed.clone(),
-                            estimator: e.spec.clone(),
-                            samples: part.samples,
-                            reps: part.sweep.reps,
-                            bias: e.entry.bias,
-                        });
+                        out.push(family);
                     }
                 }
             }
         }
     }
+    for (_, f) in cheapest {
+        if !out.iter().any(|o| o.estimator.id == f.estimator.id) {
+            out.push(f);
+        }
+    }
+    out.retain(|f| {
+        registry.estimators().iter().any(|e| e.id == f.estimator.id)
+            && registry.test_beds().iter().any(|t| t.id == f.bed.id)
+    });
     out
 }
 
@@ -141,6 +169,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
     let tolerance = plan.sweep.tolerance();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(report.meta.threads.max(1)).build();
     let mut rows = Vec::new();
+    let mut seeds_p = Vec::new();
     let mut timing = Vec::new();
     for family in families_of_run(plan, registry) {
         let t = Instant::now();
@@ -149,6 +178,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
             Err(_) => measure::measure(&family, n, plan.sweep.seed, tolerance, mode, registry),
         }?;
         rows.push(table::row(&family, &m, &family.estimator.name()));
+        seeds_p.extend(size::seed_rows(&family, &m, &family.estimator.name()));
         timing.push(format!("{}/{} {:.1} s", family.bed.id, family.estimator.name(), t.elapsed().as_secs_f64()));
     }
     let header = format!(
@@ -159,7 +189,9 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
         crate::analysis::UNBIASEDNESS_ALPHA,
         t0.elapsed().as_secs_f64()
     );
+    table::judge_size(&mut rows);
     results.write_csv("calibration.csv", &rows)?;
+    results.write_csv("calibration-pvalues.csv", &seeds_p)?;
     results.write("calibration.md", table::markdown(&rows, &header).as_bytes())?;
     report.meta.notes.push(format!("calibration: {header}; per family: {}", timing.join(", ")));
     report.paper.extend(table::claims(&rows));
@@ -170,24 +202,37 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
 mod tests {
     use super::*;
 
-    /// Every case gets at most one unbiased family in quick mode, every control that is not exempted is a
-    /// family somewhere, and each family carries its row's samples and repetitions.
-    #[test]
-    fn families_cover_the_controls_and_few_unbiased_estimators_per_case() {
-        let registry = Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
+    fn registry() -> Registry {
+        Registry::new().with_catalog(mcbench_papers::catalog()).with_references(
             crate::store::references::ReferenceDir::new(concat!(
                 env!("CARGO_MANIFEST_DIR"),
                 "/../estimators/references"
             )),
-        );
+        )
+    }
+
+    /// Every unbiased estimator and every control that is not exempted is a family somewhere, a
+    /// case gets at most one first-unbiased family in quick mode (plus the estimators whose
+    /// cheapest case it is), and each family carries its row's samples and repetitions.
+    #[test]
+    fn families_cover_every_unbiased_estimator_and_the_controls() {
+        let registry = registry();
         let all = families(&registry, Mode::Quick);
+        for e in registry.estimators().iter().filter(|e| matches!(e.bias, Bias::Biased | Bias::Unbiased)) {
+            assert!(all.iter().any(|f| f.estimator.id == e.id), "{} is in no family", e.id);
+        }
+        // Beyond the first unbiased estimator of each case, an unbiased estimator has one family.
         let mut per_case = std::collections::HashMap::new();
         for f in all.iter().filter(|f| f.bias == Bias::Unbiased) {
-            *per_case.entry((f.bed.id.clone(), f.bed.variant.clone())).or_insert(0) += 1;
+            per_case
+                .entry((f.bed.id.clone(), f.bed.variant.clone()))
+                .or_insert_with(Vec::new)
+                .push(f.estimator.id.clone());
         }
-        assert!(per_case.values().all(|&n| n <= unbiased_per_case(Mode::Quick)), "{per_case:?}");
-        for e in registry.estimators().iter().filter(|e| e.bias == Bias::Biased) {
-            assert!(all.iter().any(|f| f.estimator.id == e.id), "control {} is in no family", e.id);
+        for ids in per_case.values() {
+            for id in &ids[unbiased_per_case(Mode::Quick).min(ids.len())..] {
+                assert_eq!(all.iter().filter(|f| &f.estimator.id == id).count(), 1, "{id}: {ids:?}");
+            }
         }
         let parts = crate::unbiasedness::parts(&registry, Mode::Quick);
         for f in &all {
@@ -195,5 +240,24 @@ mod tests {
                 .iter()
                 .any(|p| p.samples == f.samples && p.sweep.reps == f.reps && p.sweep.testbeds.contains(&f.bed)));
         }
+    }
+
+    /// A selection narrows the families without changing them: the families of a registry narrowed
+    /// to some estimators are exactly the full registry's families of those estimators.
+    #[test]
+    fn a_selection_narrows_the_families_without_changing_them() {
+        let registry = registry();
+        let key = |f: &Family| (f.bed.clone(), f.estimator.name(), f.samples, f.reps);
+        let all: Vec<_> = families(&registry, Mode::Quick).iter().map(key).collect();
+        let only = crate::selection::Selection::new(Some("pmc_hi*,spm_*,delta_tracking"), None);
+        let (narrowed, _) = only.apply(&registry).unwrap();
+        let some: Vec<_> = families(&narrowed, Mode::Quick).iter().map(key).collect();
+        let expected: Vec<_> = all
+            .iter()
+            .filter(|k| ["pmc_hi", "spm_", "delta_tracking"].iter().any(|p| k.1.starts_with(p)))
+            .cloned()
+            .collect();
+        assert_eq!(some, expected);
+        assert_eq!(some.iter().filter(|k| k.1 == "pmc_hi").count(), 1);
     }
 }

@@ -1,7 +1,8 @@
 //! The calibration table: per row family, the measured false-flag rate, power and 80% point beside
 //! what the unbiasedness rows report, and the checks they are held to.
 
-use super::measure::{bias_grid, Family, Measured, NOMINAL};
+use super::measure::{bias_grid, Family, Measured, SeedOutcome, NOMINAL};
+use super::size;
 use crate::output::Claim;
 use mcbench_core::estimator::Bias;
 use serde::{Deserialize, Serialize};
@@ -68,7 +69,31 @@ pub struct Row {
     pub ok_control: Option<bool>,
     /// What the checks found.
     pub note: String,
+    /// Unbiased families, no injected bias: seeds with a combined p-value (the decision-level size
+    /// check's sample; 0 for a control or a zero-variance estimator).
+    pub size_seeds: usize,
+    /// Of those, the count below the verdicts' alpha.
+    pub below_alpha: usize,
+    /// Of those, the count below 1%.
+    pub below_1pct: usize,
+    /// Of those, the count below 5%.
+    pub below_5pct: usize,
+    /// The family's size p-value at the decision level ([`super::size::family_p`]).
+    pub size_p: f64,
+    /// The decision-level size check, Holm across the families judged ([`super::size`]; None: not
+    /// judged).
+    pub ok_size: Option<bool>,
+    /// The planted miscalibrated test's size p-value on the same seeds.
+    pub planted_size_p: f64,
+    /// Its count below the verdicts' alpha.
+    pub planted_below_alpha: usize,
+    /// Whether the planted test passes the same check (it should not).
+    pub planted_ok_size: Option<bool>,
 }
+
+/// Below this flag rate of the firefly rejection an unbiased row's note says its power against a
+/// rare-large-value bug is low.
+pub const FIREFLY_LOW_POWER: f64 = 0.5;
 
 /// The band the false-flag rate must be consistent with: within 1.5x of [`NOMINAL`].
 pub const SIZE_BAND: (f64, f64) = (NOMINAL / 1.5, NOMINAL * 1.5);
@@ -180,6 +205,25 @@ pub fn row(family: &Family, m: &Measured, name: &str) -> Row {
     if ok_control == Some(false) {
         note.push(format!("control flagged in {:.1}% of seeds", 100.0 * flag_rate));
     }
+    let firefly_flag_rate = frac(s.iter().filter(|o| o.firefly_flagged).count(), n);
+    let firefly_rel_bias = s.iter().map(|o| o.firefly_rel).sum::<f64>() / n.max(1) as f64;
+    if unbiased && firefly_flag_rate < FIREFLY_LOW_POWER {
+        note.push(format!(
+            "low power against a rare-large-value bug: a firefly rejection ({:+.2}% bias) flagged in {:.0}% of seeds",
+            100.0 * firefly_rel_bias,
+            100.0 * firefly_flag_rate
+        ));
+    }
+    let judged = unbiased && !deterministic;
+    let p_of = |t: fn(&SeedOutcome) -> f64| -> Vec<f64> {
+        if judged {
+            s.iter().map(t).collect()
+        } else {
+            Vec::new()
+        }
+    };
+    let (counts, size_seeds) = size::tail_counts(&p_of(|o| o.null.p_value));
+    let (planted, planted_seeds) = size::tail_counts(&p_of(|o| o.planted.p_value));
     Row {
         testbed: family.bed.id.clone(),
         variant: family.bed.variant.clone().unwrap_or_default(),
@@ -201,13 +245,45 @@ pub fn row(family: &Family, m: &Measured, name: &str) -> Row {
         measured_80,
         detectable_ratio: detectable / measured_80,
         firefly_threshold: m.threshold,
-        firefly_rel_bias: s.iter().map(|o| o.firefly_rel).sum::<f64>() / n.max(1) as f64,
-        firefly_flag_rate: frac(s.iter().filter(|o| o.firefly_flagged).count(), n),
+        firefly_rel_bias,
+        firefly_flag_rate,
         ok_false_flag,
         ok_detectable,
         ok_power,
         ok_control,
         note: if note.is_empty() { "ok".into() } else { note.join("; ") },
+        size_seeds,
+        below_alpha: counts[0],
+        below_1pct: counts[1],
+        below_5pct: counts[2],
+        size_p: size::family_p(counts, size_seeds),
+        ok_size: None,
+        planted_size_p: size::family_p(planted, planted_seeds),
+        planted_below_alpha: planted[0],
+        planted_ok_size: None,
+    }
+}
+
+/// The decision-level size check across `rows` (Holm over the families judged, [`super::size`]):
+/// sets `ok_size` and `planted_ok_size`, and adds a failing family's counts to its note.
+pub fn judge_size(rows: &mut [Row]) {
+    let real = size::holm_rejects(&rows.iter().map(|r| r.size_p).collect::<Vec<_>>(), size::FAMILY_FWER);
+    let planted = size::holm_rejects(&rows.iter().map(|r| r.planted_size_p).collect::<Vec<_>>(), size::FAMILY_FWER);
+    for (r, (bad, planted_bad)) in rows.iter_mut().zip(real.into_iter().zip(planted)) {
+        r.ok_size = r.size_p.is_finite().then_some(!bad);
+        r.planted_ok_size = r.planted_size_p.is_finite().then_some(!planted_bad);
+        if bad {
+            let text = format!(
+                "size fails at the decision level: {} below {}, {} below 1%, {} below 5% of {} seeds (size p {:.1e})",
+                r.below_alpha,
+                crate::analysis::UNBIASEDNESS_ALPHA,
+                r.below_1pct,
+                r.below_5pct,
+                r.size_seeds,
+                r.size_p
+            );
+            r.note = if r.note == "ok" { text } else { format!("{}; {text}", r.note) };
+        }
     }
 }
 
@@ -231,18 +307,20 @@ fn mark(x: Option<bool>) -> &'static str {
 pub fn markdown(rows: &[Row], header: &str) -> String {
     use crate::output::report::md_text;
     let mut s = format!("# calibration\n\n{}\n\n", md_text(header));
-    s.push_str("| test bed | estimator | claim | reps | seeds | tested % | false flags % at 5% [95% CI] | flagged % | pass % | power 1% | power 1% on pass | power 3% | detectable % | measured 80% point % | firefly bias % / flagged % | checks |\n");
-    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    s.push_str("| test bed | estimator | claim | reps | seeds | tested % | false flags % at 5% [95% CI] | flagged % | pass % | power 1% | power 1% on pass | power 3% | detectable % | measured 80% point % | firefly bias % / flagged % | p below alpha / 1% / 5% of seeds (planted below alpha) | checks | note |\n");
+    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for r in rows {
         let checks = format!(
-            "size {} / detectable {} / power {} / control {}",
+            "size at alpha {} (planted {}) / size 5% {} / detectable {} / power {} / control {}",
+            mark(r.ok_size),
+            mark(r.planted_ok_size),
             mark(r.ok_false_flag),
             mark(r.ok_detectable),
             mark(r.ok_power),
             mark(r.ok_control)
         );
         s.push_str(&format!(
-            "| {}/{} | {} | {} | {} | {} | {} | {} [{}, {}] | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} |\n",
+            "| {}/{} | {} | {} | {} | {} | {} | {} [{}, {}] | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} | {} | {} |\n",
             md_text(&r.testbed),
             md_text(&r.variant),
             md_text(&r.estimator),
@@ -262,7 +340,16 @@ pub fn markdown(rows: &[Row], header: &str) -> String {
             pct(r.measured_80),
             pct(r.firefly_rel_bias),
             pct(r.firefly_flag_rate),
-            checks
+            if r.size_seeds == 0 {
+                "-".to_string()
+            } else {
+                format!(
+                    "{} / {} / {} of {} ({})",
+                    r.below_alpha, r.below_1pct, r.below_5pct, r.size_seeds, r.planted_below_alpha
+                )
+            },
+            checks,
+            md_text(&r.note)
         ));
     }
     s
@@ -357,49 +444,10 @@ pub fn claims(rows: &[Row]) -> Vec<Claim> {
             }
         })
         .chain(pooled_claims(rows))
+        .chain(size::claims(rows))
         .collect()
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn calibration_md_escapes_names_and_claims() {
-        let r = Row {
-            testbed: "t<script>".into(),
-            variant: "v|w".into(),
-            estimator: "<img src=x onerror=alert(1)>".into(),
-            claim: "a & b".into(),
-            ..Row::default()
-        };
-        let md = markdown(&[r], "seeds <b>");
-        assert!(!md.contains('<') && !md.contains('>'), "{md}");
-        assert!(md.contains("| t&lt;script&gt;/v\\|w | &lt;img src=x onerror=alert(1)&gt; | a &amp; b |"), "{md}");
-        assert!(md.contains("seeds &lt;b&gt;"), "{md}");
-    }
-
-    #[test]
-    fn wilson_interval_matches_known_values() {
-        let (lo, hi) = wilson(10, 200);
-        assert!((lo - 0.0274).abs() < 5e-4 && (hi - 0.0898).abs() < 5e-4, "{lo} {hi}");
-        assert_eq!(wilson(0, 0), (0.0, 1.0));
-    }
-
-    #[test]
-    fn the_size_band_takes_the_interval_into_account() {
-        // 2 of 100: the interval [0.6%, 7.0%] meets [3.3%, 7.5%]; 0 of 400 does not; 30 of 100 does not.
-        assert!(within_band(2, 100));
-        assert!(!within_band(0, 400));
-        assert!(!within_band(30, 100));
-        assert!(within_band(5, 100));
-    }
-
-    #[test]
-    fn the_80_point_is_interpolated_in_log_bias() {
-        let grid = [0.01, 0.1, 1.0];
-        assert!((point_of(&grid, &[0.0, 0.6, 1.0], 0.8) - 10f64.powf(-0.5)).abs() < 1e-12);
-        assert_eq!(point_of(&grid, &[0.9, 1.0, 1.0], 0.8), 0.01);
-        assert!(point_of(&grid, &[0.0, 0.1, 0.2], 0.8).is_nan());
-    }
-}
+#[path = "table_tests.rs"]
+mod tests;
