@@ -15,6 +15,7 @@
 //! first case at one seed; the analysis ([`post`]) measures every family.
 
 pub mod measure;
+pub mod report;
 pub mod size;
 pub mod table;
 pub mod wrap;
@@ -192,9 +193,9 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
     table::judge_size(&mut rows);
     results.write_csv("calibration.csv", &rows)?;
     results.write_csv("calibration-pvalues.csv", &seeds_p)?;
-    results.write("calibration.md", table::markdown(&rows, &header).as_bytes())?;
+    results.write("calibration.md", report::markdown(&rows, &header).as_bytes())?;
     report.meta.notes.push(format!("calibration: {header}; per family: {}", timing.join(", ")));
-    report.paper.extend(table::claims(&rows));
+    report.paper.extend(report::claims(&rows));
     Ok(Vec::new())
 }
 

@@ -254,11 +254,11 @@ mod tests {
         let (mut false_fail, mut planted_family, mut planted_pooled) = (0, 0, 0);
         for _ in 0..runs {
             let (per, pooled) = check(&simulated(&mut rng, 40, 100, 1.0));
-            if !pooled || per.iter().any(|p| *p == Some(false)) {
+            if !pooled || per.contains(&Some(false)) {
                 false_fail += 1;
             }
             let (per, pooled) = check(&simulated(&mut rng, 40, 100, PLANTED_SE_FACTOR));
-            planted_family += usize::from(per.iter().any(|p| *p == Some(false)));
+            planted_family += usize::from(per.contains(&Some(false)));
             planted_pooled += usize::from(!pooled);
         }
         let rate = false_fail as f64 / runs as f64;

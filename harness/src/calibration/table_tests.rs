@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::analysis::TestRow;
+use crate::calibration::report::markdown;
 use crate::config::{EstimatorSpec, TestBedSpec};
 
 #[test]
