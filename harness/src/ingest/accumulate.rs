@@ -51,8 +51,7 @@ impl<'a> CellBuilder<'a> {
         let n = values.len().min(self.reference.value.len());
         let (mut dev, mut sq, mut p_err, mut display) =
             (NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new(), NeumaierSum::new());
-        for i in 0..n {
-            let (v, r) = (values[i], self.reference.value[i]);
+        for (i, (&v, &r)) in values.iter().zip(&self.reference.value).enumerate() {
             let mut sq_i = 0.0;
             for c in 0..3 {
                 self.cell.moments[i][c].push(v[c]);
