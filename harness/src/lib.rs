@@ -24,6 +24,7 @@
 //! | [`output`] | `summary.csv`/`summary.json`, `integrals.csv`, report, console, plots, HTML, listings |
 //! | [`unbiasedness`], [`calibration`], [`sensitivity`], [`conformance`] | the built-in experiments and the plug-in check |
 //! | [`compare`] | two runs compared: changes with intervals and verdicts, baselines |
+//! | [`ingest`] | estimates another program wrote, read from files and analysed as a run |
 //! | [`registry`], [`plugins`], [`selection`] | names looked up, what a user's crate adds to built-in checks, the entries a run is limited to |
 //!
 //! ## Quick start: your own estimator, from your own crate
@@ -81,6 +82,7 @@ pub mod compare;
 pub mod config;
 pub mod conformance;
 pub mod error;
+pub mod ingest;
 pub mod output;
 pub mod plan;
 pub mod plugins;

@@ -110,3 +110,34 @@ pub(super) fn param_pairs(pairs: &[String]) -> Result<Params> {
     }
     Ok(p)
 }
+
+/// `mcbench ingest`: reads the manifest's files, writes the results and prints each estimator's
+/// declared bias beside its test's verdict.
+pub(super) fn ingest(
+    manifest: &std::path::Path,
+    results_root: std::path::PathBuf,
+    plots_root: std::path::PathBuf,
+    plots: bool,
+    wait: bool,
+    integrals: IntegralsFormat,
+    registry: &Registry,
+) -> Result<()> {
+    let opts = crate::ingest::IngestOptions { results_root, plots_root, plots, wait, integrals, registry };
+    let t0 = std::time::Instant::now();
+    let (out, judged) = crate::ingest::ingest(manifest, &opts)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    let tally = crate::output::console::print_experiment(&out.report, seconds, false, registry);
+    let report = plots.then(|| out.plots_dir.join("index.html"));
+    crate::output::console::print_totals(&[tally], seconds, crate::run::phases::process_seconds(), report.as_deref());
+    for j in &judged {
+        let said = match j.expectation {
+            crate::ingest::Expectation::AsDeclared => "as declared",
+            crate::ingest::Expectation::Contradicted => "CONTRADICTS the declaration",
+            crate::ingest::Expectation::Undecided => "undecided",
+            crate::ingest::Expectation::NoClaim => "no declaration",
+        };
+        println!("{}: declared {:?}, unbiasedness test {}: {said}", j.estimator, j.declared, j.verdict);
+    }
+    println!("results: {}", out.results_dir.display());
+    Ok(())
+}

@@ -1,4 +1,4 @@
-//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, `compare`, and the
+//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, `compare`, `ingest`, and the
 //! default quick suite. Every subcommand exits by the one table of [`crate::error`]: bad input is
 //! one line on stderr naming the field or file, exit code 2, and nothing written; a results folder
 //! that another run holds is exit code 3 (or a wait, with `--wait`).
@@ -104,6 +104,29 @@ enum Command {
         /// Where stored references are read (default: `<results>/references`).
         #[arg(long, value_name = "DIR")]
         references: Option<PathBuf>,
+    },
+    /// Analyse per-repetition estimates another program wrote, described by a manifest.toml.
+    Ingest {
+        /// The manifest (book: your-renderer.md).
+        manifest: PathBuf,
+        /// Results root (the manifest's `name` folder is written below it).
+        #[arg(long, value_name = "DIR", default_value = "results")]
+        results: PathBuf,
+        /// Plots root.
+        #[arg(long, value_name = "DIR", default_value = "plots")]
+        plots: PathBuf,
+        /// Skip plots and reports.
+        #[arg(long)]
+        no_plots: bool,
+        /// Wait for another run holding the output folders instead of refusing.
+        #[arg(long)]
+        wait: bool,
+        /// Where stored references are read (default: `<results>/references`).
+        #[arg(long, value_name = "DIR")]
+        references: Option<PathBuf>,
+        /// The per-integral file: gz (integrals.csv.gz), csv (plain integrals.csv) or none
+        #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
+        integrals: IntegralsFormat,
     },
     /// Compare two runs: per cell, the change from A to B in RMSE, efficiency, FoM and slope with
     /// 95% intervals and verdicts (improved, regressed, no change, inconclusive).
@@ -368,6 +391,10 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             );
             println!("merged results: {}  plots: {}", out.results_dir.display(), out.plots_dir.display());
             Ok(())
+        }
+        Some(Command::Ingest { manifest, results, plots, no_plots, wait, references, integrals }) => {
+            let registry = &with_references(registry, &results, &references);
+            ingest(&manifest, results, plots, !no_plots, wait, integrals, registry)
         }
         Some(Command::Compare {
             a,

@@ -154,7 +154,7 @@ pub fn powers_of_four(ks: std::ops::RangeInclusive<u32>) -> Vec<Budget> {
 
 /// A TOML error as one line: the message, the line and column where it starts, and that line's
 /// text (which holds the key, so the field is named even for a syntax error).
-fn toml_reason(text: &str, e: &toml::de::Error) -> String {
+pub(crate) fn toml_reason(text: &str, e: &toml::de::Error) -> String {
     let msg = e.message().lines().next().unwrap_or("malformed").to_string();
     let Some(span) = e.span() else { return msg };
     let start = span.start.min(text.len());
