@@ -182,7 +182,8 @@ fn the_budget_stops_the_rounds() {
         .collect();
     let first: u64 = entries.iter().map(Entry::spent).sum();
     // Room for one row's doubling only: the cheaper (or the first of equals) grows, once.
-    let ran = grow(&mut entries, first + entries[0].spent(), 1, |_| Ok(())).expect("grow");
+    let room = first + entries[0].spent();
+    let ran = grow(&mut entries, room, 1, |_| Ok(())).expect("grow");
     assert_eq!(ran, 1);
     assert_eq!(entries.iter().map(|e| e.cell.key.reps).collect::<Vec<_>>(), vec![128, 64]);
     assert!(entries.iter().all(|e| !e.open), "a doubling that does not fit closes its row");

@@ -93,7 +93,6 @@ pub fn synthetic_report() -> RunReport {
             run_id: "r1".into(),
             reproducible: true,
             cost_model: Default::default(),
-            repetitions: Default::default(),
         },
         fits,
         tests: vec![test("is0_cv0", 0.42, "pass"), test("is1_cv2", 3.1e-7, "biased")],
