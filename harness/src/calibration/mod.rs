@@ -15,6 +15,7 @@
 //! first case at one seed; the analysis ([`post`]) measures every family.
 
 pub mod measure;
+pub mod rounds;
 pub mod table;
 pub mod wrap;
 
@@ -134,6 +135,9 @@ fn first_sweep(registry: &Registry, mode: Mode) -> Sweep {
 
 /// Measures every family and writes `calibration.csv` and `calibration.md`, and the claims.
 pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    if !cx.plan.sweep.repetitions.is_fixed() {
+        return rounds::post(cx);
+    }
     let PostContext { plan, report, out: results, registry, .. } = cx;
     let t0 = Instant::now();
     let mode = plan.sweep.mode;

@@ -141,7 +141,8 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
     Ok(())
 }
 
-/// `--repetitions rounds`: only `unbiasedness` runs in rounds, and not sharded (a shard cannot see
+/// `--repetitions rounds`: only `unbiasedness` runs in rounds (`calibration` measures its rule),
+/// and not sharded (a shard cannot see
 /// which rows the others left open); the first part runs its first round, the fixed-mode
 /// repetitions kept in the sweep's mode.
 fn in_rounds(sweep: &mut crate::config::Sweep, args: &RunArgs) -> Result<()> {
