@@ -142,9 +142,8 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
 }
 
 /// `--repetitions rounds`: only `unbiasedness` runs in rounds (`calibration` measures its rule),
-/// and not sharded (a shard cannot see
-/// which rows the others left open); the first part runs its first round, the fixed-mode
-/// repetitions kept in the sweep's mode.
+/// and not sharded (a shard cannot see which rows the others left open); the first part runs its
+/// first round, the fixed-mode repetitions kept in the sweep's mode.
 fn in_rounds(sweep: &mut crate::config::Sweep, args: &RunArgs) -> Result<()> {
     let refuse = |reason: String| -> Result<()> {
         Err(mcbench_core::error::ConfigError::invalid("--repetitions", "rounds", reason).into())
@@ -152,14 +151,19 @@ fn in_rounds(sweep: &mut crate::config::Sweep, args: &RunArgs) -> Result<()> {
     if args.shard.is_some() {
         return refuse("a sharded run cannot follow the rounds (each round depends on every row's last look): run it without --shard".into());
     }
+    sweep.repetitions = crate::config::Repetitions::Rounds { fixed_reps: sweep.reps };
+    if sweep.experiment == crate::calibration::NAME {
+        // Calibration measures the rule of the rounds on its own seeds; its sweep runs as it is.
+        return Ok(());
+    }
     if sweep.experiment != crate::unbiasedness::NAME {
         return refuse(format!(
-            "only the {} experiment runs in rounds, not {}",
+            "only the {} experiment runs in rounds (and {} measures them), not {}",
             crate::unbiasedness::NAME,
+            crate::calibration::NAME,
             sweep.experiment
         ));
     }
-    sweep.repetitions = crate::config::Repetitions::Rounds { fixed_reps: sweep.reps };
     sweep.reps = crate::unbiasedness::rounds::first_round(sweep.reps);
     Ok(())
 }
