@@ -62,12 +62,15 @@ pub struct RoundsRow {
     pub mean_reps: f64,
 }
 
+/// Per repetition, every integral's estimate.
+type Reps = Vec<Vec<[f64; 3]>>;
+
 /// One seed's looks at the family-wise `alpha`: the last look's deciding row, whether any look
 /// flagged it, whether any look ran a test, and the repetitions it stopped at.
 fn looks(
     plan: &Plan,
     family: &Family,
-    (cell_reps, pilot_reps): (&mut Vec<Vec<[f64; 3]>>, &mut Vec<Vec<[f64; 3]>>),
+    (cell_reps, pilot_reps): (&mut Reps, &mut Reps),
     (cell_from, pilot_from): (u64, u64),
     alpha: f64,
     tolerance: f64,

@@ -63,7 +63,7 @@ fn first_rounds_are_a_quarter_in_whole_blocks_and_at_least_the_minimum() {
     assert_eq!(first_round(1500), 384);
     assert_eq!(first_round(16_384), 4096);
     assert_eq!(first_round(2), MIN_FIRST_REPS);
-    assert!([100, 1000, 4097].iter().all(|&r| first_round(r) % REP_BLOCK == 0));
+    assert!([100, 1000, 4097].iter().all(|&r| first_round(r).is_multiple_of(REP_BLOCK)));
 }
 
 fn combined(verdict: &str, reps_needed: Option<f64>) -> Vec<TestRow> {
