@@ -92,7 +92,7 @@ fn looks(
         let row = tests.iter().find(|t| t.test == "combined").cloned().unwrap_or_default();
         tested |= !row.p_value.is_nan();
         flagged |= row.verdict == "biased";
-        if !stays_open(&tests, reps, look, true) {
+        if !stays_open(&tests, reps, look, true, false) {
             return Ok((row, flagged, tested, reps));
         }
         reps *= 2;

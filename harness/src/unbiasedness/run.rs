@@ -287,15 +287,18 @@ fn in_rounds(
             push_entries(&mut entries, (&r.plan, &r.pilot_plan), &r.run.cells, &r.pilot.cells, r.fixed);
         }
     }
-    for e in &mut entries {
-        let (tests, _, can_pass) = judge_cell(e.plan, (e.bi, e.ei), &e.cell, &e.pilot, registry, alpha);
-        e.open = rounds::stays_open(&tests, e.cell.key.reps, e.looks, can_pass);
-    }
+    // A look: the entry's tests at the level of a look, whether it stays open, what it needs.
+    let look = |e: &mut Entry<'_>| {
+        let (tests, exempt, can_pass) = judge_cell(e.plan, (e.bi, e.ei), &e.cell, &e.pilot, registry, alpha);
+        e.control = e.plan.estimators[e.ei].entry.bias == mcbench_core::estimator::Bias::Biased && exempt.is_none();
+        e.open = rounds::stays_open(&tests, e.cell.key.reps, e.looks, can_pass, e.control);
+        e.needed = rounds::needed(&tests);
+    };
+    entries.iter_mut().for_each(|e| look(e));
     let budget: u64 = entries.iter().map(Entry::fixed_cost).sum();
     let t0 = Instant::now();
     let extra = rounds::grow(&mut entries, budget, report.meta.threads, |e| {
-        let (tests, _, can_pass) = judge_cell(e.plan, (e.bi, e.ei), &e.cell, &e.pilot, registry, alpha);
-        e.open = rounds::stays_open(&tests, e.cell.key.reps, e.looks, can_pass);
+        look(e);
         Ok(())
     })?;
     let spent: u64 = entries.iter().map(Entry::spent).sum();
@@ -352,6 +355,8 @@ fn push_entries<'p>(
             pilot: pilot.clone(),
             looks: 1,
             open: false,
+            needed: None,
+            control: false,
         });
     }
 }
