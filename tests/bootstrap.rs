@@ -39,6 +39,7 @@ fn plan(reps: usize) -> Plan {
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     Plan::prepare(sweep, registry()).expect("valid sweep")
 }

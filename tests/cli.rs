@@ -41,6 +41,14 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
     // A pattern of --estimators or --testbeds that matches nothing is named, with the valid ids.
     assert_bad_input(d, &["run", "unbiasedness", "--estimators", "integrand_mc,nope*"], "--estimators = nope*");
     assert_bad_input(d, &["run", "unbiasedness", "--testbeds", "peak"], "product-peak");
+    // Rounds are for unbiasedness alone, and a shard cannot follow them.
+    assert_bad_input(
+        d,
+        &["run", "unbiasedness", "--repetitions", "rounds", "--shard", "1/2"],
+        "--repetitions = rounds",
+    );
+    assert_bad_input(d, &["run", "surface-smc", "--repetitions", "rounds"], "only the unbiasedness experiment");
+    assert_bad_input(d, &["run", "unbiasedness", "--repetitions", "sometimes"], "--repetitions");
     assert_bad_input(d, &["conformance", "--testbeds", "no-such-bed"], "--testbeds = no-such-bed");
     assert_bad_input(d, &["conformance", "no_such_estimator"], "integrand_mc");
     assert_bad_input(d, &["run"], "experiment");

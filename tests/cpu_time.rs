@@ -98,6 +98,7 @@ fn sweep(ids: &[&str], resolution: f64, budgets: Vec<Budget>, reps: usize) -> Sw
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     }
 }
 

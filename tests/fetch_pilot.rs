@@ -52,6 +52,7 @@ fn run_trackers(
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     let plan = mcbench::plan::Plan::prepare(sweep, &registry).expect("valid sweep");
     let opts = ExecOptions {

@@ -29,6 +29,7 @@ fn sweep(ids: &[&str], reps: usize) -> Sweep {
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     }
 }
 

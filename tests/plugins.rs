@@ -90,6 +90,7 @@ fn one_file_and_one_registration_are_enough() {
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     let plan = mcbench::plan::Plan::prepare(sweep(Params::new().with("tilt", 0.5)), &registry).expect("plans");
     let bad = mcbench::plan::Plan::prepare(sweep(Params::new().with("tlit", 0.5)), &registry);

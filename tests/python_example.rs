@@ -39,6 +39,7 @@ fn small_run(dir: &Path) {
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     let registry = experiments::registry();
     let plan = mcbench::plan::Plan::prepare(sweep, &registry).expect("valid sweep");

@@ -194,6 +194,7 @@ fn run() -> (mcbench::output::RunReport, String) {
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     let plan = mcbench::plan::Plan::prepare(sweep, &registry).expect("plans");
     let dir = tempfile::tempdir().expect("tempdir");

@@ -141,6 +141,7 @@ fn a_mini_sweep_flags_the_control_and_passes_the_trackers() {
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     let registry = crate::test_registry();
     let opts = ExecOptions {

@@ -47,6 +47,7 @@ fn rows(
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     let plan = Plan::prepare(sweep, registry).expect("valid sweep");
     let opts = RunOptions { threads: Some(threads), store: None, observer: &Silent };

@@ -186,6 +186,8 @@ pub(super) struct RowBase<'a> {
     pub(super) gate: Option<&'a Gate>,
     pub(super) tolerance: f64,
     pub(super) spread: Spread,
+    /// The family-wise level of the decision.
+    pub(super) alpha: f64,
 }
 
 impl RowBase<'_> {
@@ -201,7 +203,7 @@ impl RowBase<'_> {
             statistic,
             p_value: p,
             verdict: verdict.into(),
-            alpha: UNBIASEDNESS_ALPHA,
+            alpha: self.alpha,
             detectable_rel_bias: detectable,
             claim: self.claim.name().into(),
             agrees: agrees(self.claim, verdict),
@@ -254,10 +256,22 @@ pub fn unbiasedness(
     gate: Option<&Gate>,
     tolerance: f64,
 ) -> Vec<TestRow> {
-    let alpha = UNBIASEDNESS_ALPHA;
+    unbiasedness_at(cell, reference, claim, gate, tolerance, UNBIASEDNESS_ALPHA)
+}
+
+/// [`unbiasedness`] at the family-wise level `alpha` instead of [`UNBIASEDNESS_ALPHA`]: one look
+/// of the round-based repetitions ([`crate::unbiasedness::rounds`]) decides at its share of it.
+pub fn unbiasedness_at(
+    cell: &CellResult,
+    reference: &Reference,
+    claim: Bias,
+    gate: Option<&Gate>,
+    tolerance: f64,
+    alpha: f64,
+) -> Vec<TestRow> {
     let zero = ZeroChannels::of(cell, reference, gate);
     let spread = zero.spread(gate.is_some());
-    let rows = RowBase { cell, claim, gate, tolerance, spread };
+    let rows = RowBase { cell, claim, gate, tolerance, spread, alpha };
     if spread == Spread::ZeroVariance {
         return super::direct::rows(&rows, reference, &zero);
     }

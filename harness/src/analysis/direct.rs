@@ -15,7 +15,7 @@
 
 use super::bias::{RowBase, TestRow, POOLED_SHARE};
 use super::spread::ZeroChannels;
-use super::{POWER, UNBIASEDNESS_ALPHA};
+use super::POWER;
 use mcbench_core::stats::{detectable_shift_t, holm_bonferroni, t_test, TestOutcome};
 use mcbench_core::testbed::{Reference, ReferenceKind};
 
@@ -69,7 +69,7 @@ fn worst(zero: &ZeroChannels, cell_means: &[[f64; 3]], reference: &Reference, bo
 /// The three test rows of a zero-variance cell (see the module documentation).
 pub(super) fn rows(base: &RowBase<'_>, reference: &Reference, zero: &ZeroChannels) -> Vec<TestRow> {
     let cell = base.cell;
-    let alpha = UNBIASEDNESS_ALPHA;
+    let alpha = base.alpha;
     let (alpha_holm, alpha_pooled) = (alpha * (1.0 - POOLED_SHARE), alpha * POOLED_SHARE);
     let (bound, stored) = match &reference.kind {
         ReferenceKind::Exact { bound, .. } => (bound.max(0.0), None),

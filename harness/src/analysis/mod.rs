@@ -13,7 +13,7 @@ pub mod roundoff;
 pub mod speedup;
 pub mod spread;
 
-pub use bias::{unbiasedness, Gate, TestRow, DEFAULT_TOLERANCE, POOLED_SHARE};
+pub use bias::{unbiasedness, unbiasedness_at, Gate, TestRow, DEFAULT_TOLERANCE, POOLED_SHARE};
 pub use speedup::{speedups, SpeedUp, SpeedUpOutcome};
 pub use spread::Spread;
 

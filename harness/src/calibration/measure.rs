@@ -90,6 +90,7 @@ fn plan_of(f: &Family, reps: usize, seed: u64, mode: Mode, registry: &Registry) 
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     Plan::prepare(sweep, registry)
 }

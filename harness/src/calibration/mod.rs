@@ -16,6 +16,7 @@
 
 pub mod measure;
 pub mod report;
+pub mod rounds;
 pub mod size;
 pub mod table;
 pub mod wrap;
@@ -163,6 +164,9 @@ fn first_sweep(registry: &Registry, mode: Mode) -> Sweep {
 
 /// Measures every family and writes `calibration.csv` and `calibration.md`, and the claims.
 pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
+    if !cx.plan.sweep.repetitions.is_fixed() {
+        return rounds::post(cx);
+    }
     let PostContext { plan, report, out: results, registry, .. } = cx;
     let t0 = Instant::now();
     let mode = plan.sweep.mode;

@@ -198,6 +198,13 @@ struct ReferenceArgs {
     wait: bool,
 }
 
+/// `--repetitions`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum RepetitionsArg {
+    Fixed,
+    Rounds,
+}
+
 #[derive(Clone, Copy, Debug, ValueEnum)]
 enum ListWhat {
     Testbeds,
@@ -222,6 +229,10 @@ struct RunArgs {
     /// Worker threads (default: all cores).
     #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=crate::config::limits::MAX_THREADS))]
     threads: Option<u64>,
+    /// How `unbiasedness` spends its repetitions: fixed (every row its part's) or rounds (doubling
+    /// until decided, within the fixed mode's work; calibration measures that rule; no --shard)
+    #[arg(long, value_name = "MODE", value_enum, default_value_t = RepetitionsArg::Fixed, hide_possible_values = true)]
+    repetitions: RepetitionsArg,
     /// Results root.
     #[arg(long, value_name = "DIR", default_value = "results")]
     results: PathBuf,

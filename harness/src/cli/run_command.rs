@@ -39,6 +39,9 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
         if let Some(r) = args.reps {
             sweep.reps = r as usize;
         }
+        if args.repetitions == RepetitionsArg::Rounds {
+            in_rounds(&mut sweep, args)?;
+        }
         // A config that reshapes a named experiment without claims of its own keeps the
         // experiment's, judged `not measured` where the reshaped sweep lacks their cells.
         let plan = if def.is_some() && args.config.is_some() && !file_claims {
@@ -135,6 +138,33 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
         let dir = crate::compare::baseline::save(&args.results, name, &written)?;
         println!("baseline {name} saved: {}", dir.display());
     }
+    Ok(())
+}
+
+/// `--repetitions rounds`: only `unbiasedness` runs in rounds (`calibration` measures its rule),
+/// and not sharded (a shard cannot see which rows the others left open); the first part runs its
+/// first round, the fixed-mode repetitions kept in the sweep's mode.
+fn in_rounds(sweep: &mut crate::config::Sweep, args: &RunArgs) -> Result<()> {
+    let refuse = |reason: String| -> Result<()> {
+        Err(mcbench_core::error::ConfigError::invalid("--repetitions", "rounds", reason).into())
+    };
+    if args.shard.is_some() {
+        return refuse("a sharded run cannot follow the rounds (each round depends on every row's last look): run it without --shard".into());
+    }
+    sweep.repetitions = crate::config::Repetitions::Rounds { fixed_reps: sweep.reps };
+    if sweep.experiment == crate::calibration::NAME {
+        // Calibration measures the rule of the rounds on its own seeds; its sweep runs as it is.
+        return Ok(());
+    }
+    if sweep.experiment != crate::unbiasedness::NAME {
+        return refuse(format!(
+            "only the {} experiment runs in rounds (and {} measures them), not {}",
+            crate::unbiasedness::NAME,
+            crate::calibration::NAME,
+            sweep.experiment
+        ));
+    }
+    sweep.reps = crate::unbiasedness::rounds::first_round(sweep.reps);
     Ok(())
 }
 

@@ -138,6 +138,40 @@ pub struct Sweep {
     /// Unit costs of the `renderer` cost regime ([`CostModel`]; its defaults unless set).
     #[serde(default)]
     pub cost_model: CostModel,
+    /// How the `unbiasedness` experiment spends its repetitions ([`Repetitions`]); absent
+    /// (fixed) in files written before it existed and in every fixed sweep.
+    #[serde(default, skip_serializing_if = "Repetitions::is_fixed")]
+    pub repetitions: Repetitions,
+}
+
+/// How the `unbiasedness` experiment spends its repetitions (`--repetitions`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Repetitions {
+    /// Every row runs its part's repetitions.
+    #[default]
+    Fixed,
+    /// Rows run in rounds of doubling repetitions until decided or the budget is spent
+    /// ([`crate::unbiasedness::rounds`]); `fixed_reps` is the first part's repetitions in the
+    /// fixed mode (what `--reps` set), from which every part's first round and the budget follow.
+    Rounds {
+        /// The first part's fixed-mode repetitions.
+        fixed_reps: usize,
+    },
+}
+
+impl Repetitions {
+    /// Whether this is the fixed mode.
+    pub fn is_fixed(&self) -> bool {
+        *self == Repetitions::Fixed
+    }
+    /// `fixed` or `rounds`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Repetitions::Fixed => "fixed",
+            Repetitions::Rounds { .. } => "rounds",
+        }
+    }
 }
 
 impl Sweep {
@@ -225,6 +259,7 @@ impl SweepFile {
                 claims: Vec::new(),
                 bias_tolerance: None,
                 cost_model: CostModel::default(),
+                repetitions: Default::default(),
             },
         };
         if let Some(name) = self.name {

@@ -51,6 +51,22 @@ pub fn run_group_with(
     bi: usize,
     budget: Budget,
     cells: &[GroupCell<'_>],
+    sink: impl FnMut(usize, usize, CellResult) -> Result<()>,
+) -> Result<()> {
+    run_group_at(plan, bi, budget, plan.sweep.reps, cells, sink)
+}
+
+/// [`run_group_with`] for cells of `reps` repetitions instead of the sweep's (their keys say
+/// `reps`): the round-based repetitions of `unbiasedness` ([`crate::unbiasedness::rounds`]) run a
+/// cell's later blocks at a larger count than its sweep's. A block's repetitions and streams do
+/// not depend on `reps` when the block is full, so the blocks of a cell grown this way are the
+/// blocks of a cell run at `reps` from the start.
+pub fn run_group_at(
+    plan: &Plan,
+    bi: usize,
+    budget: Budget,
+    reps: usize,
+    cells: &[GroupCell<'_>],
     mut sink: impl FnMut(usize, usize, CellResult) -> Result<()>,
 ) -> Result<()> {
     let b = &plan.beds[bi];
@@ -58,7 +74,6 @@ pub fn run_group_with(
     let frames = b.bed.sequence_length().max(1);
     let sequences = n / frames;
     let per_item = BATCH.div_ceil(frames);
-    let reps = plan.sweep.reps;
     let batches = sequences.div_ceil(per_item);
     let longest = cells.iter().map(|c| c.blocks.len()).max().unwrap_or(0);
     if longest == 0 {
@@ -70,7 +85,7 @@ pub fn run_group_with(
         let samples = if c.blocks.is_empty() { None } else { calibrated_samples(plan, bi, c.ei, budget)? };
         runs.push(CellRun { plan, label: &label, bi, ei: c.ei, budget, samples });
     }
-    let keys: Vec<CellKey> = cells.iter().map(|c| cell_key(plan, bi, c.ei, budget)).collect();
+    let keys: Vec<CellKey> = cells.iter().map(|c| CellKey { reps, ..cell_key(plan, bi, c.ei, budget) }).collect();
     let reference = &b.bed.reference().value;
     // Paper 003's per-integral weight 1 / tvi(L_ref), for each repetition's `Err`.
     let inv_tvi: Vec<f64> = reference

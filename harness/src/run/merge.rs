@@ -188,6 +188,7 @@ mod tests {
             claims: Vec::new(),
             bias_tolerance: None,
             cost_model: Default::default(),
+            repetitions: Default::default(),
         };
         let m = Manifest {
             format: shard::FORMAT,

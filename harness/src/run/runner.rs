@@ -9,7 +9,7 @@ use crate::error::{HarnessError, Result};
 use crate::plan::Plan;
 use crate::run::cell::{add_diagnostics, CellKey, CellResult, TimeStats};
 use crate::run::interleave::empty_cell;
-pub use crate::run::interleave::{run_group_with, GroupCell};
+pub use crate::run::interleave::{run_group_at, run_group_with, GroupCell};
 pub use crate::run::resume::{preload, preload_from};
 use crate::store::StoreWriter;
 use mcbench_core::budget::{Budget, BudgetKind};

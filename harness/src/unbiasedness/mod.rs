@@ -16,6 +16,7 @@
 //! experiment's sweep (what `--config` overrides); the others run in its analysis ([`run`]) into
 //! the same results folder, summary rows and tests.
 
+pub mod rounds;
 pub mod run;
 pub mod stats;
 pub mod table;
@@ -97,6 +98,7 @@ pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
                     claims: Vec::new(),
                     bias_tolerance: None,
                     cost_model: Default::default(),
+                    repetitions: Default::default(),
                 },
             }
         })
@@ -120,6 +122,7 @@ fn first_part(registry: &Registry, mode: Mode) -> Sweep {
             claims: Vec::new(),
             bias_tolerance: None,
             cost_model: Default::default(),
+            repetitions: Default::default(),
         };
     }
     all.swap_remove(0).sweep

@@ -55,6 +55,15 @@ pub struct Row {
     pub reps_for_tolerance: Option<f64>,
     /// Where the tests' gate came from (`pilot`, `previous budget`, `none`).
     pub gate: String,
+    /// How the repetitions were spent: `fixed` (the part's repetitions) or `rounds` (doubling
+    /// until decided, [`super::rounds`]; `reps` is then where the row stopped).
+    pub repetitions: String,
+    /// The looks at the row's data: 1 in the fixed mode, the rounds it ran in the rounds mode (0
+    /// when not run).
+    pub rounds: usize,
+    /// The family-wise level each look decided at: 1e-3 in the fixed mode, its share of it per
+    /// look in the rounds mode.
+    pub decision_alpha: f64,
     /// For a biased control: why it is not required to be flagged here (its registry entry's
     /// exemption), if it is not.
     #[serde(skip)]
@@ -89,6 +98,9 @@ pub fn row_from_tests(cell: &CellResult, bias: Bias, tests: &[TestRow], exempt: 
         tolerance: decision.map_or(f64::NAN, |d| d.tolerance),
         reps_for_tolerance: decision.and_then(|d| d.reps_needed),
         gate: decision.map_or("none".into(), |d| d.gate.clone()),
+        repetitions: "fixed".into(),
+        rounds: 1,
+        decision_alpha: decision.map_or(UNBIASEDNESS_ALPHA, |d| d.alpha),
         exempt,
     };
     r.reps_for_target = reps_for_target(r.detectable_rel_bias, r.reps, 1.0);
@@ -167,6 +179,9 @@ pub fn not_run(
         tolerance: f64::NAN,
         reps_for_tolerance: None,
         gate: String::new(),
+        repetitions: "fixed".into(),
+        rounds: 0,
+        decision_alpha: UNBIASEDNESS_ALPHA,
         exempt,
     };
     judge(&mut r);

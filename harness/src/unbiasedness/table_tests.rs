@@ -143,6 +143,7 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     let plan = Plan::prepare(
         sweep,
