@@ -151,6 +151,7 @@ pub fn plan(m: &Manifest, bed: PreparedBed) -> Plan {
         claims: Vec::new(),
         bias_tolerance: None,
         cost_model: Default::default(),
+        repetitions: Default::default(),
     };
     let pairs = (0..estimators.len()).map(|ei| (0, ei)).collect();
     Plan { sweep, beds: vec![bed], estimators, pairs, skipped: Vec::new() }

@@ -294,7 +294,7 @@ fn in_rounds(
         e.open = rounds::stays_open(&tests, e.cell.key.reps, e.looks, can_pass, e.control);
         e.needed = rounds::needed(&tests);
     };
-    entries.iter_mut().for_each(|e| look(e));
+    entries.iter_mut().for_each(&look);
     let budget: u64 = entries.iter().map(Entry::fixed_cost).sum();
     let t0 = Instant::now();
     let extra = rounds::grow(&mut entries, budget, report.meta.threads, |e| {
