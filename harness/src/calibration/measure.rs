@@ -96,7 +96,7 @@ fn plan_of(f: &Family, reps: usize, seed: u64, mode: Mode, registry: &Registry) 
 }
 
 /// Every integral's estimates of repetition `rep`, as a run computes them.
-fn rep_estimates(plan: &Plan, rep: u64) -> Result<Vec<[f64; 3]>> {
+pub(super) fn rep_estimates(plan: &Plan, rep: u64) -> Result<Vec<[f64; 3]>> {
     let bed = plan.beds[0].bed.as_ref();
     let budget = plan.sweep.budgets[0];
     let mut out = Vec::with_capacity(bed.integrals());

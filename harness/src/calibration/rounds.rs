@@ -11,7 +11,7 @@
 //! shared budget here: each row may take all its looks (the budget of a run only stops rows
 //! earlier, which cannot raise the rate).
 
-use super::measure::Family;
+use super::measure::{rep_estimates, Family};
 use super::table::wilson;
 use crate::analysis::{unbiasedness_at, Gate, TestRow, UNBIASEDNESS_ALPHA};
 use crate::config::{Mode, Sweep};
@@ -19,7 +19,6 @@ use crate::error::Result;
 use crate::plan::Plan;
 use crate::registry::{PostContext, Registry};
 use crate::run::guarded;
-use crate::run::runner::sequence_estimates;
 use crate::unbiasedness::rounds::{first_round, stays_open, LOOKS};
 use mcbench_core::budget::Budget;
 use rayon::prelude::*;
@@ -98,16 +97,6 @@ fn looks(
         reps *= 2;
     }
     unreachable!("the last look never stays open")
-}
-
-fn rep_estimates(plan: &Plan, rep: u64) -> Result<Vec<[f64; 3]>> {
-    let bed = plan.beds[0].bed.as_ref();
-    let budget = plan.sweep.budgets[0];
-    let mut out = Vec::with_capacity(bed.integrals());
-    for first in (0..bed.integrals()).step_by(bed.sequence_length().max(1)) {
-        out.extend(sequence_estimates(plan, 0, 0, budget, rep, first)?.into_iter().map(|v| v.0));
-    }
-    Ok(out)
 }
 
 /// Measures `family` in the rounds mode over `seeds` seeds from `seed`.

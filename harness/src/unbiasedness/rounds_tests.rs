@@ -213,21 +213,13 @@ fn a_grown_cell_is_the_cell_run_whole_at_its_repetitions_whatever_the_threads() 
     }
 }
 
-#[test]
-fn the_budget_stops_the_rounds() {
-    let registry = Registry::new().with_catalog(mcbench_papers::catalog());
-    let plan = small_plan(&registry, 64, 1);
-    let run = crate::run::runner::run(
-        &plan,
-        &crate::run::runner::RunOptions { threads: Some(1), store: None, observer: &crate::run::runner::Silent },
-    )
-    .expect("run");
-    let mut entries: Vec<Entry<'_>> = run
-        .cells
+/// Every cell of `run` as an open row after its first look (its own pilot), 64 repetitions fixed.
+fn open_rows<'a>(plan: &'a Plan, run: &crate::run::runner::RunResults) -> Vec<Entry<'a>> {
+    run.cells
         .iter()
         .map(|(bi, ei, c)| Entry {
-            plan: &plan,
-            pilot_plan: &plan,
+            plan,
+            pilot_plan: plan,
             bi: *bi,
             ei: *ei,
             fixed: 64,
@@ -238,7 +230,19 @@ fn the_budget_stops_the_rounds() {
             needed: None,
             control: false,
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn the_budget_stops_the_rounds() {
+    let registry = Registry::new().with_catalog(mcbench_papers::catalog());
+    let plan = small_plan(&registry, 64, 1);
+    let run = crate::run::runner::run(
+        &plan,
+        &crate::run::runner::RunOptions { threads: Some(1), store: None, observer: &crate::run::runner::Silent },
+    )
+    .expect("run");
+    let mut entries = open_rows(&plan, &run);
     let first: u64 = entries.iter().map(Entry::spent).sum();
     // Room for one row's doubling only: the cheaper (or the first of equals) grows, once.
     let room = first + entries[0].spent();
@@ -257,23 +261,7 @@ fn rows_within_reach_of_a_decision_grow_before_the_others() {
         &crate::run::runner::RunOptions { threads: Some(1), store: None, observer: &crate::run::runner::Silent },
     )
     .expect("run");
-    let mut entries: Vec<Entry<'_>> = run
-        .cells
-        .iter()
-        .map(|(bi, ei, c)| Entry {
-            plan: &plan,
-            pilot_plan: &plan,
-            bi: *bi,
-            ei: *ei,
-            fixed: 64,
-            cell: c.clone(),
-            pilot: c.clone(),
-            looks: 1,
-            open: true,
-            needed: None,
-            control: false,
-        })
-        .collect();
+    let mut entries = open_rows(&plan, &run);
     // The second row would be resolved by one doubling, the first has no estimate.
     entries[1].needed = Some(128.0);
     let first: u64 = entries.iter().map(Entry::spent).sum();
