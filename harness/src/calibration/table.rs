@@ -102,7 +102,7 @@ pub const MIN_POWER: f64 = 0.8;
 /// Whether `k` flags in `n` seeds are consistent with a rate inside [`SIZE_BAND`]: the 95% Wilson
 /// interval meets the band (with 100 seeds a test of size exactly 5% shows 3 or fewer flags in a
 /// quarter of families, so the point estimate alone would fail sized tests by chance; the pooled
-/// rate over all families, [`claims`], is the sharp check).
+/// rate over all families, [`claims`](super::report::claims), is the sharp check).
 pub fn within_band(k: usize, n: usize) -> bool {
     let (lo, hi) = wilson(k, n);
     hi >= SIZE_BAND.0 && lo <= SIZE_BAND.1
