@@ -77,7 +77,7 @@ pub struct Measured {
     pub threshold: f64,
 }
 
-fn plan_of(f: &Family, reps: usize, seed: u64, mode: Mode, registry: &Registry) -> Result<Plan> {
+pub(super) fn plan_of(f: &Family, reps: usize, seed: u64, mode: Mode, registry: &Registry) -> Result<Plan> {
     let sweep = Sweep {
         experiment: super::NAME.into(),
         testbeds: vec![f.bed.clone()],

@@ -14,13 +14,12 @@
 use super::measure::{rep_estimates, Family};
 use super::table::wilson;
 use crate::analysis::{unbiasedness_at, Gate, TestRow, UNBIASEDNESS_ALPHA};
-use crate::config::{Mode, Sweep};
+use crate::config::Mode;
 use crate::error::Result;
 use crate::plan::Plan;
 use crate::registry::{PostContext, Registry};
 use crate::run::guarded;
 use crate::unbiasedness::rounds::{first_round, stays_open, LOOKS};
-use mcbench_core::budget::Budget;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::PathBuf;
@@ -108,21 +107,7 @@ pub fn measure(
     mode: Mode,
     registry: &Registry,
 ) -> Result<RoundsRow> {
-    let sweep = Sweep {
-        experiment: super::NAME.into(),
-        testbeds: vec![family.bed.clone()],
-        estimators: vec![family.estimator.clone()],
-        budgets: vec![Budget::samples(family.samples)?],
-        reps: family.reps.max(2),
-        seed,
-        mode,
-        baseline: None,
-        claims: Vec::new(),
-        bias_tolerance: None,
-        cost_model: Default::default(),
-        repetitions: Default::default(),
-    };
-    let plan = Plan::prepare(sweep, registry)?;
+    let plan = super::measure::plan_of(family, family.reps, seed, mode, registry)?;
     let most = (first_round(family.reps) << (LOOKS - 1)) as u64;
     type Outcome = ((TestRow, bool, bool, usize), (TestRow, bool, bool, usize));
     let outcomes: Vec<Result<Outcome>> = (0..seeds as u64)
