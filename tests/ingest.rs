@@ -14,7 +14,7 @@ use std::process::{Command, Output};
 
 const SIDE: usize = 4;
 const REPS: usize = 64;
-const BUDGETS: [u64; 2] = [16, 64];
+const BUDGETS: [u64; 3] = [16, 64, 256];
 
 fn mcbench(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mcbench")).current_dir(dir).args(args).output().expect("binary runs")
@@ -132,6 +132,36 @@ fn two_ingested_runs_of_one_bed_compare_with_two_sample() {
     }
 }
 
+/// A manifest's `[[claims]]` are judged on the ingested run as a config's are: a slope claim the
+/// series meets holds, one it misses does not, and the +1% control is flagged.
+#[test]
+fn claims_of_the_manifest_are_judged_on_the_ingested_run() {
+    let tmp = tempfile::tempdir().expect("tempdir");
+    let data = tmp.path().join("data");
+    let manifest = produce(&data, 1, false);
+    edit(&data, "name = \"mine\"\n", "name = \"mine\"\nbaseline = \"good\"\n");
+    let claims = [("-0.5", "matches"), ("-0.8", "steeper")]
+        .map(|(v, t)| format!("[[claims]]\nkind = \"slope\"\ntestbed = \"gradient-plane/diffuse\"\nestimator = \"good\"\nvalue = {v}\ntext = \"{t}\"\n"))
+        .concat();
+    let m = std::fs::read_to_string(&manifest).expect("manifest");
+    std::fs::write(&manifest, format!("{m}{claims}[[claims]]\nkind = \"control_flagged\"\nestimator = \"high\"\n"))
+        .expect("w");
+    let out = mcbench(tmp.path(), &["ingest", manifest.to_str().expect("utf-8"), "--no-plots"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(tmp.path().join("results/mine/claims.csv")).expect("claims.csv");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = |name| header.iter().position(|c| *c == name).expect("column");
+    let verdicts: Vec<(String, String)> = lines
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .map(|f| (f[col("claim")].to_string(), f[col("verdict")].to_string()))
+        .collect();
+    let verdict = |claim: &str| verdicts.iter().find(|(c, _)| c.contains(claim)).map(|(_, v)| v.as_str());
+    assert_eq!(verdict("matches"), Some("held"), "{verdicts:?}");
+    assert_eq!(verdict("steeper"), Some("not held"), "{verdicts:?}");
+    assert_eq!(verdict("biased control high"), Some("held"), "{verdicts:?}");
+}
+
 /// Each hostile change to a good set of files: exit 2, one line naming `file` and `field`, and no
 /// results folder.
 #[test]
@@ -221,6 +251,26 @@ fn malformed_manifests_and_files_are_refused_naming_file_and_field() {
             "manifest.toml",
             "estimators[1].budgets",
         ),
+        (
+            "claim naming no estimator",
+            |d| append(d, "[[claims]]\nkind = \"control_flagged\"\nestimator = \"nobody\"\n"),
+            "manifest.toml",
+            "claims[0].estimator",
+        ),
+        (
+            "claim on another bed",
+            |d| {
+                append(d, "[[claims]]\nkind = \"slope\"\ntestbed = \"gradient-box/thick\"\nestimator = \"good\"\nvalue = -0.5\ntext = \"t\"\n")
+            },
+            "manifest.toml",
+            "claims[0].testbed",
+        ),
+        (
+            "baseline naming no estimator",
+            |d| edit(d, "name = \"mine\"\n", "name = \"mine\"\nbaseline = \"nobody\"\n"),
+            "manifest.toml",
+            "baseline",
+        ),
     ];
     for (name, break_it, file, field) in cases {
         let tmp = tempfile::tempdir().expect("tempdir");
@@ -240,4 +290,9 @@ fn edit(d: &Path, from: &str, to: &str) {
     let m = std::fs::read_to_string(d.join("manifest.toml")).expect("manifest");
     assert!(m.contains(from), "{from}");
     std::fs::write(d.join("manifest.toml"), m.replacen(from, to, 1)).expect("manifest");
+}
+
+fn append(d: &Path, text: &str) {
+    let m = std::fs::read_to_string(d.join("manifest.toml")).expect("manifest");
+    std::fs::write(d.join("manifest.toml"), m + text).expect("manifest");
 }

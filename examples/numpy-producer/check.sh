@@ -25,6 +25,7 @@ for m in images scalars; do
     grep -q "^numpy_unbiased: declared Unbiased, unbiasedness test pass: as declared" "ingest-$m.txt"
     grep -q "^numpy_biased: declared Biased, unbiasedness test biased: as declared" "ingest-$m.txt"
 done
+grep -q "claims 2 held |" ingest-images.txt
 "$mcbench" ingest estimates-b/images/manifest.toml --results results-b --no-plots
 "$mcbench" compare results/numpy-images results-b/numpy-images --two-sample numpy_unbiased numpy_unbiased | tee same.txt
 grep -q " 0 differ" same.txt

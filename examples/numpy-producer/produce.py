@@ -79,6 +79,12 @@ def images(out, rng, name):
                 f.write("rep,seconds\n" + "".join(f"{r},{s:.9g}\n" for r, s in enumerate(seconds)))
             lines += ["[[estimators.budgets]]", f"samples = {spp}", f'files = "{sub}/rep-{{rep:04}}.npy"',
                       f"reps = {REPS}", f'seconds = "{sub}/seconds.csv"']
+    # Claims judged on the ingested run, as in a config file; an image reference's test bed is
+    # `reference-image/<the image's path>`.
+    lines += ["", "[[claims]]", 'kind = "slope"', 'testbed = "reference-image/ref.npy"',
+              'estimator = "numpy_unbiased"', "value = -0.5",
+              'text = "independent noise: RMSE falls as samples^-1/2"',
+              "", "[[claims]]", 'kind = "control_flagged"', 'estimator = "numpy_biased"']
     with open(os.path.join(folder, "manifest.toml"), "w") as f:
         f.write("\n".join(lines) + "\n")
 

@@ -3,6 +3,7 @@
 //! estimator its bias claim and, per budget, the files of its repetitions. Every field is checked
 //! here, before any estimate is read; paths stay inside the manifest's folder.
 
+use crate::config::claim_spec::ClaimSpec;
 use crate::error::{HarnessError, Result};
 use mcbench_core::params::Params;
 use serde::Deserialize;
@@ -18,6 +19,12 @@ pub struct Manifest {
     pub reference: ReferenceSpec,
     /// The estimators whose repetitions were written.
     pub estimators: Vec<IngestEstimator>,
+    /// The estimator the others are compared with (efficiency ratios, `speedup` claims without a
+    /// baseline of their own), as a config's `baseline`.
+    pub baseline: Option<String>,
+    /// Claims judged on the ingested run (`[[claims]]` tables, exactly as in a config file).
+    #[serde(default)]
+    pub claims: Vec<ClaimSpec>,
 }
 
 /// The reference: a built-in test bed (`testbed`, `variant`, `params`) or an image of the
@@ -157,6 +164,15 @@ impl Manifest {
             if mine != first {
                 return Err((f("budgets"), "every estimator needs the same budgets (samples) as the first".into()));
             }
+        }
+        if let Some(b) = &self.baseline {
+            if !self.estimators.iter().any(|e| &e.id == b) {
+                let ids: Vec<&str> = self.estimators.iter().map(|e| e.id.as_str()).collect();
+                return Err(("baseline".into(), format!("`{b}` names no estimator (valid: {})", ids.join(", "))));
+            }
+        }
+        for (i, c) in self.claims.iter().enumerate() {
+            c.check().map_err(|e| (format!("claims[{i}].{}", e.field), format!("{} (`{}`)", e.problem, e.value)))?;
         }
         for (field, p) in [("reference.image", &r.image), ("reference.variance", &r.variance)] {
             if let Some(p) = p {

@@ -88,6 +88,7 @@ pub fn ingest(manifest_path: &Path, opts: &IngestOptions<'_>) -> Result<(Outcome
         return Err(HarnessError::bad_file(manifest_path, format!("field `reference.testbed`: {why}")));
     }
     let plan = plan::plan(&m, bed);
+    plan.check_claims().map_err(|e| HarnessError::bad_file(manifest_path, e))?;
     let mut cells = Vec::new();
     for (ei, e) in m.estimators.iter().enumerate() {
         for (bj, b) in e.budgets.iter().enumerate() {

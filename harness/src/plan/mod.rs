@@ -206,7 +206,7 @@ impl Plan {
 
     /// Checks every claim of the sweep against what the plan runs
     /// ([`crate::config::claim_spec::ClaimSpec::check_against`]).
-    fn check_claims(&self) -> Result<()> {
+    pub(crate) fn check_claims(&self) -> Result<()> {
         let ran = crate::analysis::claim_check::Ran {
             beds: self.beds.iter().map(PreparedBed::label).collect(),
             estimators: self.estimators.iter().map(|e| e.name.as_str()).collect(),
