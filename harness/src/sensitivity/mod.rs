@@ -5,8 +5,9 @@
 //! experiment's results folder (cells resume and merge as any other); the claim is judged on each
 //! setting's cells alone, and the part ends in exactly one outcome ([`outcome::Outcome`]): held at
 //! the paper-like setting, holds where (the settings where it held), cannot hold on this scene (a
-//! ceiling below the claim at every setting), or unsupportable as written (a reason the file
-//! states with its numbers).
+//! proven bound, [`Bound`], below the claim at every setting), or unsupportable as written (a
+//! reason the file states with its numbers). A measured limit ([`Ceiling`]) is reported as the
+//! best measured value and decides nothing.
 //!
 //! ```
 //! use mcbench::sensitivity::SensitivityFile;
@@ -70,7 +71,9 @@ pub struct PartMode {
     pub budgets: Vec<u64>,
 }
 
-/// What bounds a claim on a scene, computed at every setting.
+/// A measured limit of a claim computed at every setting from the run (`ceiling = "...`" in a
+/// part, for history): it is what the claim's estimator achieved, not a bound, so the result
+/// files call it `best_measured` and it never decides that a claim cannot hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Ceiling {
@@ -80,6 +83,21 @@ pub enum Ceiling {
     /// `ratio` claims on an efficiency it is the error that efficiency divides by (MSE for
     /// `efficiency_mse`, paper 003's `Err` for `p_eff`), at the claim's budget.
     WorkRatio,
+}
+
+/// A bound no estimator of the claim's family can beat on the scene, one value per setting,
+/// computed outside the run by a stated command and derived in the book (`bound = { ... }` in a
+/// part). Only such a bound below the claim at every setting makes a part "cannot hold on this
+/// scene".
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Bound {
+    /// What it bounds, in a few words (shown beside its value).
+    pub method: String,
+    /// The command that computes `values`.
+    pub command: String,
+    /// One value per setting, in the order of the part's `values`.
+    pub values: Vec<f64>,
 }
 
 /// One claim against one parameter.
@@ -117,9 +135,12 @@ pub struct Part {
     pub budget_kind: Option<String>,
     /// The claim, written for the default setting.
     pub claim: ClaimSpec,
-    /// A ceiling computed at every setting.
+    /// A measured limit computed at every setting (reported as `best_measured`).
     #[serde(default)]
     pub ceiling: Option<Ceiling>,
+    /// A proven bound at every setting (reported as `ceiling`).
+    #[serde(default)]
+    pub bound: Option<Bound>,
     /// Why the claim cannot be supported as the paper writes it, with the numbers that show it.
     #[serde(default)]
     pub unsupportable: Option<String>,
@@ -172,6 +193,14 @@ impl Part {
                 "vary = {:?} is not testbed.<param>, variant, estimator.<id>.<param> or budget_max",
                 self.vary
             ));
+        }
+        if let Some(b) = &self.bound {
+            if b.values.len() != self.values.len() {
+                return Err(format!("bound: {} values for {} settings", b.values.len(), self.values.len()));
+            }
+            if let Some(v) = b.values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+                return Err(format!("bound: {v} is not a positive number"));
+            }
         }
         self.claim.check().map_err(|e| e.to_string())
     }

@@ -1,8 +1,9 @@
 //! How a part ends: one outcome from its verdicts at every setting, decided in a fixed order
-//! (held at the paper-like setting; else holds where it held; else cannot hold, when a ceiling
-//! lies below the claim at every setting; else unsupportable as written, when the file states
-//! why; else not held anywhere tried, when at least one setting is not held; else inconclusive at
-//! every setting tried: an outcome is never stronger than its verdicts).
+//! (held at the paper-like setting; else holds where it held; else cannot hold, when a proven
+//! bound lies below the claim at every setting; else unsupportable as written, when the file
+//! states why; else not held anywhere tried, when at least one setting is not held; else
+//! inconclusive at every setting tried: an outcome is never stronger than its verdicts). A best
+//! measured value below the claim is said beside the last two, never in place of a bound.
 
 use super::table::SettingRow;
 use super::{setting_text, Part};
@@ -25,9 +26,12 @@ pub enum Outcome {
         /// The verdict at our default and the paper-like setting, with values.
         elsewhere: String,
     },
-    /// A ceiling of the scene lies below the claim at every setting.
+    /// A proven bound of the scene (the part's [`super::Bound`]) lies below the claim at every
+    /// setting.
     CannotHold {
-        /// The largest ceiling and where.
+        /// What the bound is.
+        method: String,
+        /// The largest bound and where.
         best: String,
         /// The paper's number.
         paper: f64,
@@ -39,12 +43,16 @@ pub enum Outcome {
     NotHeldAnywhere {
         /// The best value and where.
         best: String,
+        /// The largest best measured value and where, when the part computes one.
+        measured: Option<String>,
     },
     /// Neither held nor not held at any setting tried: every verdict is inconclusive (or not
     /// measured), so the part decides nothing either way.
     InconclusiveEverywhere {
         /// The value closest to the paper's and where.
         best: String,
+        /// The largest best measured value and where, when the part computes one.
+        measured: Option<String>,
     },
 }
 
@@ -83,13 +91,15 @@ impl Outcome {
             Outcome::HoldsWhere { held, elsewhere } => {
                 format!("holds where {}; {elsewhere}", held.join("; "))
             }
-            Outcome::CannotHold { best, paper } => {
-                format!("cannot hold on this scene: the ceiling is below the paper's {paper} at every setting (largest {best})")
+            Outcome::CannotHold { method, best, paper } => {
+                format!("cannot hold on this scene: the ceiling ({method}) is below the paper's {paper} at every setting (largest {best})")
             }
             Outcome::Unsupportable(why) => format!("unsupportable as written: {why}"),
-            Outcome::NotHeldAnywhere { best } => format!("not held at any setting tried; the closest: {best}"),
-            Outcome::InconclusiveEverywhere { best } => {
-                format!("inconclusive at every setting tried; the closest: {best}")
+            Outcome::NotHeldAnywhere { best, measured } => {
+                format!("not held at any setting tried; the closest: {best}{}", measured_text(measured))
+            }
+            Outcome::InconclusiveEverywhere { best, measured } => {
+                format!("inconclusive at every setting tried; the closest: {best}{}", measured_text(measured))
             }
         }
     }
@@ -125,9 +135,19 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
         let (best, r) =
             ceilings.iter().fold((f64::NEG_INFINITY, rows[0]), |acc, (c, r)| if *c > acc.0 { (*c, r) } else { acc });
         if all && best < p {
-            return Outcome::CannotHold { best: format!("{best:.3} at {} = {}", part.vary, r.setting), paper: p };
+            let method = part.bound.as_ref().map_or_else(String::new, |b| b.method.clone());
+            return Outcome::CannotHold {
+                method,
+                best: format!("{best:.3} at {} = {}", part.vary, r.setting),
+                paper: p,
+            };
         }
     }
+    let measured = rows
+        .iter()
+        .filter_map(|r| Some((r.best_measured?, *r)))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(m, r)| format!("{m:.3} at {} = {}", part.vary, r.setting));
     if let Some(why) = &part.unsupportable {
         return Outcome::Unsupportable(why.clone());
     }
@@ -141,8 +161,13 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
         })
         .map_or_else(|| "no setting measured".to_string(), |r| at(r, &part.vary));
     if rows.iter().any(|r| r.verdict == Verdict::NotHeld) {
-        Outcome::NotHeldAnywhere { best }
+        Outcome::NotHeldAnywhere { best, measured }
     } else {
-        Outcome::InconclusiveEverywhere { best }
+        Outcome::InconclusiveEverywhere { best, measured }
     }
+}
+
+/// The best measured value as a clause of a sentence: achieved here, not a bound.
+fn measured_text(measured: &Option<String>) -> String {
+    measured.as_ref().map_or_else(String::new, |m| format!("; best measured here (not a bound) at most {m}"))
 }

@@ -96,7 +96,7 @@ pub fn setting_report(plan: &Plan, run: &RunResults, like: &RunReport) -> RunRep
 /// The error a work ratio multiplies by rays, read from a summary row.
 type ErrorOf = fn(&crate::analysis::metrics::SummaryRow) -> f64;
 
-/// The ceiling of `claim` on one setting's report.
+/// The best measured limit of `claim` on one setting's report (not a bound: [`Ceiling`]).
 pub(super) fn ceiling(
     kind: Ceiling,
     claim: &crate::config::claim_spec::ClaimSpec,
@@ -150,8 +150,9 @@ pub fn post(file: &SensitivityFile, cx: PostContext<'_>) -> Result<Vec<PathBuf>>
             setting_report(&p, &r, report)
         };
         let judged = claim.judge(&sub);
-        let ceiling = part.ceiling.and_then(|k| ceiling(k, &claim, sweep.baseline.as_deref(), &sub));
-        rows.push(SettingRow::new(part, value, &judged, ceiling));
+        let measured = part.ceiling.and_then(|k| ceiling(k, &claim, sweep.baseline.as_deref(), &sub));
+        let bound = part.bound.as_ref().map(|b| b.values[i]);
+        rows.push(SettingRow::new(part, value, &judged, bound, measured));
     }
     let mut written = Vec::new();
     let mut outcomes: Vec<(&Part, Outcome)> = Vec::new();

@@ -41,7 +41,7 @@ pub struct SettingRow {
     pub high: Option<f64>,
     /// The verdict there.
     pub verdict: Verdict,
-    /// The ceiling there, where the part computes one.
+    /// The proven bound there, where the part gives one ([`super::Bound`]).
     pub ceiling: Option<f64>,
     /// The compared pair, for ratio claims.
     pub pair: String,
@@ -49,11 +49,17 @@ pub struct SettingRow {
     pub regime: String,
     /// Why the verdict is what it is.
     pub reason: String,
+    /// `exact` when `ceiling` is a proven bound, `best measured` when the part reports only
+    /// `best_measured`, empty when it has neither.
+    pub bound_kind: String,
+    /// The best measured value there (the work ratio at free overhead), where the part computes
+    /// one: achieved by our estimator, not a bound.
+    pub best_measured: Option<f64>,
 }
 
 impl SettingRow {
     /// The row of `part` at `value`, from the claim judged there.
-    pub fn new(part: &Part, value: &ParamValue, c: &Claim, ceiling: Option<f64>) -> Self {
+    pub fn new(part: &Part, value: &ParamValue, c: &Claim, ceiling: Option<f64>, best_measured: Option<f64>) -> Self {
         let role = match (value == &part.default, part.paper_like.as_ref() == Some(value)) {
             (true, true) => "default+paper-like",
             (true, false) => "default",
@@ -78,6 +84,13 @@ impl SettingRow {
             pair: c.pair.clone(),
             regime: c.regime.clone(),
             reason: if c.reason.is_empty() { c.note.clone() } else { c.reason.clone() },
+            bound_kind: match (finite(ceiling), finite(best_measured)) {
+                (Some(_), _) => "exact",
+                (None, Some(_)) => "best measured",
+                (None, None) => "",
+            }
+            .into(),
+            best_measured: finite(best_measured),
         }
     }
 }
@@ -114,7 +127,10 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
             md_text(o.kind()),
             md_text(&o.sentence())
         );
-        s.push_str("| setting | role | ours | interval | paper | verdict | ceiling | reason |\n|---|---|---|---|---|---|---|---|\n");
+        if let Some(b) = &p.bound {
+            let _ = write!(s, "Ceiling: {} (`{}`).\n\n", md_text(&b.method), md_text(&b.command));
+        }
+        s.push_str("| setting | role | ours | interval | paper | verdict | ceiling | best measured | reason |\n|---|---|---|---|---|---|---|---|---|\n");
         for r in rows.iter().filter(|r| r.part == p.id) {
             let interval = match (r.low, r.high) {
                 (Some(a), Some(b)) => format!("[{a:.4}, {b:.4}]"),
@@ -122,7 +138,7 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
             };
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 md_text(&r.setting),
                 md_text(&r.role),
                 num(r.value),
@@ -130,6 +146,7 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
                 num(r.paper_value),
                 md_text(r.verdict.as_str()),
                 num(r.ceiling),
+                num(r.best_measured),
                 md_text(&r.reason)
             );
         }

@@ -93,7 +93,58 @@ fn row(setting: &str, role: &str, value: f64, verdict: Verdict, ceiling: Option<
         pair: String::new(),
         regime: String::new(),
         reason: String::new(),
+        bound_kind: if ceiling.is_some() { "exact".into() } else { String::new() },
+        best_measured: None,
     }
+}
+
+/// A setting with a best measured value and no bound.
+fn measured(setting: &str, role: &str, value: f64, verdict: Verdict, best: f64) -> SettingRow {
+    SettingRow {
+        best_measured: Some(best),
+        bound_kind: "best measured".into(),
+        ..row(setting, role, value, verdict, None)
+    }
+}
+
+#[test]
+fn a_best_measured_value_below_the_claim_never_says_cannot_hold() {
+    let f = file_with(("", "")).unwrap();
+    let p = &f.parts[0];
+    let (a, b) =
+        (measured("1", "paper-like", 4.0, Verdict::NotHeld, 5.0), measured("5", "default", 2.0, Verdict::NotHeld, 3.0));
+    let o = classify(p, &[&a, &b]);
+    assert!(matches!(o, Outcome::NotHeldAnywhere { .. }), "{o:?}");
+    assert!(
+        o.sentence().ends_with("best measured here (not a bound) at most 5.000 at estimator.smc.moves = 1"),
+        "{}",
+        o.sentence()
+    );
+    let (a, b) = (
+        measured("1", "paper-like", 4.0, Verdict::Inconclusive, 5.0),
+        measured("5", "default", 2.0, Verdict::Inconclusive, 3.0),
+    );
+    assert!(matches!(classify(p, &[&a, &b]), Outcome::InconclusiveEverywhere { measured: Some(_), .. }));
+    // With a proven bound below the claim at every setting the part cannot hold, and says which.
+    let mut q = p.clone();
+    q.bound = Some(Bound { method: "exact cache".into(), command: "c".into(), values: vec![5.0, 3.0] });
+    let (a, b) = (
+        row("1", "paper-like", 4.0, Verdict::NotHeld, Some(5.0)),
+        row("5", "default", 2.0, Verdict::NotHeld, Some(3.0)),
+    );
+    let o = classify(&q, &[&a, &b]);
+    assert!(o.sentence().starts_with("cannot hold on this scene: the ceiling (exact cache)"), "{}", o.sentence());
+}
+
+#[test]
+fn a_bound_needs_one_positive_value_per_setting() {
+    let c = "ceiling = \"work_ratio\"";
+    let ok = file_with((c, "bound = { method = \"m\", command = \"c\", values = [2.0, 3.0] }")).unwrap();
+    assert_eq!(ok.parts[0].bound.as_ref().map(|b| b.values.len()), Some(2));
+    let e = file_with((c, "bound = { method = \"m\", command = \"c\", values = [2.0] }")).unwrap_err();
+    assert!(e.contains("part a") && e.contains("1 values for 2 settings"), "{e}");
+    let e = file_with((c, "bound = { method = \"m\", command = \"c\", values = [2.0, -1.0] }")).unwrap_err();
+    assert!(e.contains("not a positive number"), "{e}");
 }
 
 #[test]
