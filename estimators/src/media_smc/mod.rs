@@ -18,6 +18,7 @@
 //! per pixel instead (for comparison). Unbiasedness holds either way: each estimate uses a
 //! snapshot fixed before its direction is drawn.
 
+pub mod exact_cache;
 pub mod octree;
 pub mod params;
 pub mod walk;

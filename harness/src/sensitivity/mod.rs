@@ -141,6 +141,10 @@ pub struct Part {
     /// A proven bound at every setting (reported as `ceiling`).
     #[serde(default)]
     pub bound: Option<Bound>,
+    /// An idealised value at every setting that bounds only a narrower family than the claim's
+    /// (reported as `limit`, never deciding an outcome; same fields as `bound`).
+    #[serde(default)]
+    pub limit: Option<Bound>,
     /// Why the claim cannot be supported as the paper writes it, with the numbers that show it.
     #[serde(default)]
     pub unsupportable: Option<String>,
@@ -194,12 +198,13 @@ impl Part {
                 self.vary
             ));
         }
-        if let Some(b) = &self.bound {
+        for (name, b) in [("bound", &self.bound), ("limit", &self.limit)] {
+            let Some(b) = b else { continue };
             if b.values.len() != self.values.len() {
-                return Err(format!("bound: {} values for {} settings", b.values.len(), self.values.len()));
+                return Err(format!("{name}: {} values for {} settings", b.values.len(), self.values.len()));
             }
             if let Some(v) = b.values.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
-                return Err(format!("bound: {v} is not a positive number"));
+                return Err(format!("{name}: {v} is not a positive number"));
             }
         }
         self.claim.check().map_err(|e| e.to_string())

@@ -43,7 +43,7 @@ pub enum Outcome {
     NotHeldAnywhere {
         /// The best value and where.
         best: String,
-        /// The largest best measured value and where, when the part computes one.
+        /// The largest best measured value and the part's limit, and where, when it has them.
         measured: Option<String>,
     },
     /// Neither held nor not held at any setting tried: every verdict is inconclusive (or not
@@ -51,7 +51,7 @@ pub enum Outcome {
     InconclusiveEverywhere {
         /// The value closest to the paper's and where.
         best: String,
-        /// The largest best measured value and where, when the part computes one.
+        /// The largest best measured value and the part's limit, and where, when it has them.
         measured: Option<String>,
     },
 }
@@ -147,7 +147,15 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
         .iter()
         .filter_map(|r| Some((r.best_measured?, *r)))
         .max_by(|a, b| a.0.total_cmp(&b.0))
-        .map(|(m, r)| format!("{m:.3} at {} = {}", part.vary, r.setting));
+        .map(|(m, r)| format!("best measured here (not a bound) at most {m:.3} at {} = {}", part.vary, r.setting));
+    let limit = rows.iter().filter_map(|r| Some((r.limit?, *r))).max_by(|a, b| a.0.total_cmp(&b.0)).map(|(l, r)| {
+        let method = part.limit.as_ref().map_or("limit", |b| b.method.as_str());
+        format!("{method} (not a bound of the claim's family) at most {l:.3} at {} = {}", part.vary, r.setting)
+    });
+    let measured = match (measured, limit) {
+        (Some(m), Some(l)) => Some(format!("{m}; {l}")),
+        (m, l) => m.or(l),
+    };
     if let Some(why) = &part.unsupportable {
         return Outcome::Unsupportable(why.clone());
     }
@@ -169,5 +177,5 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
 
 /// The best measured value as a clause of a sentence: achieved here, not a bound.
 fn measured_text(measured: &Option<String>) -> String {
-    measured.as_ref().map_or_else(String::new, |m| format!("; best measured here (not a bound) at most {m}"))
+    measured.as_ref().map_or_else(String::new, |m| format!("; {m}"))
 }

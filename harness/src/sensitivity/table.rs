@@ -55,6 +55,9 @@ pub struct SettingRow {
     /// The best measured value there (the work ratio at free overhead), where the part computes
     /// one: achieved by our estimator, not a bound.
     pub best_measured: Option<f64>,
+    /// The part's idealised value there ([`Part::limit`]): bounds a narrower family than the
+    /// claim's, so it decides nothing.
+    pub limit: Option<f64>,
 }
 
 impl SettingRow {
@@ -91,6 +94,9 @@ impl SettingRow {
             }
             .into(),
             best_measured: finite(best_measured),
+            limit: finite(
+                part.limit.as_ref().and_then(|l| part.values.iter().position(|v| v == value).map(|i| l.values[i])),
+            ),
         }
     }
 }
@@ -128,9 +134,17 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
             md_text(&o.sentence())
         );
         if let Some(b) = &p.bound {
-            let _ = write!(s, "Ceiling: {} (`{}`).\n\n", md_text(&b.method), md_text(&b.command));
+            let _ = write!(s, "Ceiling (a proven bound): {} (`{}`).\n\n", md_text(&b.method), md_text(&b.command));
         }
-        s.push_str("| setting | role | ours | interval | paper | verdict | ceiling | best measured | reason |\n|---|---|---|---|---|---|---|---|---|\n");
+        if let Some(b) = &p.limit {
+            let _ = write!(
+                s,
+                "Limit (not a bound of the claim's family): {} (`{}`).\n\n",
+                md_text(&b.method),
+                md_text(&b.command)
+            );
+        }
+        s.push_str("| setting | role | ours | interval | paper | verdict | ceiling | best measured | limit | reason |\n|---|---|---|---|---|---|---|---|---|---|\n");
         for r in rows.iter().filter(|r| r.part == p.id) {
             let interval = match (r.low, r.high) {
                 (Some(a), Some(b)) => format!("[{a:.4}, {b:.4}]"),
@@ -138,7 +152,7 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
             };
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 md_text(&r.setting),
                 md_text(&r.role),
                 num(r.value),
@@ -147,6 +161,7 @@ pub fn markdown(outcomes: &[(&Part, Outcome)], rows: &[SettingRow]) -> String {
                 md_text(r.verdict.as_str()),
                 num(r.ceiling),
                 num(r.best_measured),
+                num(r.limit),
                 md_text(&r.reason)
             );
         }

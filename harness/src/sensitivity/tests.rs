@@ -95,6 +95,7 @@ fn row(setting: &str, role: &str, value: f64, verdict: Verdict, ceiling: Option<
         reason: String::new(),
         bound_kind: if ceiling.is_some() { "exact".into() } else { String::new() },
         best_measured: None,
+        limit: None,
     }
 }
 
@@ -125,6 +126,21 @@ fn a_best_measured_value_below_the_claim_never_says_cannot_hold() {
         measured("5", "default", 2.0, Verdict::Inconclusive, 3.0),
     );
     assert!(matches!(classify(p, &[&a, &b]), Outcome::InconclusiveEverywhere { measured: Some(_), .. }));
+    // A limit below the claim (a narrower family's bound) is said, and decides nothing either.
+    let mut q = p.clone();
+    q.limit = Some(Bound { method: "exact cache".into(), command: "c".into(), values: vec![2.0, 1.0] });
+    let (a, b) = (
+        SettingRow { limit: Some(2.0), ..measured("1", "paper-like", 4.0, Verdict::NotHeld, 5.0) },
+        SettingRow { limit: Some(1.0), ..measured("5", "default", 2.0, Verdict::NotHeld, 3.0) },
+    );
+    let o = classify(&q, &[&a, &b]);
+    assert!(matches!(o, Outcome::NotHeldAnywhere { .. }), "{o:?}");
+    assert!(
+        o.sentence()
+            .ends_with("exact cache (not a bound of the claim's family) at most 2.000 at estimator.smc.moves = 1"),
+        "{}",
+        o.sentence()
+    );
     // With a proven bound below the claim at every setting the part cannot hold, and says which.
     let mut q = p.clone();
     q.bound = Some(Bound { method: "exact cache".into(), command: "c".into(), values: vec![5.0, 3.0] });
