@@ -95,6 +95,29 @@ pub(super) fn reference(args: ReferenceArgs, registry: &Registry) -> Result<()> 
     Ok(())
 }
 
+/// `mcbench export`: the scene files and the reference image, then one line per file written.
+pub(super) fn export(
+    testbed: &str,
+    variant: Option<&str>,
+    params: &[String],
+    format: &str,
+    out: &std::path::Path,
+    registry: &Registry,
+) -> Result<()> {
+    let params = param_pairs(params)?;
+    // Without --variant: the first the format exports, else the test bed's first (refused below).
+    let exported =
+        registry.exports().iter().find(|e| e.testbed == testbed && e.format == format).map(|e| e.variants[0]);
+    let variant = variant.or(exported).or_else(|| registry.test_bed(testbed).ok().map(|e| e.variants[0])).unwrap_or("");
+    let req = crate::export::ExportRequest { testbed, variant, params: &params, format, out };
+    let written = crate::export::export(registry, &req)?;
+    println!("{testbed}/{variant} as {format}: {} files written to {}", written.len(), out.display());
+    for p in &written {
+        println!("  {}", p.display());
+    }
+    Ok(())
+}
+
 /// `--param key=value` pairs as parameters: a number where the value parses as one, else text.
 pub(super) fn param_pairs(pairs: &[String]) -> Result<Params> {
     let mut p = Params::new();

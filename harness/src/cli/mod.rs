@@ -1,4 +1,4 @@
-//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, `compare`, `ingest`, and the
+//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, `compare`, `ingest`, `export`, and the
 //! default quick suite. Every subcommand exits by the one table of [`crate::error`]: bad input is
 //! one line on stderr naming the field or file, exit code 2, and nothing written; a results folder
 //! that another run holds is exit code 3 (or a wait, with `--wait`).
@@ -127,6 +127,27 @@ enum Command {
         /// The per-integral file: gz (integrals.csv.gz), csv (plain integrals.csv) or none
         #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
         integrals: IntegralsFormat,
+    },
+    /// Write a test bed as another renderer's scene, with its reference as reference.npy
+    /// (book: exported-beds.md).
+    Export {
+        /// Test bed id (`gradient-plane`, `gradient-box`).
+        testbed: String,
+        /// Variant (the first the format exports when omitted).
+        #[arg(long)]
+        variant: Option<String>,
+        /// A test-bed parameter (repeatable): `--param resolution=4`.
+        #[arg(long = "param", value_name = "KEY=VALUE")]
+        params: Vec<String>,
+        /// The scene format.
+        #[arg(long, value_name = "FORMAT", default_value = "mitsuba")]
+        format: String,
+        /// Output folder (created when missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Where stored references are read (default: `results/references`).
+        #[arg(long, value_name = "DIR")]
+        references: Option<PathBuf>,
     },
     /// Compare two runs: per cell, the change from A to B in RMSE, efficiency, FoM and slope with
     /// 95% intervals and verdicts (improved, regressed, no change, inconclusive).
@@ -423,6 +444,10 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
             let args =
                 crate::compare::command::CompareArgs { a, b, results, out, margins, fail_on_regression, two_sample };
             crate::compare::command::compare_command(&args)
+        }
+        Some(Command::Export { testbed, variant, params, format, out, references }) => {
+            let registry = &with_references(registry, &PathBuf::from("results"), &references);
+            export(&testbed, variant.as_deref(), &params, &format, &out, registry)
         }
         Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait, registry),
         Some(Command::Conformance { estimators, estimator_list, testbeds, results, references }) => {
