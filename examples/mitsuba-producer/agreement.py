@@ -11,8 +11,8 @@ the batch spread gives the standard error of the pixel's mean. Per pixel and cha
 of one pixel are not (the same paths), so the script prints, per channel, the mean of z^2 over
 the pixels, which is about (B - 1) / (B - 3) for B batches when the render agrees (z is then a
 Student t with B - 1 degrees of freedom when the reference's variance is small), with the
-chi-square p-value of the sum of z^2 scaled by (B - 3) / (B - 1); and the largest |z|, and the
-mean relative difference over the image with its standard error.
+chi-square p-value of the sum of z^2 scaled by (B - 3) / (B - 1), the largest |z|, and the
+mean relative difference over the image (inverse-variance weighted) with its standard error.
 """
 import argparse
 import math
@@ -37,7 +37,7 @@ def main():
     ap.add_argument("scene")
     ap.add_argument("--spp", type=int, default=16384)
     ap.add_argument("--batches", type=int, default=8)
-    ap.add_argument("--integrator", choices=["path", "clamped"], default="path")
+    ap.add_argument("--integrator", choices=["path", "clamped"], default="path", help="path: the scene's own")
     ap.add_argument("--clamp", type=float, default=1.6)
     ap.add_argument("--seed", type=int, default=7)
     a = ap.parse_args()
@@ -59,18 +59,17 @@ def main():
     expected = (a.batches - 1) / (a.batches - 3)
     rel = (mean - ref) / ref
     rel_se = np.sqrt(se2 + ref_var) / np.abs(ref)
-    w = 1 / rel_se ** 2
-    pooled = float(np.sum(w * rel) / np.sum(w))
-    pooled_se = float(1 / math.sqrt(np.sum(w)))
     px = side * side
-    print(f"{a.scene}: {side}x{side} pixels, {a.integrator}, {a.batches} x {a.spp} spp per pixel, {seconds:.1f} s")
+    label = str(integrator).split("[")[0] if a.integrator == "path" else f"clamped at {a.clamp}"
+    print(f"{a.scene}: {side}x{side} pixels, {label}, {a.batches} x {a.spp} spp per pixel, {seconds:.1f} s")
     for c, name in enumerate("RGB"):
         zc = z[..., c].ravel()
         q = float(np.mean(zc ** 2))
         p = chi2_sf(q * px / expected, px)
-        print(f"  {name}: mean z^2 = {q:.3f} (expected {expected:.3f}; p = {p:.3f}), max |z| = {np.abs(zc).max():.2f}, "
-              f"mean z = {zc.mean():+.3f}")
-    print(f"  relative difference, inverse-variance mean over the image: {pooled:+.2e} +- {pooled_se:.1e}")
+        w = 1 / rel_se[..., c] ** 2
+        pooled, pooled_se = float(np.sum(w * rel[..., c]) / np.sum(w)), float(1 / math.sqrt(np.sum(w)))
+        print(f"  {name}: mean z^2 = {q:.3f} (expected {expected:.3f}; p = {p:.3f}), max |z| = {np.abs(zc).max():.2f}; "
+              f"relative difference {pooled:+.2e} +- {pooled_se:.1e}")
 
 
 if __name__ == "__main__":

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Mitsuba 3 on an exported test bed (book: exported-beds.md, your-renderer.md), on the debug
-# binary: `mcbench export` writes gradient-plane/diffuse at 4x4 pixels as a Mitsuba scene,
-# render.py renders 64 repetitions at 16, 64 and 256 samples per pixel with Mitsuba's path tracer
-# and with a clamped copy of it, and `mcbench ingest` must read the path tracer `pass` against the
-# bed's exact reference and the clamped one `biased` (its tests.csv row says so too). Mitsuba and
-# NumPy are installed with pip into a folder under the target directory (later runs reuse it); a
-# failed install fails the check.
+# binary: `mcbench export` writes gradient-plane/diffuse at 4x4 pixels as a Mitsuba scene (its sky
+# bitmap checked against the exact sky), render.py renders 64 repetitions at 16, 64 and 256
+# samples per pixel with Mitsuba's path tracer and with a clamped copy of it, and `mcbench ingest`
+# must read the path tracer `pass` against the bed's exact reference and the clamped one `biased`
+# (the combined rows of tests.csv say so too). Mitsuba and NumPy are installed with pip into a
+# folder under the target directory (later runs reuse it); a failed install fails the check.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 target="${CARGO_TARGET_DIR:-target}"
@@ -22,6 +22,8 @@ here="$PWD"
 cd "$work"
 start=$(date +%s.%N)  # seconds, for the closing line
 "$mcbench" export gradient-plane --variant diffuse --param resolution=4 --out scene
+# The sky bitmap in Mitsuba's layout: its error over the upper hemisphere is 3.2e-5 (book).
+python3 "$here/examples/mitsuba-producer/sky_error.py" scene --directions 4000 --require-upper 1e-4
 python3 "$here/examples/mitsuba-producer/render.py" scene renders --bed gradient-plane/diffuse
 rendered=$(date +%s.%N)
 "$mcbench" ingest renders/manifest.toml --no-plots | tee ingest.txt
