@@ -130,25 +130,7 @@ enum Command {
     },
     /// Write a test bed as another renderer's scene, with its reference as reference.npy
     /// (book: exported-beds.md).
-    Export {
-        /// Test bed id (`gradient-plane`, `gradient-box`).
-        testbed: String,
-        /// Variant (the first the format exports when omitted).
-        #[arg(long)]
-        variant: Option<String>,
-        /// A test-bed parameter (repeatable): `--param resolution=4`.
-        #[arg(long = "param", value_name = "KEY=VALUE")]
-        params: Vec<String>,
-        /// The scene format.
-        #[arg(long, value_name = "FORMAT", default_value = "mitsuba")]
-        format: String,
-        /// Output folder (created when missing).
-        #[arg(long, value_name = "DIR")]
-        out: PathBuf,
-        /// Where stored references are read (default: `results/references`).
-        #[arg(long, value_name = "DIR")]
-        references: Option<PathBuf>,
-    },
+    Export(ExportArgs),
     /// Compare two runs: per cell, the change from A to B in RMSE, efficiency, FoM and slope with
     /// 95% intervals and verdicts (improved, regressed, no change, inconclusive).
     Compare {
@@ -445,10 +427,7 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
                 crate::compare::command::CompareArgs { a, b, results, out, margins, fail_on_regression, two_sample };
             crate::compare::command::compare_command(&args)
         }
-        Some(Command::Export { testbed, variant, params, format, out, references }) => {
-            let registry = &with_references(registry, &PathBuf::from("results"), &references);
-            export(&testbed, variant.as_deref(), &params, &format, &out, registry)
-        }
+        Some(Command::Export(args)) => export(&args, registry),
         Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait, registry),
         Some(Command::Conformance { estimators, estimator_list, testbeds, results, references }) => {
             let only = Selection::new(estimator_list.as_deref(), testbeds.as_deref()).with_estimator_ids(&estimators);
