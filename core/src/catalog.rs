@@ -18,6 +18,7 @@
 
 use crate::entry::{EstimatorEntry, TestBedEntry};
 use crate::error::ConfigError;
+use crate::export::SceneExport;
 use crate::references::ReferenceSource;
 
 /// Estimators and test beds, in the order they are listed, and the stored references the crate
@@ -31,18 +32,31 @@ pub struct Catalog {
     /// Stored references built into the crate, looked up after the folder a run names
     /// ([`crate::references::Chain`]).
     pub references: Vec<&'static dyn ReferenceSource>,
+    /// Test beds written as other renderers' scenes (`mcbench export`).
+    pub exports: Vec<&'static SceneExport>,
 }
 
 impl Catalog {
     /// The estimators and test beds of two lists.
     pub fn new(estimators: &[&'static EstimatorEntry], testbeds: &[&'static TestBedEntry]) -> Self {
-        Catalog { estimators: estimators.to_vec(), testbeds: testbeds.to_vec(), references: Vec::new() }
+        Catalog {
+            estimators: estimators.to_vec(),
+            testbeds: testbeds.to_vec(),
+            references: Vec::new(),
+            exports: Vec::new(),
+        }
     }
 
     /// The same with `source`, the stored references the crate ships (for example compiled in
     /// with `include_str!`), looked up after the folder a run names.
     pub fn with_references(mut self, source: &'static dyn ReferenceSource) -> Self {
         self.references.push(source);
+        self
+    }
+
+    /// The same with `exports`, test beds written as other renderers' scenes.
+    pub fn with_exports(mut self, exports: &[&'static SceneExport]) -> Self {
+        self.exports.extend_from_slice(exports);
         self
     }
 

@@ -17,6 +17,7 @@
 //!   ([`lighting`]), phase functions ([`phase`]), environment maps ([`envmap`]), perception
 //!   ([`perception`]), compensated accumulation ([`accumulate`]), a process-wide memo ([`memo`])
 //!   and the parallel map of reference builders ([`parallel`]).
+//! - Exported scenes: a test bed as another renderer's scene files ([`export`]).
 //!
 //! No estimator of a paper, no I/O, plotting or CLI lives here: the papers' estimators and test
 //! beds are the `mcbench-papers` crate, the harness is `mcbench`.
@@ -30,6 +31,7 @@ pub mod entry;
 pub mod envmap;
 pub mod error;
 pub mod estimator;
+pub mod export;
 pub mod integrand;
 pub mod integrand_bed;
 pub mod lighting;

@@ -6,9 +6,11 @@ use mcbench_core::error::ConfigError;
 use mcbench_core::Catalog;
 
 /// The built-in estimators and test beds with their stored references
-/// ([`crate::built_in_references`]), to hand to a registry (`Registry::with_catalog`).
+/// ([`crate::built_in_references`]) and exported scenes ([`crate::export`]), to hand to a registry (`Registry::with_catalog`).
 pub fn catalog() -> Catalog {
-    Catalog::new(ESTIMATORS, TESTBEDS).with_references(&crate::built_in_references::BUILT_IN)
+    Catalog::new(ESTIMATORS, TESTBEDS)
+        .with_references(&crate::built_in_references::BUILT_IN)
+        .with_exports(crate::export::EXPORTS)
 }
 
 /// Every built-in estimator, in the order `mcbench list estimators` shows them.

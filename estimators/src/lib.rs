@@ -10,7 +10,7 @@
 //! with [`cache`], their radiance cache), [`media_smc`] (paper 000 in a medium), [`tracking`] and
 //! [`single_scatter`] (paper 002's trackers with their moment theory, and its single-scattering
 //! estimators), [`pmc`] (paper 003), [`envmap_smc`] (paper 004), [`integrand_mc`] (estimators of any generic integrand); and
-//! [`testbeds`], the test beds with their references.
+//! [`testbeds`], the test beds with their references, and [`export`], two of them as Mitsuba 3 scenes.
 //!
 //! No I/O, plotting or CLI lives here (that is the `mcbench` crate, in `harness/`).
 #![warn(missing_docs)]
@@ -19,6 +19,7 @@ pub mod built_in_references;
 pub mod builtins;
 pub mod cache;
 pub mod envmap_smc;
+pub mod export;
 pub mod independent;
 pub mod integrand_mc;
 pub mod media_smc;

@@ -25,6 +25,7 @@
 //! | [`unbiasedness`], [`calibration`], [`sensitivity`], [`conformance`] | the built-in experiments and the plug-in check |
 //! | [`compare`] | two runs compared: changes with intervals and verdicts, baselines |
 //! | [`ingest`] | estimates another program wrote, read from files and analysed as a run |
+//! | [`export`] | a built-in test bed written as another renderer's scene, with its reference image |
 //! | [`registry`], [`plugins`], [`selection`] | names looked up, what a user's crate adds to built-in checks, the entries a run is limited to |
 //!
 //! ## Quick start: your own estimator, from your own crate
@@ -82,6 +83,7 @@ pub mod compare;
 pub mod config;
 pub mod conformance;
 pub mod error;
+pub mod export;
 pub mod ingest;
 pub mod output;
 pub mod plan;

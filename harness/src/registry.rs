@@ -27,6 +27,7 @@ use crate::store::folder::OutputDir;
 use crate::store::references::ReferenceDir;
 use mcbench_core::entry::{EstimatorEntry, Exemption, TestBedEntry};
 use mcbench_core::error::ConfigError;
+use mcbench_core::export::SceneExport;
 use mcbench_core::references::{Chain, ReferenceKey, ReferenceSource, StoredReference};
 use mcbench_core::{Catalog, SamplerEntry};
 use std::path::{Path, PathBuf};
@@ -127,6 +128,8 @@ pub struct Registry {
     built_in: Vec<&'static dyn ReferenceSource>,
     /// `references`, then `built_in`.
     chain: Chain,
+    /// Test beds as other renderers' scenes (`mcbench export`).
+    exports: Vec<&'static SceneExport>,
     /// Exemptions of controls added by the crate that registers them ([`crate::plugins`]).
     pub(crate) exemptions: Vec<(&'static str, Exemption)>,
     /// Samplers added by the crate that registers them ([`crate::plugins`]).
@@ -147,6 +150,7 @@ impl Default for Registry {
             on_demand: Vec::new(),
             references: Arc::new(ReferenceDir::new(DEFAULT_REFERENCES)),
             built_in: Vec::new(),
+            exports: Vec::new(),
             chain: Chain(vec![Arc::new(ReferenceDir::new(DEFAULT_REFERENCES))]),
             exemptions: Vec::new(),
             samplers: Vec::new(),
@@ -191,6 +195,7 @@ impl Registry {
         self.estimators.extend(catalog.estimators);
         self.test_beds.extend(catalog.testbeds);
         self.built_in.extend(catalog.references);
+        self.exports.extend(catalog.exports);
         self.rechain()
     }
 
@@ -224,6 +229,11 @@ impl Registry {
     /// (their labels and ids where they have none).
     pub fn display_names(&self) -> DisplayNames<'_> {
         DisplayNames::new(&self.estimators, &self.test_beds)
+    }
+
+    /// The test beds the catalogs can write as other renderers' scenes (`mcbench export`).
+    pub fn exports(&self) -> &[&'static SceneExport] {
+        &self.exports
     }
 
     /// Adds an estimator.

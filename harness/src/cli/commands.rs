@@ -95,6 +95,51 @@ pub(super) fn reference(args: ReferenceArgs, registry: &Registry) -> Result<()> 
     Ok(())
 }
 
+/// `mcbench export`'s arguments.
+#[derive(Args, Debug)]
+pub(super) struct ExportArgs {
+    /// Test bed id (`gradient-plane`, `gradient-box`).
+    testbed: String,
+    /// Variant (the first the format exports when omitted).
+    #[arg(long)]
+    variant: Option<String>,
+    /// A test-bed parameter (repeatable): `--param resolution=4`.
+    #[arg(long = "param", value_name = "KEY=VALUE")]
+    params: Vec<String>,
+    /// The scene format.
+    #[arg(long, value_name = "FORMAT", default_value = "mitsuba")]
+    format: String,
+    /// Output folder (created when missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Where stored references are read (default: `results/references`).
+    #[arg(long, value_name = "DIR")]
+    references: Option<PathBuf>,
+}
+
+/// `mcbench export`: the scene files and the reference image, then one line per file written.
+pub(super) fn export(args: &ExportArgs, registry: &Registry) -> Result<()> {
+    let registry = &with_references(registry, std::path::Path::new("results"), &args.references);
+    let params = param_pairs(&args.params)?;
+    let (testbed, format) = (args.testbed.as_str(), args.format.as_str());
+    // Without --variant: the first the format exports, else the test bed's first (refused below).
+    let exported =
+        registry.exports().iter().find(|e| e.testbed == testbed && e.format == format).map(|e| e.variants[0]);
+    let variant = args
+        .variant
+        .as_deref()
+        .or(exported)
+        .or_else(|| registry.test_bed(testbed).ok().map(|e| e.variants[0]))
+        .unwrap_or("");
+    let req = crate::export::ExportRequest { testbed, variant, params: &params, format, out: &args.out };
+    let written = crate::export::export(registry, &req)?;
+    println!("{testbed}/{variant} as {format}: {} files written to {}", written.len(), args.out.display());
+    for p in &written {
+        println!("  {}", p.display());
+    }
+    Ok(())
+}
+
 /// `--param key=value` pairs as parameters: a number where the value parses as one, else text.
 pub(super) fn param_pairs(pairs: &[String]) -> Result<Params> {
     let mut p = Params::new();

@@ -1,4 +1,4 @@
-//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, `compare`, `ingest`, and the
+//! The `mcbench` command line (book: cli.md): `list`, `run`, `reference`, `merge`, `plot`, `compare`, `ingest`, `export`, and the
 //! default quick suite. Every subcommand exits by the one table of [`crate::error`]: bad input is
 //! one line on stderr naming the field or file, exit code 2, and nothing written; a results folder
 //! that another run holds is exit code 3 (or a wait, with `--wait`).
@@ -128,6 +128,9 @@ enum Command {
         #[arg(long, value_name = "FORMAT", value_enum, default_value_t = IntegralsFormat::Gz, hide_possible_values = true)]
         integrals: IntegralsFormat,
     },
+    /// Write a test bed as another renderer's scene, with its reference as reference.npy
+    /// (book: exported-beds.md).
+    Export(ExportArgs),
     /// Compare two runs: per cell, the change from A to B in RMSE, efficiency, FoM and slope with
     /// 95% intervals and verdicts (improved, regressed, no change, inconclusive).
     Compare {
@@ -424,6 +427,7 @@ fn dispatch(cli: Cli, registry: &Registry) -> Result<()> {
                 crate::compare::command::CompareArgs { a, b, results, out, margins, fail_on_regression, two_sample };
             crate::compare::command::compare_command(&args)
         }
+        Some(Command::Export(args)) => export(&args, registry),
         Some(Command::Plot { results_dir, plots, wait }) => plot(&results_dir, &plots, wait, registry),
         Some(Command::Conformance { estimators, estimator_list, testbeds, results, references }) => {
             let only = Selection::new(estimator_list.as_deref(), testbeds.as_deref()).with_estimator_ids(&estimators);
