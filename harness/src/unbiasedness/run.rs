@@ -247,8 +247,10 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
             in_rounds(plan, run, first, others, report, registry, &mut notes)?
         }
     };
+    let pilot_size =
+        if plan.sweep.repetitions.is_fixed() { "as many repetitions" } else { "its first round's repetitions" };
     report.meta.notes.push(format!(
-        "unbiasedness parts (each with a pilot of as many repetitions on seed {}): {}",
+        "unbiasedness parts (each with a pilot of {pilot_size} on seed {}): {}",
         pilot_seed(plan.sweep.seed),
         notes.join(", ")
     ));
