@@ -1,6 +1,6 @@
 //! Round-based repetitions of `unbiasedness` (`--repetitions rounds`, book: unbiasedness.md).
 //!
-//! Every row (a cell and its pilot, the gate) starts with a first round of a quarter of its part's
+//! Every row (a cell and its pilot, the gate) starts with a first round of an eighth of its part's
 //! fixed-mode repetitions (at least [`MIN_FIRST_REPS`], a whole number of [`FIRST_ROUND_STEP`]);
 //! the cells of the rows still open then double their repetitions, round by round, until each is
 //! decided, has had [`LOOKS`] looks, or the next doubling no longer fits the experiment's budget.
@@ -37,7 +37,7 @@ use crate::plan::Plan;
 use crate::run::cell::{rep_block_count, rep_block_size, CellResult, RepBlock, MAX_REP_BLOCKS};
 use crate::run::runner::{merge_blocks, run_group_at, GroupCell, REP_BLOCK};
 
-/// The most looks at one row: its repetitions run from the first round to 128 times it (32 times
+/// The most looks at one row: its repetitions run from the first round to 128 times it (16 times
 /// the fixed mode's).
 pub const LOOKS: usize = 8;
 
@@ -54,11 +54,11 @@ pub fn look_alpha() -> f64 {
     UNBIASEDNESS_ALPHA / LOOKS as f64
 }
 
-/// The first round's repetitions for a part of `fixed` repetitions in the fixed mode: a quarter,
+/// The first round's repetitions for a part of `fixed` repetitions in the fixed mode: an eighth,
 /// rounded up to a whole number of [`FIRST_ROUND_STEP`], at least [`MIN_FIRST_REPS`].
 pub fn first_round(fixed: usize) -> usize {
     let step = FIRST_ROUND_STEP;
-    fixed.div_ceil(4).div_ceil(step).max(1).saturating_mul(step).max(MIN_FIRST_REPS.next_multiple_of(step))
+    fixed.div_ceil(8).div_ceil(step).max(1).saturating_mul(step).max(MIN_FIRST_REPS.next_multiple_of(step))
 }
 
 /// One row of the rounds: a cell and its pilot (the gate) with the tests of their last look.

@@ -57,13 +57,14 @@ fn looks_at_their_share_of_alpha_keep_the_false_flags_under_continuous_monitorin
 }
 
 #[test]
-fn first_rounds_are_a_quarter_in_whole_steps_and_at_least_the_minimum() {
+fn first_rounds_are_an_eighth_in_whole_steps_and_at_least_the_minimum() {
     assert_eq!(first_round(256), MIN_FIRST_REPS);
-    assert_eq!(first_round(512), 128);
-    assert_eq!(first_round(1500), 384);
-    assert_eq!(first_round(16_384), 4096);
+    assert_eq!(first_round(512), 64);
+    assert_eq!(first_round(1024), 128);
+    assert_eq!(first_round(1500), 192);
+    assert_eq!(first_round(16_384), 2048);
     assert_eq!(first_round(2), MIN_FIRST_REPS);
-    assert_eq!(first_round(720), 192, "180 rounded up to six steps of 32");
+    assert_eq!(first_round(720), 96, "90 rounded up to three steps of 32");
     assert!([100, 1000, 4097, 720].iter().all(|&r| first_round(r).is_multiple_of(FIRST_ROUND_STEP)));
     assert!(FIRST_ROUND_STEP.is_multiple_of(REP_BLOCK) && FIRST_ROUND_STEP.is_multiple_of(MAX_REP_BLOCKS));
 }
