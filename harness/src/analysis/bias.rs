@@ -73,6 +73,8 @@ pub struct Gate {
     /// through a sequence ([`mcbench_core::estimator::Estimator::integrals_independent`]). Known
     /// before any outcome; [`Gate::from_cell`] takes the whole cell as one group.
     pub group: usize,
+    /// The repetitions its spread and skewness come from (what their precision rests on).
+    pub reps: u64,
 }
 
 impl Gate {
@@ -89,7 +91,30 @@ impl Gate {
             integral_skew: cell.moments.iter().map(|m| [skew(&m[0]), skew(&m[1]), skew(&m[2])]).collect(),
             integral_var: cell.moments.iter().map(|m| [0, 1, 2].map(|c| m[c].variance() * scale * scale)).collect(),
             group: cell.moments.len().max(1),
+            reps: cell.key.reps as u64,
         }
+    }
+
+    /// The degrees of freedom of the mean of a tested cell's variance (from `reps` repetitions)
+    /// and this gate's: twice the cell's when the gate has as many repetitions, else (the two
+    /// estimate the same variance when the estimator is unbiased, on independent draws) the
+    /// Satterthwaite degrees of freedom of an even mean of two variance estimates of equal
+    /// expectation, `4 / (1 / (reps - 1) + 1 / (gate reps - 1))`.
+    pub fn mixed_dof(&self, reps: u64) -> f64 {
+        let d = (reps as f64 - 1.0).max(1.0);
+        if self.reps == reps {
+            return 2.0 * d;
+        }
+        let g = (self.reps as f64 - 1.0).max(1.0);
+        4.0 / (1.0 / d + 1.0 / g)
+    }
+
+    /// The degrees of freedom of a t-test of a cell of `reps` repetitions whose variance is the
+    /// mean of its own and this gate's: the cell's `reps - 1`, or fewer when a gate of fewer
+    /// repetitions makes the mean less precise than the cell alone ([`Gate::mixed_dof`]).
+    pub fn t_dof(&self, reps: u64) -> f64 {
+        let d = (reps as f64 - 1.0).max(1.0);
+        d.min(self.mixed_dof(reps))
     }
 
     /// With integrals independent in groups of `group` consecutive ones (see [`Gate::group`]).

@@ -304,3 +304,26 @@ fn the_decision_detects_what_the_stronger_of_its_tests_detects() {
     // lies at or above it (binomial sd over 60 seeds: 5%).
     assert!(flagged as f64 >= 0.65 * seeds as f64, "{flagged} of {seeds} flagged at b = {b}");
 }
+
+#[test]
+fn a_gate_of_fewer_repetitions_counts_fewer_degrees_of_freedom() {
+    let reference = exact(&[[1.0; 3]; 16]);
+    let cell = cell_from(&normal_reps(21, 16, 1024, 1.0, 0.05), &reference);
+    let same = Gate::from_cell(&cell_from(&normal_reps(22, 16, 1024, 1.0, 0.05), &reference), "pilot", 1.0);
+    assert_eq!((same.reps, same.mixed_dof(1024), same.t_dof(1024)), (1024, 2046.0, 1023.0));
+    // The same spread and skewness from 64 repetitions: an even mean of two variance estimates of
+    // 1023 and 63 degrees of freedom has about 237, fewer than the cell's own.
+    let small = Gate { reps: 64, ..same.clone() };
+    let dof = small.mixed_dof(1024);
+    assert!((dof - 4.0 / (1.0 / 1023.0 + 1.0 / 63.0)).abs() < 1e-9 && dof < 1023.0, "{dof}");
+    assert_eq!(small.t_dof(1024), dof);
+    assert_eq!(small.mixed_dof(64), 126.0);
+    // A pass asks the tolerance at the upper bound of the spread: 2046 degrees of freedom put it
+    // about 2.6% above the estimate, 237 about 7.7%, so a tolerance 5% above the detectable bias
+    // passes behind the gate of as many repetitions and not behind the smaller one.
+    let d = decision(&unbiasedness(&cell, &reference, Bias::Unbiased, Some(&same), DEFAULT_TOLERANCE)).clone();
+    let tolerance = d.detectable_rel_bias * 1.05;
+    let verdict =
+        |g: &Gate| decision(&unbiasedness(&cell, &reference, Bias::Unbiased, Some(g), tolerance)).verdict.clone();
+    assert_eq!((verdict(&same), verdict(&small)), ("pass".to_string(), "inconclusive".to_string()));
+}

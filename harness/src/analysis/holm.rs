@@ -100,11 +100,16 @@ pub(super) fn holm(
     let heavy = gate.is_some_and(|g| {
         let mut all: Vec<f64> = g.integral_skew.iter().flatten().map(|s| s.abs()).filter(|s| s.is_finite()).collect();
         all.sort_by(f64::total_cmp);
-        all.get(all.len() / 2).is_some_and(|&median| median > limit + 2.0 * (6.0 / reps.max(1) as f64).sqrt())
+        all.get(all.len() / 2).is_some_and(|&median| median > limit + 2.0 * (6.0 / g.reps.max(1) as f64).sqrt())
     });
     // Per independent group of integrals, its strongest test (the tests within a group may share
     // everything).
     let group = gate.map_or(usize::MAX, |g| g.group.max(1));
+    // The degrees of freedom of a variance that is the mean of the cell's and the gate's
+    // ([`Gate::t_dof`]: the cell's unless the gate has fewer repetitions), and the repetitions a
+    // Welch test counts for them.
+    let t_dof = gate.map_or((reps as f64 - 1.0).max(1.0), |g| g.t_dof(reps));
+    let welch_reps = gate.map_or(reps, |g| if g.reps == reps { reps } else { (t_dof.floor() as u64 + 1).min(reps) });
     let mut strengths = Vec::new();
     let mut strongest = 0.0f64;
     for (i, mom) in cell.moments.iter().enumerate() {
@@ -124,8 +129,10 @@ pub(super) fn holm(
             };
             let se_total = (se * se + rse * rse).sqrt();
             if r != 0.0 {
-                detect
-                    .push(detectable_shift_t(se_total, per_test_alpha, POWER, reps.saturating_sub(1) as f64) / r.abs());
+                detect.push(
+                    detectable_shift_t(se_total, per_test_alpha, POWER, t_dof.min(reps.saturating_sub(1) as f64))
+                        / r.abs(),
+                );
             }
             if let Some(u) = zero.direct(spread, i, c) {
                 // No spread beyond round-off in the cell or its gate while other integrals vary:
@@ -151,8 +158,8 @@ pub(super) fn holm(
                     untested += 1;
                     continue;
                 }
-                None => t_test(mc.mean() - r_test, se, reps as f64 - 1.0),
-                Some(n) => mcbench_core::stats::welch(mc.mean(), se, reps, r, rse, n),
+                None => t_test(mc.mean() - r_test, se, t_dof.min(reps as f64 - 1.0)),
+                Some(n) => mcbench_core::stats::welch(mc.mean(), se, welch_reps, r, rse, n),
             };
             max_t = max_t.max(t.statistic.abs());
             ps.push(t.p_value);
@@ -172,7 +179,7 @@ pub(super) fn holm(
     detect.sort_by(f64::total_cmp);
     let name = if stored_n.is_some() { "holm_welch" } else { "holm_t" };
     // Each integral's variance is the mean of the cell's and the gate's (when it has one).
-    let spread_dof = (reps as f64 - 1.0).max(1.0) * if gate.is_some() { 2.0 } else { 1.0 };
+    let spread_dof = gate.map_or((reps as f64 - 1.0).max(1.0), |g| g.mixed_dof(reps));
     Holm {
         name: name.into(),
         max_t,
@@ -180,7 +187,7 @@ pub(super) fn holm(
         median_detect: detect.get(detect.len() / 2).copied().unwrap_or(f64::NAN),
         untested,
         strengths,
-        dof: (reps as f64 - 1.0).max(1.0),
+        dof: t_dof,
         spread_upper: spread_upper(spread_dof),
         direct,
         direct_beyond,

@@ -54,12 +54,16 @@ pub(super) fn pooled(
     });
     let a = sd * sd / r.max(1) as f64;
     let se = (a + var_ref).sqrt();
+    // The spread's degrees of freedom: the cell's, or those of the mean with the gate's (fewer
+    // than the cell's alone when the gate has fewer repetitions, [`Gate::t_dof`]).
+    let mixed = gate.filter(|g| !g.rep_sd.is_nan());
+    let cell_dof = mixed.map_or((r as f64 - 1.0).max(1.0), |g| g.t_dof(r));
     let dof = if var_ref > 0.0 && a > 0.0 {
-        (a + var_ref).powi(2) / (a * a / (r as f64 - 1.0).max(1.0) + var_ref * var_ref / dof_ref)
+        (a + var_ref).powi(2) / (a * a / cell_dof + var_ref * var_ref / dof_ref)
     } else if var_ref > 0.0 {
         dof_ref
     } else {
-        (r as f64 - 1.0).max(1.0)
+        cell_dof
     };
     let t = t_test(dev, se, dof);
     let shift = if se > 0.0 { detectable_shift_t(se, alpha, POWER, dof) / ref_sum } else { 0.0 };
@@ -67,7 +71,7 @@ pub(super) fn pooled(
     // The spread is estimated from the cell's repetitions (and the gate's, when they are averaged):
     // a pass asks that the bias be detectable at the upper 95% bound of that estimate, so that a
     // row at the edge of its tolerance does not pass in the seeds that underestimate its spread.
-    let spread_dof = (r as f64 - 1.0).max(1.0) * if gate.is_some_and(|g| !g.rep_sd.is_nan()) { 2.0 } else { 1.0 };
+    let spread_dof = mixed.map_or((r as f64 - 1.0).max(1.0), |g| g.mixed_dof(r));
     let detectable_upper = multiplicative(shift * spread_upper(spread_dof));
     let limit = t_test_skewness_limit(r, alpha);
     let skew_run = d.skewness().abs();

@@ -4,10 +4,10 @@
 //! its share of a nominal 5% (the false-flag rate of the whole rule, optional stopping included),
 //! and, at the experiment's own 1e-3, how often a row is decided and at how many repetitions.
 //!
-//! Seed `k`'s cell is repetitions `2kM .. 2kM + M` of one long run and its pilot the next `M`, where
-//! `M` is the most repetitions a row can reach (its first round times `2^(LOOKS-1)`); a look at `R`
-//! repetitions uses the first `R` of each, so the looks of one seed are nested exactly as the
-//! rounds of a run are. Repetitions are computed only as far as some look needs them. There is no
+//! Seed `k`'s cell is repetitions `2kM .. 2kM + M` of one long run and its pilot the first round's
+//! repetitions after them, where `M` is the most repetitions a row can reach (its first round
+//! times `2^(LOOKS-1)`); a look at `R` repetitions uses the first `R` of the cell's and the whole
+//! pilot, as the rounds of a run do. Repetitions are computed only as far as some look needs them. There is no
 //! shared budget here: each row may take all its looks (the budget of a run only stops rows
 //! earlier, which cannot raise the rate).
 
@@ -77,15 +77,18 @@ fn looks(
     let id = plan.estimators[0].name.clone();
     let budget = plan.sweep.budgets[0];
     let group = Gate::group_of(plan.estimators[0].estimator.as_ref(), bed);
-    let (mut reps, mut flagged, mut tested) = (first_round(family.reps), false, false);
+    let first = first_round(family.reps);
+    while pilot_reps.len() < first {
+        pilot_reps.push(rep_estimates(plan, pilot_from + pilot_reps.len() as u64)?);
+    }
+    let pilot = guarded::cell_of(bed, &id, budget, plan.sweep.seed, &pilot_reps[..first]);
+    let gate = Gate::from_cell(&pilot, "pilot", 1.0).with_group(group);
+    let (mut reps, mut flagged, mut tested) = (first, false, false);
     for look in 1..=LOOKS {
         while cell_reps.len() < reps {
             cell_reps.push(rep_estimates(plan, cell_from + cell_reps.len() as u64)?);
-            pilot_reps.push(rep_estimates(plan, pilot_from + pilot_reps.len() as u64)?);
         }
         let cell = guarded::cell_of(bed, &id, budget, plan.sweep.seed, &cell_reps[..reps]);
-        let pilot = guarded::cell_of(bed, &id, budget, plan.sweep.seed, &pilot_reps[..reps]);
-        let gate = Gate::from_cell(&pilot, "pilot", 1.0).with_group(group);
         let tests = unbiasedness_at(&cell, bed.reference(), family.bias, Some(&gate), tolerance, alpha / LOOKS as f64);
         let row = tests.iter().find(|t| t.test == "combined").cloned().unwrap_or_default();
         tested |= !row.p_value.is_nan();

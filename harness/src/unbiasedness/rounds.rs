@@ -1,12 +1,14 @@
 //! Round-based repetitions of `unbiasedness` (`--repetitions rounds`, book: unbiasedness.md).
 //!
-//! Every row (a cell and its pilot, the gate) starts with a first round of a quarter of its part's
+//! Every row (a cell and its pilot, the gate) starts with a first round of an eighth of its part's
 //! fixed-mode repetitions (at least [`MIN_FIRST_REPS`], a whole number of [`FIRST_ROUND_STEP`]);
-//! the rows still open then double their repetitions, round by round, until each is decided, has
-//! had [`LOOKS`] looks, or the next doubling no longer fits the experiment's budget. A control (a
-//! row whose registry entry calls the estimator biased, with no exemption there) is not stopped
-//! by a pass: it grows until flagged. A row without a valid test (the skewness gate) stays open
-//! while looks remain.
+//! the cells of the rows still open then double their repetitions, round by round, until each is
+//! decided, has had [`LOOKS`] looks, or the next doubling no longer fits the experiment's budget.
+//! The pilot keeps its first round's repetitions at every look. A control (a row whose registry
+//! entry calls the estimator biased, with no exemption there) is not stopped by a pass: it grows
+//! until flagged. Any other row stays open while some look left could resolve it by its last
+//! look's estimate, the repetitions that would bring a skewness beyond the gate's limit under it
+//! included ([`stays_open`]).
 //!
 //! Validity under this optional stopping: a row is looked at most [`LOOKS`] times, a number fixed
 //! before any outcome, and every look runs the fixed mode's tests
@@ -14,8 +16,11 @@
 //! over the looks. By the union bound the chance that any look of a correct row flags it is at
 //! most 1e-3 whatever rule chooses when to stop, so the rule may use the data and the registry
 //! (decided rows stop, controls grow until flagged, the rows nearest a decision grow first). The
-//! gate grows with the cell: at every look the pilot has as many repetitions as the cell, on its
-//! own seed.
+//! tests at a look are the fixed mode's tests behind a pilot of the first round's repetitions: the
+//! pilot is the same pair on its own seed, independent of the cell at every look, and the tests
+//! count its size (the spread, the mean of the cell's and the pilot's variance, has the
+//! degrees of freedom of such a mean, [`crate::analysis::Gate::t_dof`]; the per-integral skewness
+//! margin is that of the pilot's repetitions). Keeping the pilot fixed halves what a doubling costs.
 //!
 //! The budget is deterministic: repetitions x integrals x samples per estimate, summed over every
 //! cell and pilot, at most what the fixed mode spends (each part's repetitions for the cell and as
@@ -23,7 +28,8 @@
 //! blocks of a grown cell are merged in block order, so a row stopped at `R` repetitions holds
 //! exactly the moments of a fixed-mode cell of `R` repetitions, whatever the thread count; its
 //! bootstrap blocks ([`rep_block_size`]) have the fixed-mode layout at `R` (adjacent blocks merge
-//! when the repetitions double), their sums equal up to the order of the additions.
+//! when the repetitions double), their sums equal up to the order of the additions. Its pilot is
+//! the fixed mode's pilot at the first round's repetitions.
 
 use crate::analysis::{TestRow, UNBIASEDNESS_ALPHA};
 use crate::error::{HarnessError, Result};
@@ -31,9 +37,9 @@ use crate::plan::Plan;
 use crate::run::cell::{rep_block_count, rep_block_size, CellResult, RepBlock, MAX_REP_BLOCKS};
 use crate::run::runner::{merge_blocks, run_group_at, GroupCell, REP_BLOCK};
 
-/// The most looks at one row: its repetitions run from the first round to 32 times it (8 times
+/// The most looks at one row: its repetitions run from the first round to 128 times it (16 times
 /// the fixed mode's).
-pub const LOOKS: usize = 6;
+pub const LOOKS: usize = 8;
 
 /// A first round is a whole number of these repetitions: whole repetition blocks of the run, and
 /// as many as a cell has bootstrap blocks, so that every doubling merges adjacent bootstrap
@@ -48,19 +54,17 @@ pub fn look_alpha() -> f64 {
     UNBIASEDNESS_ALPHA / LOOKS as f64
 }
 
-/// The first round's repetitions for a part of `fixed` repetitions in the fixed mode: a quarter,
+/// The first round's repetitions for a part of `fixed` repetitions in the fixed mode: an eighth,
 /// rounded up to a whole number of [`FIRST_ROUND_STEP`], at least [`MIN_FIRST_REPS`].
 pub fn first_round(fixed: usize) -> usize {
     let step = FIRST_ROUND_STEP;
-    fixed.div_ceil(4).div_ceil(step).max(1).saturating_mul(step).max(MIN_FIRST_REPS.next_multiple_of(step))
+    fixed.div_ceil(8).div_ceil(step).max(1).saturating_mul(step).max(MIN_FIRST_REPS.next_multiple_of(step))
 }
 
 /// One row of the rounds: a cell and its pilot (the gate) with the tests of their last look.
 pub struct Entry<'p> {
     /// The part's plan the cell belongs to.
     pub plan: &'p Plan,
-    /// The same part on the pilot seed.
-    pub pilot_plan: &'p Plan,
     /// Test bed index.
     pub bi: usize,
     /// Estimator index.
@@ -69,7 +73,8 @@ pub struct Entry<'p> {
     pub fixed: usize,
     /// The cell so far.
     pub cell: CellResult,
-    /// Its pilot so far (as many repetitions).
+    /// Its pilot (the gate): the same pair on the pilot seed at the first round's repetitions,
+    /// which it keeps at every look.
     pub pilot: CellResult,
     /// Looks so far.
     pub looks: usize,
@@ -90,9 +95,13 @@ impl Entry<'_> {
     pub fn fixed_cost(&self) -> u64 {
         2u64.saturating_mul(self.fixed as u64).saturating_mul(self.unit())
     }
-    /// What the row has spent so far.
+    /// What the row has spent so far: its cell and its pilot (which stays at the first round).
     pub fn spent(&self) -> u64 {
-        2u64.saturating_mul(self.cell.key.reps as u64).saturating_mul(self.unit())
+        (self.cell.key.reps as u64).saturating_add(self.pilot.key.reps as u64).saturating_mul(self.unit())
+    }
+    /// What its next doubling costs: as many repetitions of the cell again.
+    pub fn doubling(&self) -> u64 {
+        (self.cell.key.reps as u64).saturating_mul(self.unit())
     }
     /// Its place in a round (lowest first) and the work it claims there: controls (a doubling),
     /// then the rows whose needed repetitions some look reaches, by the work of the doublings to
@@ -100,12 +109,12 @@ impl Entry<'_> {
     fn priority(&self) -> (u8, u64) {
         let reps = self.cell.key.reps.max(1) as f64;
         match self.needed.filter(|&n| n.is_finite()) {
-            _ if self.control => (0, self.spent()),
+            _ if self.control => (0, self.doubling()),
             Some(n) if n <= reach(self.cell.key.reps, self.looks) => {
                 let doublings = (n / reps).log2().ceil().max(1.0) as u32;
-                (1, self.spent().saturating_mul((1u64 << doublings) - 1))
+                (1, self.doubling().saturating_mul((1u64 << doublings) - 1))
             }
-            _ => (2, self.spent()),
+            _ => (2, self.doubling()),
         }
     }
 }
@@ -117,10 +126,12 @@ fn reach(reps: usize, looks: usize) -> f64 {
 
 /// Whether a row whose last look gave `tests` (at `reps` repetitions, look `looks`) stays open. No
 /// row stays open after the last look or once flagged. A `control` (a row that must be flagged)
-/// stays open otherwise, pass or not. Any other row stays open while inconclusive and able to
-/// pass at all (`can_pass`: not judged against a reference of its own making), either without a
-/// valid pooled test (more repetitions may bring its skewness under the gate's limit) or with
-/// some repetitions within the remaining looks that would resolve it.
+/// stays open otherwise, pass or not. Any other row stays open while inconclusive, able to pass at
+/// all (`can_pass`: not judged against a reference of its own making), and with some repetitions
+/// within the remaining looks that would resolve it: for a row without a valid pooled test, the
+/// repetitions that would bring its skewness under the gate's limit count too, so a row too
+/// skewed for any look to test stops (it is inconclusive at those repetitions in the fixed mode
+/// as well) and leaves the budget to the rows within reach.
 pub fn stays_open(tests: &[TestRow], reps: usize, looks: usize, can_pass: bool, control: bool) -> bool {
     let Some(d) = tests.iter().find(|t| t.test == "combined") else { return false };
     if looks >= LOOKS || d.verdict == "biased" {
@@ -129,8 +140,7 @@ pub fn stays_open(tests: &[TestRow], reps: usize, looks: usize, can_pass: bool, 
     if control {
         return true;
     }
-    let untested = tests.iter().any(|t| t.test == "pooled_t" && t.p_value.is_nan());
-    d.verdict == "inconclusive" && can_pass && (untested || d.reps_needed.is_some_and(|r| r <= reach(reps, looks)))
+    d.verdict == "inconclusive" && can_pass && d.reps_needed.is_some_and(|r| r <= reach(reps, looks))
 }
 
 /// The combined row's repetitions needed, for [`Entry::needed`].
@@ -173,7 +183,7 @@ pub fn grow(
         }
         if chosen.is_empty() {
             for &(_, i) in &open {
-                let cost = entries[i].spent();
+                let cost = entries[i].doubling();
                 if spent.saturating_add(cost) <= budget {
                     spent += cost;
                     chosen.push(i);
@@ -182,7 +192,7 @@ pub fn grow(
                 }
             }
         } else {
-            spent += chosen.iter().map(|&i| entries[i].spent()).sum::<u64>();
+            spent += chosen.iter().map(|&i| entries[i].doubling()).sum::<u64>();
         }
         chosen.sort_unstable();
         if chosen.is_empty() {
@@ -197,8 +207,9 @@ pub fn grow(
     }
 }
 
-/// Doubles the repetitions of the entries `chosen` and of their pilots: the new blocks of the
-/// cells of one (plan, test bed, repetitions) run interleaved, then merge after the old ones.
+/// Doubles the repetitions of the cells of the entries `chosen` (their pilots stay as they are):
+/// the new blocks of the cells of one (plan, test bed, repetitions) run interleaved, then merge
+/// after the old ones.
 fn double(entries: &mut [Entry<'_>], chosen: &[usize]) -> Result<()> {
     let mut done = vec![false; chosen.len()];
     for a in 0..chosen.len() {
@@ -210,27 +221,22 @@ fn double(entries: &mut [Entry<'_>], chosen: &[usize]) -> Result<()> {
             std::ptr::eq(e.plan, first.plan) && e.bi == first.bi && e.cell.key.reps == first.cell.key.reps
         };
         let group: Vec<usize> = (a..chosen.len()).filter(|&b| !done[b] && same(&entries[chosen[b]])).collect();
-        let (reps, bi, budget) = (first.cell.key.reps, first.bi, first.cell.key.budget);
+        let (reps, bi, budget, plan) = (first.cell.key.reps, first.bi, first.cell.key.budget, first.plan);
         let blocks: Vec<usize> = (reps / REP_BLOCK..2 * reps / REP_BLOCK).collect();
         let cells: Vec<GroupCell<'_>> =
             group.iter().map(|&b| GroupCell { ei: entries[chosen[b]].ei, blocks: &blocks }).collect();
-        for pilot in [false, true] {
-            let e0 = &entries[chosen[a]];
-            let plan = if pilot { e0.pilot_plan } else { e0.plan };
-            let mut parts: Vec<Vec<CellResult>> = vec![Vec::new(); group.len()];
-            run_group_at(plan, bi, budget, 2 * reps, &cells, |k, _, part| {
-                parts[k].push(part);
-                Ok(())
-            })?;
-            for (k, new) in parts.into_iter().enumerate() {
-                let e = &mut entries[chosen[group[k]]];
-                let old = if pilot { &mut e.pilot } else { &mut e.cell };
-                let key = crate::run::cell::CellKey { reps: 2 * reps, ..old.key.clone() };
-                let mut head = old.clone();
-                head.blocks = regroup(&old.blocks, reps, 2 * reps);
-                let all: Vec<CellResult> = std::iter::once(head).chain(new).collect();
-                *old = merge_blocks(key, &all);
-            }
+        let mut parts: Vec<Vec<CellResult>> = vec![Vec::new(); group.len()];
+        run_group_at(plan, bi, budget, 2 * reps, &cells, |k, _, part| {
+            parts[k].push(part);
+            Ok(())
+        })?;
+        for (k, new) in parts.into_iter().enumerate() {
+            let old = &mut entries[chosen[group[k]]].cell;
+            let key = crate::run::cell::CellKey { reps: 2 * reps, ..old.key.clone() };
+            let mut head = old.clone();
+            head.blocks = regroup(&old.blocks, reps, 2 * reps);
+            let all: Vec<CellResult> = std::iter::once(head).chain(new).collect();
+            *old = merge_blocks(key, &all);
         }
         for b in group {
             done[b] = true;

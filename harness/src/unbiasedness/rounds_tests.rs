@@ -57,13 +57,14 @@ fn looks_at_their_share_of_alpha_keep_the_false_flags_under_continuous_monitorin
 }
 
 #[test]
-fn first_rounds_are_a_quarter_in_whole_steps_and_at_least_the_minimum() {
+fn first_rounds_are_an_eighth_in_whole_steps_and_at_least_the_minimum() {
     assert_eq!(first_round(256), MIN_FIRST_REPS);
-    assert_eq!(first_round(512), 128);
-    assert_eq!(first_round(1500), 384);
-    assert_eq!(first_round(16_384), 4096);
+    assert_eq!(first_round(512), 64);
+    assert_eq!(first_round(1024), 128);
+    assert_eq!(first_round(1500), 192);
+    assert_eq!(first_round(16_384), 2048);
     assert_eq!(first_round(2), MIN_FIRST_REPS);
-    assert_eq!(first_round(720), 192, "180 rounded up to six steps of 32");
+    assert_eq!(first_round(720), 96, "90 rounded up to three steps of 32");
     assert!([100, 1000, 4097, 720].iter().all(|&r| first_round(r).is_multiple_of(FIRST_ROUND_STEP)));
     assert!(FIRST_ROUND_STEP.is_multiple_of(REP_BLOCK) && FIRST_ROUND_STEP.is_multiple_of(MAX_REP_BLOCKS));
 }
@@ -89,9 +90,9 @@ fn a_row_stays_open_only_while_another_look_could_decide_it() {
     assert!(!stays_open(&combined("pass", None), 64, 1, true, false));
     assert!(!stays_open(&combined("biased", None), 64, 1, true, false));
     assert!(!stays_open(&combined("inconclusive", None), 64, 1, true, false), "no repetitions resolve it");
-    // At look 5 of 6 with 512 repetitions, one more look reaches 1024.
-    assert!(stays_open(&combined("inconclusive", Some(1024.0)), 512, 5, true, false));
-    assert!(!stays_open(&combined("inconclusive", Some(1025.0)), 512, 5, true, false), "beyond the last look");
+    // At the look before the last with 512 repetitions, one more look reaches 1024.
+    assert!(stays_open(&combined("inconclusive", Some(1024.0)), 512, LOOKS - 1, true, false));
+    assert!(!stays_open(&combined("inconclusive", Some(1025.0)), 512, LOOKS - 1, true, false), "beyond the last look");
 }
 
 #[test]
@@ -104,11 +105,15 @@ fn a_control_grows_past_a_pass_until_flagged() {
 }
 
 #[test]
-fn a_row_without_a_valid_test_stays_open_while_looks_remain() {
-    assert!(stays_open(&untested(None), 64, 1, true, false));
-    assert!(stays_open(&untested(Some(1e9)), 64, LOOKS - 1, true, false), "skewness may fall faster than estimated");
-    assert!(!stays_open(&untested(None), 64, LOOKS, true, false), "no look left");
-    assert!(!stays_open(&untested(None), 64, 1, false, false), "a row that cannot pass");
+fn a_row_without_a_valid_test_stays_open_only_while_a_look_could_test_it() {
+    // From 64 repetitions at look 1, the last look reaches 64 x 2^(LOOKS - 1).
+    let last = (64u64 << (LOOKS - 1)) as f64;
+    assert!(stays_open(&untested(Some(last)), 64, 1, true, false), "the skewness limit within reach");
+    assert!(!stays_open(&untested(Some(last + 1.0)), 64, 1, true, false), "too skewed for any look");
+    assert!(!stays_open(&untested(Some(1e9)), 64, LOOKS - 1, true, false));
+    assert!(!stays_open(&untested(None), 64, 1, true, false), "no estimate");
+    assert!(!stays_open(&untested(Some(128.0)), 64, LOOKS, true, false), "no look left");
+    assert!(!stays_open(&untested(Some(128.0)), 64, 1, false, false), "a row that cannot pass");
 }
 
 #[test]
@@ -160,7 +165,6 @@ fn grown(registry: &Registry, reps: usize, rounds: usize, threads: usize) -> Vec
         .zip(&pilots.cells)
         .map(|((bi, ei, c), (_, _, p))| Entry {
             plan: &plan,
-            pilot_plan: &pilot_plan,
             bi: *bi,
             ei: *ei,
             fixed: reps,
@@ -179,6 +183,13 @@ fn grown(registry: &Registry, reps: usize, rounds: usize, threads: usize) -> Vec
     })
     .expect("grow");
     assert_eq!(ran, rounds);
+    // The pilots stay at their first round: a doubling costs the cell's repetitions alone.
+    for ((e, (_, _, p)), (_, _, c)) in entries.iter().zip(&pilots.cells).zip(&cells.cells) {
+        assert_eq!((&e.pilot.key, &e.pilot.rep_dev), (&p.key, &p.rep_dev), "the pilot is not grown");
+        let unit = (c.moments.len() as u64) * c.key.budget.amount;
+        assert_eq!(e.spent(), ((reps << rounds) + reps) as u64 * unit);
+        assert_eq!(e.doubling(), (reps << rounds) as u64 * unit);
+    }
     entries.into_iter().map(|e| e.cell).collect()
 }
 
@@ -219,7 +230,6 @@ fn open_rows<'a>(plan: &'a Plan, run: &crate::run::runner::RunResults) -> Vec<En
         .iter()
         .map(|(bi, ei, c)| Entry {
             plan,
-            pilot_plan: plan,
             bi: *bi,
             ei: *ei,
             fixed: 64,
@@ -245,7 +255,7 @@ fn the_budget_stops_the_rounds() {
     let mut entries = open_rows(&plan, &run);
     let first: u64 = entries.iter().map(Entry::spent).sum();
     // Room for one row's doubling only: the cheaper (or the first of equals) grows, once.
-    let room = first + entries[0].spent();
+    let room = first + entries[0].doubling();
     let ran = grow(&mut entries, room, 1, |_| Ok(())).expect("grow");
     assert_eq!(ran, 1);
     assert_eq!(entries.iter().map(|e| e.cell.key.reps).collect::<Vec<_>>(), vec![128, 64]);
@@ -265,7 +275,7 @@ fn rows_within_reach_of_a_decision_grow_before_the_others() {
     // The second row would be resolved by one doubling, the first has no estimate.
     entries[1].needed = Some(128.0);
     let first: u64 = entries.iter().map(Entry::spent).sum();
-    let room = first + entries[0].spent() + entries[1].spent();
+    let room = first + entries[0].doubling() + entries[1].doubling();
     let mut order = Vec::new();
     let ran = grow(&mut entries, room, 1, |e| {
         order.push(e.ei);

@@ -187,11 +187,10 @@ pub fn preflight(registry: &Registry, first: &Sweep, cells: &Path) -> Result<()>
     Ok(())
 }
 
-/// One plan of a part as it ran: its plan, its plan on the pilot seed, their cells and the
-/// part's fixed-mode repetitions.
+/// One plan of a part as it ran: its plan, its cells, its pilot cells (the plan on the pilot
+/// seed) and the part's fixed-mode repetitions.
 struct Ran {
     plan: Plan,
-    pilot_plan: Plan,
     run: RunResults,
     pilot: RunResults,
     fixed: usize,
@@ -224,7 +223,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
                     report.labels.push((e.name.clone(), e.entry.label.to_string()));
                 }
             }
-            ran.push(Ran { plan: p, pilot_plan, run: r, pilot, fixed });
+            ran.push(Ran { plan: p, run: r, pilot, fixed });
         }
         others.push((invalid, ran));
         notes.push(format!("{label} {:.1} s", t0.elapsed().as_secs_f64()));
@@ -244,12 +243,14 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
             all
         }
         Repetitions::Rounds { fixed_reps } => {
-            let first = (&first_pilot_plan, &first_pilot, fixed_reps);
+            let first = (&first_pilot, fixed_reps);
             in_rounds(plan, run, first, others, report, registry, &mut notes)?
         }
     };
+    let pilot_size =
+        if plan.sweep.repetitions.is_fixed() { "as many repetitions" } else { "its first round's repetitions" };
     report.meta.notes.push(format!(
-        "unbiasedness parts (each with a pilot of as many repetitions on seed {}): {}",
+        "unbiasedness parts (each with a pilot of {pilot_size} on seed {}): {}",
         pilot_seed(plan.sweep.seed),
         notes.join(", ")
     ));
@@ -261,22 +262,22 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
 }
 
 /// The rounds mode ([`rounds`]): every row of every part from its first round (`first`: the first
-/// part's pilot plan, pilot cells and fixed-mode repetitions), grown until decided or the budget is
+/// part's pilot cells and fixed-mode repetitions), grown until decided or the budget is
 /// spent; the table in the fixed mode's order, the report's summary rows and tests the rows' last
 /// looks.
 fn in_rounds(
     plan: &Plan,
     run: &RunResults,
-    first: (&Plan, &RunResults, usize),
+    first: (&RunResults, usize),
     others: Vec<PartRun>,
     report: &mut RunReport,
     registry: &Registry,
     notes: &mut Vec<String>,
 ) -> Result<Vec<Row>> {
     let alpha = rounds::look_alpha();
-    let (first_pilot_plan, first_pilot, first_fixed) = first;
+    let (first_pilot, first_fixed) = first;
     let mut entries = Vec::new();
-    push_entries(&mut entries, (plan, first_pilot_plan), &run.cells, &first_pilot.cells, first_fixed);
+    push_entries(&mut entries, plan, &run.cells, &first_pilot.cells, first_fixed);
     let mut others = others;
     let invalids: Vec<Vec<Row>> = others.iter_mut().map(|(invalid, _)| std::mem::take(invalid)).collect();
     // Each part's rows that could not run go before the entry at this index, as in the fixed mode.
@@ -284,7 +285,7 @@ fn in_rounds(
     for ((_, ran), invalid) in others.iter().zip(invalids) {
         invalid_before.push((entries.len(), invalid));
         for r in ran {
-            push_entries(&mut entries, (&r.plan, &r.pilot_plan), &r.run.cells, &r.pilot.cells, r.fixed);
+            push_entries(&mut entries, &r.plan, &r.run.cells, &r.pilot.cells, r.fixed);
         }
     }
     // A look: the entry's tests at the level of a look, whether it stays open, what it needs.
@@ -339,7 +340,7 @@ fn in_rounds(
 /// The entries of one plan's cells and their pilots, at their first round.
 fn push_entries<'p>(
     entries: &mut Vec<Entry<'p>>,
-    (plan, pilot_plan): (&'p Plan, &'p Plan),
+    plan: &'p Plan,
     cells: &[(usize, usize, CellResult)],
     pilots: &[(usize, usize, CellResult)],
     fixed: usize,
@@ -347,7 +348,6 @@ fn push_entries<'p>(
     for ((bi, ei, cell), (_, _, pilot)) in cells.iter().zip(pilots) {
         entries.push(Entry {
             plan,
-            pilot_plan,
             bi: *bi,
             ei: *ei,
             fixed,
