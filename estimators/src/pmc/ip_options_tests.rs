@@ -1,7 +1,7 @@
 //! Tests of PMC-IP's options (paper 003 §4.2, §4.4): the kernel weights under `allocate` and
 //! `luminance_scale`, and the sub-image combinations on an image whose noise is spatially
-//! coherent, as in a rendered image (their unbiasedness is tested with the sampler's, in
-//! `ip_tests.rs`).
+//! coherent, as in a rendered image, and the bias of each combination on a small checker (their
+//! unbiasedness on exact integrals is tested with the sampler's, in `ip_tests.rs`).
 
 use super::tests::{build, moments};
 use super::*;
