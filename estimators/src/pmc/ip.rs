@@ -30,7 +30,9 @@
 //! Options beyond the paper's defaults (each default is the behaviour above):
 //! - `combine` ([`Combine`], [`super::sub_images`]): how the sub-images are combined: `fixed`
 //!   (the shares above), `unweighted` (the paper's literal average, §4.4) or `inverse_variance`
-//!   (per-pixel weights from each sub-image's variance, committed before it is drawn);
+//!   (per-pixel weights from each sub-image's variance, committed before it is drawn); `pooled`
+//!   (the plain mean of every sample of the pixel, the per-sample reading of §4.4: its weights
+//!   are the realised counts, which depend on the earlier samples, so it may be biased);
 //! - `allocate` ([`Allocate`]): what the kernel weights follow, `variance` (§4.2:
 //!   `sigma_p^2 / tvi(L_p)`) or `std_dev` (`sigma_p / sqrt(tvi(L_p))`: the allocation that
 //!   minimises `Err = mean sigma_p^2 / (n_p tvi(L_p))` for a fixed total, by Lagrange
@@ -45,7 +47,7 @@
 //! estimated by Horvitz-Thompson).
 
 pub use super::sub_images::Combine;
-use super::sub_images::{neighbours, SubImageWeights};
+use super::sub_images::{neighbours, pooled_mean, SubImageWeights};
 use mcbench_core::budget::BudgetKind;
 use mcbench_core::entry::{Checks, EstimatorEntry};
 use mcbench_core::error::{ConfigError, EstimateError};
@@ -89,7 +91,8 @@ pub struct PmcIpParams {
     /// Samples reserved for every pixel in every iteration (0 to 1024).
     pub min_samples: usize,
     /// How the sub-images are combined (paper 003 §4.4): `fixed` (each its share of the planned
-    /// budget), `unweighted` (the paper's average) or `inverse_variance`.
+    /// budget), `unweighted` (the paper's average), `inverse_variance` or `pooled` (the mean of
+    /// every sample of the pixel; may be biased).
     pub combine: Combine,
     /// What the kernel weights follow (§4.2): `variance` (`sigma^2 / tvi(L)`) or `std_dev`
     /// (`sigma / sqrt(tvi(L))`).
@@ -280,7 +283,9 @@ impl PmcIp {
             let mut kernel = Vec::with_capacity(pixels);
             for (p, probe) in probes.iter().enumerate() {
                 let sum = sample_pixel(probe, a.counts[p], &mut stats[p], rng);
-                let sub = if a.guaranteed[p] {
+                let sub = if self.combine == Combine::Pooled {
+                    pooled_mean(sum, a.counts[p])
+                } else if a.guaranteed[p] {
                     sum / a.counts[p] as f64
                 } else {
                     trace.horvitz_thompson += 1;
@@ -291,6 +296,12 @@ impl PmcIp {
             }
             trace.alpha.push(kernel);
             trace.counts.push(a.counts);
+        }
+        if self.combine == Combine::Pooled {
+            // The weights were the realised counts: normalise by each pixel's total.
+            for (e, m) in trace.estimate.iter_mut().zip(&stats) {
+                *e = *e / m.count() as f64;
+            }
         }
         trace
     }

@@ -1,6 +1,6 @@
 //! Tests of the image-plane samplers (paper 003 §4): the kernel's chi-square, unbiasedness of
 //! `uniform_image` and `pmc_ip` beside biased controls that must be flagged (the threshold-stopping
-//! sampler of §2, and PMC-IP with every sample of a pixel pooled, the combination `pmc_ip` avoids),
+//! sampler of §2, and PMC-IP with every sample of a pixel pooled, `combine = "pooled"`),
 //! on a synthetic image with exact pixel integrals and on a small `checker-image`, and the
 //! stability cases (a zero pixel, a pixel 1e6 times brighter than the others).
 
@@ -82,8 +82,8 @@ impl ImagePlaneScene for Synthetic {
     }
 }
 
-/// PMC-IP with every sample of a pixel pooled (`sum f / n` over all iterations): the natural
-/// implementation, biased because later counts depend on the earlier samples of the same pixel.
+/// PMC-IP with every sample of a pixel pooled (`sum f / n` over all iterations), written
+/// directly: the reference for `combine = "pooled"`.
 struct Pooled(PmcIp);
 
 impl Estimator for Pooled {
@@ -99,8 +99,9 @@ impl Estimator for Pooled {
             sums[k] += sample_pixel(probe, self.0.initial as usize, &mut stats[k], rng);
         }
         let rest = (spp - self.0.initial) as usize * p;
-        for _ in 0..self.0.iterations {
-            let a = self.0.allocate(&self.0.weights(&stats), rest / self.0.iterations, rng);
+        let it = self.0.iterations;
+        for t in 0..it {
+            let a = self.0.allocate(&self.0.weights(&stats), rest / it + usize::from(t < rest % it), rng);
             for (k, probe) in probes.iter().enumerate() {
                 sums[k] += sample_pixel(probe, a.counts[k], &mut stats[k], rng);
             }
@@ -176,10 +177,38 @@ fn pmc_ip_is_unbiased_on_exact_pixel_integrals_and_the_controls_are_flagged() {
     let p = min_holm_exact(&bed, &moments(&bed, threshold.as_ref(), "threshold", 10, reps));
     eprintln!("threshold_image: smallest Holm-adjusted p {p:.3e}");
     assert!(p < 1e-6, "the threshold-stopping control is not flagged: {p:e}");
-    let pooled = Pooled(PmcIp::from_params(&Params::new()).unwrap());
-    let p = min_holm_exact(&bed, &moments(&bed, &pooled, "pooled", 10, reps));
-    eprintln!("pooled PMC-IP: smallest Holm-adjusted p {p:.3e}");
+    let pooled = build("pmc_ip", text("combine", "pooled"));
+    let p = min_holm_exact(&bed, &moments(&bed, pooled.as_ref(), "pooled", 10, reps));
+    eprintln!("pmc_ip[combine=pooled]: smallest Holm-adjusted p {p:.3e}");
     assert!(p < 1e-6, "pooling every sample of a pixel is not flagged: {p:e}");
+}
+
+/// `combine = "pooled"` is the plain mean of every sample of each pixel: the same images as the
+/// direct per-sample mean (same random stream, same allocations), to rounding, at budgets that
+/// split evenly and unevenly over the iterations.
+#[test]
+fn pooled_is_the_per_sample_mean() {
+    let bed = Synthetic::new(false);
+    let mut differs = false;
+    // 16 pixels: 3 iterations at 10 spp share 128 samples as 43 + 43 + 42.
+    for (spp, rep, iterations) in [(10u64, 0u64, 2.0), (10, 1, 2.0), (16, 2, 2.0), (10, 3, 3.0)] {
+        let mut params = Params::new().with("iterations", iterations);
+        let direct = Pooled(PmcIp::from_params(&params).unwrap());
+        let fixed = build("pmc_ip", params.clone());
+        params.0.insert("combine".into(), mcbench_core::params::ParamValue::Text("pooled".into()));
+        let pooled = build("pmc_ip", params);
+        let run = |est: &dyn Estimator| {
+            let tasks: Vec<Task<'_>> =
+                (0..bed.integrals()).map(|i| Task::new(&bed, i, Budget::samples(spp).unwrap())).collect();
+            est.estimate_sequence(&tasks, &mut stream(rep, "pooled")).unwrap()
+        };
+        let (a, b, f) = (run(pooled.as_ref()), run(&direct), run(fixed.as_ref()));
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x[0] - y[0]).abs() <= 1e-12 * y[0].abs().max(1.0), "{spp} spp: {x:?} vs {y:?}");
+        }
+        differs |= a.iter().zip(&f).any(|(x, y)| (x[0] - y[0]).abs() > 1e-9);
+    }
+    assert!(differs, "pooled gives the fixed shares' images");
 }
 
 /// The paper's allocation without the reserved sample (`min_samples = 0`): starved pixels are

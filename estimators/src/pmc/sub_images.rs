@@ -28,8 +28,17 @@
 //!   luminance had the mean variance and mean of its (up to 8) neighbours' initial samples,
 //!   normalised against the other pixels' own weights. Pixel `p`'s initial samples enter none of that, so the initial weight is independent
 //!   of the initial sub-image it weights.
+//! - [`Combine::Pooled`]: the plain mean of every sample a pixel received, over the initial image
+//!   and all iterations: sub-image `t` weighs `n_t(p) / sum_s n_s(p)`, its *realised* count,
+//!   known only at the end. This is the other reading of §4.4 ("it is not clear that the samples
+//!   from one iteration are any better than those from another" fits a per-sample average as
+//!   well as an average of sub-images), and it escapes the unweighted average's bound. It breaks
+//!   the rule above: the later counts depend on the pixel's earlier samples (through
+//!   `sigma_p^2`), so the initial image's weight is correlated with its value and the estimate may
+//!   be biased. Nothing corrects that; the unbiasedness tests measure it.
 
 use super::ip::{Allocation, PmcIp};
+use mcbench_core::math::Rgb;
 use mcbench_core::stats::Moments;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
@@ -47,6 +56,10 @@ pub enum Combine {
     /// Per-pixel weights proportional to each sub-image's expected count, committed before it is
     /// drawn; the initial image's from its neighbours' samples.
     InverseVariance,
+    /// The plain mean of every sample of the pixel (weights `n_t(p) / sum_s n_s(p)`, known only
+    /// at the end): the per-sample reading of §4.4, which may be biased (the later counts depend
+    /// on the earlier samples).
+    Pooled,
 }
 
 /// The weights of the sub-images of one run, committed one sub-image at a time.
@@ -105,9 +118,13 @@ impl SubImageWeights {
 
     /// The weights of the initial image, given every pixel's statistics after it and each pixel's
     /// neighbours (indices into `stats`).
+    ///
+    /// Under [`Combine::Pooled`] the weights are the counts `s0`, not yet normalised: see
+    /// [`SubImageWeights::population`].
     pub fn initial(&mut self, ip: &PmcIp, stats: &[Moments], neighbours: &[Vec<usize>]) -> Vec<f64> {
         let iterations = self.populations.len();
         match self.combine {
+            Combine::Pooled => vec![self.s0 as f64; self.pixels()],
             Combine::Fixed => vec![(self.s0 * self.pixels()) as f64 / self.total as f64; self.pixels()],
             Combine::Unweighted => vec![1.0 / (iterations + 1) as f64; self.pixels()],
             Combine::InverseVariance => {
@@ -136,9 +153,14 @@ impl SubImageWeights {
 
     /// The weights of the sub-image of adaptive iteration `t`, drawn with kernel weights `alpha`
     /// and allocation `a`.
+    ///
+    /// Under [`Combine::Pooled`] they are the realised counts `n_t(p)`, not normalised: the run
+    /// adds `n_t(p)` times the sub-image (the mean of its samples, [`pooled_mean`]) and divides
+    /// each pixel by its total count at the end.
     pub fn population(&mut self, t: usize, alpha: &[f64], a: &Allocation) -> Vec<f64> {
         let iterations = self.populations.len();
         match self.combine {
+            Combine::Pooled => a.counts.iter().map(|&n| n as f64).collect(),
             Combine::Fixed => vec![self.populations[t] as f64 / self.total as f64; self.pixels()],
             Combine::Unweighted => vec![1.0 / (iterations + 1) as f64; self.pixels()],
             Combine::InverseVariance => (0..self.pixels())
@@ -148,6 +170,16 @@ impl SubImageWeights {
                 })
                 .collect(),
         }
+    }
+}
+
+/// The mean of `count` samples whose sum is `sum` (0 without samples): a sub-image under
+/// [`Combine::Pooled`], whatever the allocation guarantees.
+pub fn pooled_mean(sum: Rgb, count: usize) -> Rgb {
+    if count > 0 {
+        sum / count as f64
+    } else {
+        Rgb::ZERO
     }
 }
 
