@@ -94,7 +94,7 @@ pub enum Transport {
 
 /// The albedo factor of a collision (deterministic weight, then Russian roulette); `None` when
 /// the path is absorbed.
-fn albedo_factor<R: Rng + ?Sized>(albedo: f64, throughput: &mut f64, rng: &mut R) -> Option<f64> {
+pub fn albedo_factor<R: Rng + ?Sized>(albedo: f64, throughput: &mut f64, rng: &mut R) -> Option<f64> {
     if albedo <= 0.0 {
         return None;
     }

@@ -3,13 +3,12 @@
 //! coherent, as in a rendered image, and the bias of each combination on a small checker (their
 //! unbiasedness on exact integrals is tested with the sampler's, in `ip_tests.rs`).
 
-use super::tests::{build, moments};
+use super::tests::{build, moments, smallest_holm_welch};
 use super::*;
 use crate::testbeds::checker_image::CheckerImage;
 use mcbench_core::budget::Budget;
 use mcbench_core::params::{ParamValue, Params};
 use mcbench_core::rng::StreamKey;
-use mcbench_core::stats::{holm_bonferroni, welch};
 use mcbench_core::testbed::{ImagePlaneScene, Needs, Reference, ReferenceKind, TestBed};
 
 fn with_text(name: &str, v: &str) -> Params {
@@ -169,18 +168,7 @@ fn combinations_bias_on_the_checker() {
         let (px, img) = image_runs(&bed, est.as_ref(), combine, spp, reps);
         let rel = (img.mean() - base.mean()) / base.mean();
         let se = img.std_err().hypot(base.std_err()) / base.mean();
-        let ps: Vec<f64> = px
-            .iter()
-            .zip(&base_px)
-            .map(|(a, b)| {
-                if a.std_err() == 0.0 && b.std_err() == 0.0 {
-                    f64::from(u8::from(a.mean() == b.mean()))
-                } else {
-                    welch(a.mean(), a.std_err(), a.count(), b.mean(), b.std_err(), b.count()).p_value
-                }
-            })
-            .collect();
-        let p = holm_bonferroni(&ps).into_iter().fold(1.0, f64::min);
+        let p = smallest_holm_welch(&px, &base_px);
         eprintln!("checker-image/default 16x16, {spp} spp, {reps} runs: {combine}: relative bias {rel:+.5} +- {se:.5}, smallest Holm-adjusted p {p:.3e}");
         (rel, se, p)
     };

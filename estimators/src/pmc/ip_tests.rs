@@ -144,6 +144,23 @@ fn min_holm_exact(bed: &dyn TestBed, m: &[Moments]) -> f64 {
     holm_bonferroni(&ps).into_iter().fold(1.0, f64::min)
 }
 
+/// The smallest Holm-adjusted p of per-pixel Welch tests of `m` against `base` (two pixels with
+/// no spread compare equal means exactly).
+pub(super) fn smallest_holm_welch(m: &[Moments], base: &[Moments]) -> f64 {
+    let ps: Vec<f64> = m
+        .iter()
+        .zip(base)
+        .map(|(a, b)| {
+            if a.std_err() == 0.0 && b.std_err() == 0.0 {
+                f64::from(u8::from(a.mean() == b.mean()))
+            } else {
+                welch(a.mean(), a.std_err(), a.count(), b.mean(), b.std_err(), b.count()).p_value
+            }
+        })
+        .collect();
+    holm_bonferroni(&ps).into_iter().fold(1.0, f64::min)
+}
+
 pub(super) fn build(id: &str, params: Params) -> Box<dyn Estimator> {
     (builtins::estimator(id).unwrap().build)(&params).unwrap()
 }
@@ -248,20 +265,7 @@ fn pmc_ip_agrees_with_uniform_sampling_on_checker_image() {
     let bed = CheckerImage::without_reference("occluded", &params).unwrap();
     let reps = 300;
     let base = moments(&bed, build("uniform_image", Params::new()).as_ref(), "uniform_image", 10, reps);
-    let holm = |m: &[Moments]| {
-        let ps: Vec<f64> = m
-            .iter()
-            .zip(&base)
-            .map(|(a, b)| {
-                if a.std_err() == 0.0 && b.std_err() == 0.0 {
-                    f64::from(u8::from(a.mean() == b.mean()))
-                } else {
-                    welch(a.mean(), a.std_err(), a.count(), b.mean(), b.std_err(), b.count()).p_value
-                }
-            })
-            .collect();
-        holm_bonferroni(&ps).into_iter().fold(1.0, f64::min)
-    };
+    let holm = |m: &[Moments]| smallest_holm_welch(m, &base);
     let p = holm(&moments(&bed, build("pmc_ip", Params::new()).as_ref(), "pmc_ip", 10, reps));
     eprintln!("checker-image 8x8: pmc_ip vs uniform_image, smallest Holm-adjusted p {p:.3e}");
     assert!(p > 1e-3, "pmc_ip differs from uniform sampling: {p:e}");

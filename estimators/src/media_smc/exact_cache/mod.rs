@@ -15,7 +15,8 @@
 //! `p` is the cache's own importance sampling with the exact radiance (`is1`): proportional to the
 //! luminance of `L(x', w)` over the direction cells at the node `x'` nearest `x`, mixed with
 //! [`DEFENSIVE`] of the uniform density. The camera ray's pass-or-collide choice, absorption weights
-//! and Russian roulette are those of [`crate::media_smc::walk`]; rays count one per flight.
+//! and Russian roulette are those of [`crate::media_smc::walk`] ([`albedo_factor`]); rays count one
+//! per flight.
 //!
 //! The exact-cache value is therefore a limit only for the estimators whose importance sampling
 //! follows the cache (a converged cache gives exactly this `p`): a different `p` changes the
@@ -24,7 +25,7 @@
 
 pub mod field;
 
-use crate::media_smc::walk::ANALOG_BELOW;
+use crate::media_smc::walk::albedo_factor;
 use field::{direction, exit_distance, Field};
 use mcbench_core::math::{Rgb, Vec3};
 use rand::Rng;
@@ -124,18 +125,6 @@ impl<'f> ExactCache<'f> {
         }
         (radiance, flights)
     }
-}
-
-/// The albedo weight of a collision, then Russian roulette below [`ANALOG_BELOW`] (as the walks).
-fn albedo_factor<R: Rng + ?Sized>(albedo: f64, throughput: &mut f64, rng: &mut R) -> Option<f64> {
-    if albedo <= 0.0 {
-        return None;
-    }
-    if *throughput >= ANALOG_BELOW {
-        *throughput *= albedo;
-        return Some(albedo);
-    }
-    (rng.gen::<f64>() < albedo).then_some(1.0)
 }
 
 /// One path of the independent path tracer (`is0_cv0` on a medium: free flights, isotropic
