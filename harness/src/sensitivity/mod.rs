@@ -71,9 +71,9 @@ pub struct PartMode {
     pub budgets: Vec<u64>,
 }
 
-/// A measured limit of a claim computed at every setting from the run (`ceiling = "...`" in a
-/// part, for history): it is what the claim's estimator achieved, not a bound, so the result
-/// files call it `best_measured` and it never decides that a claim cannot hold.
+/// A measured limit of a claim computed at every setting from the run (`ceiling = "work_ratio"`
+/// in a part; the key keeps its name): it is what the claim's estimator achieved, not a bound, so
+/// the result files call it `best_measured` and it never decides that a claim cannot hold.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Ceiling {
