@@ -57,13 +57,18 @@ def write_reference(folder, truth):
     np.save(os.path.join(folder, "ref_var.npy"), var)
 
 
+def manifest_head(name):
+    """The manifest's first lines: the experiment name and the reference image with its variance."""
+    return [f'name = "{name}"', "", "[reference]", 'image = "ref.npy"', 'variance = "ref_var.npy"',
+            f"samples = {REFERENCE_SAMPLES}"]
+
+
 def images(out, rng, name):
     folder = os.path.join(out, "images")
     os.makedirs(folder, exist_ok=True)
     truth = truth_image()
     write_reference(folder, truth)
-    lines = [f'name = "{name}"', "", "[reference]", 'image = "ref.npy"', 'variance = "ref_var.npy"',
-             f"samples = {REFERENCE_SAMPLES}"]
+    lines = manifest_head(name)
     for est, bias_word, bias in ESTIMATORS:
         lines += ["", "[[estimators]]", f'id = "{est}"', f'bias = "{bias_word}"']
         for spp in BUDGETS:
@@ -94,8 +99,7 @@ def scalars(out, rng, name):
     os.makedirs(folder, exist_ok=True)
     truth = np.array([[1.0, 2.0, 0.5, 3.0]])  # one row of four integrals
     write_reference(folder, truth)
-    lines = [f'name = "{name}"', "", "[reference]", 'image = "ref.npy"', 'variance = "ref_var.npy"',
-             f"samples = {REFERENCE_SAMPLES}"]
+    lines = manifest_head(name)
     for est, bias_word, bias in ESTIMATORS:
         lines += ["", "[[estimators]]", f'id = "{est}"', f'bias = "{bias_word}"']
         for spp in BUDGETS:

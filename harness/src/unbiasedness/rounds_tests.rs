@@ -145,20 +145,19 @@ fn small_plan(registry: &Registry, reps: usize, seed: u64) -> Plan {
     Plan::prepare(sweep, registry).expect("plan")
 }
 
+/// The cells of `plan` on `threads` threads, stored nowhere.
+fn run_silently(plan: &Plan, threads: usize) -> crate::run::runner::RunResults {
+    let opts =
+        crate::run::runner::RunOptions { threads: Some(threads), store: None, observer: &crate::run::runner::Silent };
+    crate::run::runner::run(plan, &opts).expect("run")
+}
+
 /// Grows the cells of a plan at `reps` for `rounds` rounds on `threads` threads (every row kept
 /// open), returning the grown cells.
 fn grown(registry: &Registry, reps: usize, rounds: usize, threads: usize) -> Vec<CellResult> {
     let (plan, pilot_plan) = (small_plan(registry, reps, 1), small_plan(registry, reps, 2));
-    let cells = crate::run::runner::run(
-        &plan,
-        &crate::run::runner::RunOptions { threads: Some(threads), store: None, observer: &crate::run::runner::Silent },
-    )
-    .expect("run");
-    let pilots = crate::run::runner::run(
-        &pilot_plan,
-        &crate::run::runner::RunOptions { threads: Some(threads), store: None, observer: &crate::run::runner::Silent },
-    )
-    .expect("pilot");
+    let cells = run_silently(&plan, threads);
+    let pilots = run_silently(&pilot_plan, threads);
     let mut entries: Vec<Entry<'_>> = cells
         .cells
         .iter()
@@ -199,11 +198,7 @@ fn a_grown_cell_is_the_cell_run_whole_at_its_repetitions_whatever_the_threads() 
     let one = grown(&registry, 32, 2, 1);
     let two = grown(&registry, 32, 2, 2);
     let whole = small_plan(&registry, 128, 1);
-    let run = crate::run::runner::run(
-        &whole,
-        &crate::run::runner::RunOptions { threads: Some(2), store: None, observer: &crate::run::runner::Silent },
-    )
-    .expect("whole");
+    let run = run_silently(&whole, 2);
     assert_eq!(one.len(), 2);
     for ((a, b), (_, _, w)) in one.iter().zip(&two).zip(&run.cells) {
         assert_eq!(a.key, w.key, "keyed as a cell of 128 repetitions");
@@ -247,11 +242,7 @@ fn open_rows<'a>(plan: &'a Plan, run: &crate::run::runner::RunResults) -> Vec<En
 fn the_budget_stops_the_rounds() {
     let registry = Registry::new().with_catalog(mcbench_papers::catalog());
     let plan = small_plan(&registry, 64, 1);
-    let run = crate::run::runner::run(
-        &plan,
-        &crate::run::runner::RunOptions { threads: Some(1), store: None, observer: &crate::run::runner::Silent },
-    )
-    .expect("run");
+    let run = run_silently(&plan, 1);
     let mut entries = open_rows(&plan, &run);
     let first: u64 = entries.iter().map(Entry::spent).sum();
     // Room for one row's doubling only: the cheaper (or the first of equals) grows, once.
@@ -266,11 +257,7 @@ fn the_budget_stops_the_rounds() {
 fn rows_within_reach_of_a_decision_grow_before_the_others() {
     let registry = Registry::new().with_catalog(mcbench_papers::catalog());
     let plan = small_plan(&registry, 64, 1);
-    let run = crate::run::runner::run(
-        &plan,
-        &crate::run::runner::RunOptions { threads: Some(1), store: None, observer: &crate::run::runner::Silent },
-    )
-    .expect("run");
+    let run = run_silently(&plan, 1);
     let mut entries = open_rows(&plan, &run);
     // The second row would be resolved by one doubling, the first has no estimate.
     entries[1].needed = Some(128.0);
