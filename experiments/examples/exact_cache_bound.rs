@@ -65,6 +65,7 @@ fn main() {
         let field = Field::solve(scene, FIELD);
         let (z, rel) = against_reference(&field, sigma_t);
         let c = Limits::measure(&field, SIDE, PATHS, SEED);
+        let (limit, bound) = (c.work_ratio(), c.family_bound(&field, SIDE));
         println!(
             "{sigma_t:<8} {:<7} {z:<18.2} {rel:<8.4} {:<10.5} {:<11.4} {:<10.5} {:<11.4} {:<12.3} {:.3}",
             field.sweeps,
@@ -72,8 +73,8 @@ fn main() {
             c.independent.rays,
             c.exact.mean_variance,
             c.exact.rays,
-            c.work_ratio(),
-            c.family_bound(&field, SIDE)
+            limit,
+            bound
         );
         if check {
             let fine = Field::solve(scene, FINE);
@@ -89,8 +90,8 @@ fn main() {
                 centre(&field)
             );
         }
-        limits.push(format!("{:.3}", c.work_ratio()));
-        bounds.push(format!("{:.3}", c.family_bound(&field, SIDE)));
+        limits.push(format!("{limit:.3}"));
+        bounds.push(format!("{bound:.3}"));
     }
     println!("bound.values = [{}]", bounds.join(", "));
     println!("limit.values = [{}]", limits.join(", "));
