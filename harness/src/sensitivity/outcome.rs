@@ -25,6 +25,9 @@ pub enum Outcome {
         held: Vec<String>,
         /// The verdict at our default and the paper-like setting, with values.
         elsewhere: String,
+        /// When the held settings are only where a monotone trend passes the paper's number (not
+        /// held on both sides), that trend and where it crosses: a crossing, not a range.
+        crossing: Option<String>,
     },
     /// A proven bound of the scene (the part's [`super::Bound`]) lies below the claim at every
     /// setting.
@@ -88,8 +91,9 @@ impl Outcome {
             Outcome::HeldAtPaperLike { setting, value } => {
                 format!("held at the paper-like setting {setting}: {value}")
             }
-            Outcome::HoldsWhere { held, elsewhere } => {
-                format!("holds where {}; {elsewhere}", held.join("; "))
+            Outcome::HoldsWhere { held, elsewhere, crossing } => {
+                let crossing = crossing.as_ref().map_or_else(String::new, |c| format!("; {c}"));
+                format!("holds where {}; {elsewhere}{crossing}", held.join("; "))
             }
             Outcome::CannotHold { method, best, paper } => {
                 format!("cannot hold on this scene: the ceiling ({method}) is below the paper's {paper} at every setting (largest {best})")
@@ -126,7 +130,7 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
         if let Some(r) = part.paper_like.as_ref().and_then(find) {
             elsewhere.push(format!("at the paper-like {}", at(r, &part.vary)));
         }
-        return Outcome::HoldsWhere { held, elsewhere: elsewhere.join("; ") };
+        return Outcome::HoldsWhere { held, elsewhere: elsewhere.join("; "), crossing: crossing(part, rows) };
     }
     let paper = rows.iter().find_map(|r| r.paper_value);
     let ceilings: Vec<(f64, &SettingRow)> = rows.iter().filter_map(|r| Some((r.ceiling?, *r))).collect();
@@ -173,6 +177,38 @@ pub fn classify(part: &Part, rows: &[&SettingRow]) -> Outcome {
     } else {
         Outcome::InconclusiveEverywhere { best, measured }
     }
+}
+
+/// The clause for a claim held only where a trend crosses the paper's number: every setting is a
+/// number (in increasing order) with a value, the values are strictly monotone in the setting, the
+/// held settings are one run with a setting not held on each side, and the paper's number lies
+/// between the values at its ends. Then holding there is the trend passing the number, which says
+/// nothing of a regime where the claim is true.
+fn crossing(part: &Part, rows: &[&SettingRow]) -> Option<String> {
+    let points: Vec<(f64, f64)> =
+        rows.iter().map(|r| Some((r.setting.parse::<f64>().ok()?, r.value?))).collect::<Option<_>>()?;
+    let paper = rows.iter().find_map(|r| r.paper_value)?;
+    let increasing = |f: &dyn Fn(&(f64, f64)) -> f64| points.windows(2).all(|w| f(&w[1]) > f(&w[0]));
+    if points.len() < 3 || !increasing(&|p| p.0) || !(increasing(&|p| p.1) || increasing(&|p| -p.1)) {
+        return None;
+    }
+    let held: Vec<usize> = (0..rows.len()).filter(|&i| rows[i].verdict == Verdict::Held).collect();
+    let (first, last) = (*held.first()?, *held.last()?);
+    let one_run = last - first + 1 == held.len();
+    let flanked = first > 0
+        && last + 1 < rows.len()
+        && rows[first - 1].verdict == Verdict::NotHeld
+        && rows[last + 1].verdict == Verdict::NotHeld;
+    if !one_run || !flanked {
+        return None;
+    }
+    let side = |v: f64| (v - paper).signum();
+    let pass = points.windows(2).position(|w| side(w[0].1) != side(w[1].1))?;
+    let (a, b) = (points[0], points[points.len() - 1]);
+    Some(format!(
+        "a crossing, not a range: the value moves monotonically with {} ({:.3} at {} to {:.3} at {}) and passes the paper's {paper} between {} and {}",
+        part.vary, a.1, rows[0].setting, b.1, rows[rows.len() - 1].setting, rows[pass].setting, rows[pass + 1].setting
+    ))
 }
 
 /// The best measured value as a clause of a sentence: achieved here, not a bound.

@@ -200,6 +200,41 @@ fn the_outcome_is_decided_in_order() {
 }
 
 #[test]
+fn a_claim_held_only_where_a_monotone_trend_passes_it_is_called_a_crossing() {
+    let f = file_with(("values = [1, 5]\ndefault = 5", "values = [1, 2, 4, 8]\ndefault = 8")).unwrap();
+    let p = &f.parts[0];
+    let rows = |v: [f64; 4], held: [bool; 4]| -> Vec<SettingRow> {
+        ["1", "2", "4", "8"]
+            .iter()
+            .zip(v.iter().zip(held))
+            .map(|(s, (v, h))| row(s, "", *v, if h { Verdict::Held } else { Verdict::NotHeld }, None))
+            .collect()
+    };
+    fn refs(r: &[SettingRow]) -> Vec<&SettingRow> {
+        r.iter().collect()
+    }
+    // Decreasing through the paper's 15.3, held only at 2: a crossing between 2 and 4.
+    let r = rows([20.0, 16.0, 12.0, 9.0], [false, true, false, false]);
+    let o = classify(p, &refs(&r));
+    assert!(
+        o.sentence().contains("a crossing, not a range")
+            && o.sentence().contains("passes the paper's 15.3 between 2 and 4"),
+        "{}",
+        o.sentence()
+    );
+    // Held at an end (a half-line of the trend): a range, no crossing clause.
+    let r = rows([20.0, 16.0, 12.0, 9.0], [true, true, false, false]);
+    assert!(!classify(p, &refs(&r)).sentence().contains("crossing"));
+    // Not monotone: no trend to speak of.
+    let r = rows([20.0, 16.0, 17.0, 9.0], [false, true, false, false]);
+    assert!(!classify(p, &refs(&r)).sentence().contains("crossing"));
+    // Inconclusive beside the held setting: not shown to fail on that side.
+    let mut r = rows([20.0, 16.0, 12.0, 9.0], [false, true, false, false]);
+    r[0].verdict = Verdict::Inconclusive;
+    assert!(!classify(p, &refs(&r)).sentence().contains("crossing"));
+}
+
+#[test]
 fn not_held_anywhere_needs_a_not_held_setting_and_inconclusive_everywhere_says_so() {
     let f = file_with(("", "")).unwrap();
     let p = &f.parts[0];
