@@ -66,6 +66,14 @@ pub trait Estimator: Send + Sync {
         tasks.iter().map(|t| self.estimate(t, rng)).collect()
     }
 
+    /// What this configured estimator's expectation is, when a parameter changes it from the
+    /// registry entry's `bias` (a reading of the paper that a parameter selects and that is biased,
+    /// say); `None`, the default, keeps the entry's. The unbiasedness tests judge the estimator
+    /// against this declaration.
+    fn bias(&self) -> Option<Bias> {
+        None
+    }
+
     /// Whether the estimates of one sequence's integrals are independent of each other: no state
     /// (an adaptive structure, a sample allocation, particles) carried from one task to the next,
     /// as with the default [`Estimator::estimate_sequence`]. The unbiasedness tests then count

@@ -236,7 +236,7 @@ pub fn cell_rows(plan: &Plan, run: &RunResults, report: &RunReport) -> Vec<CellR
             family,
             ratio,
             estimator: e.name.clone(),
-            claim: e.entry.bias,
+            claim: e.bias(),
             measured: Some(Measured {
                 reps: cell.key.reps,
                 rays,

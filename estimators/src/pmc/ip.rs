@@ -32,7 +32,8 @@
 //!   (the shares above), `unweighted` (the paper's literal average, §4.4) or `inverse_variance`
 //!   (per-pixel weights from each sub-image's variance, committed before it is drawn); `pooled`
 //!   (the plain mean of every sample of the pixel, the per-sample reading of §4.4: its weights
-//!   are the realised counts, which depend on the earlier samples, so it may be biased);
+//!   are the realised counts, which depend on the earlier samples, so it is biased and declared so:
+//!   the unbiasedness tests treat it as a control);
 //! - `allocate` ([`Allocate`]): what the kernel weights follow, `variance` (§4.2:
 //!   `sigma_p^2 / tvi(L_p)`) or `std_dev` (`sigma_p / sqrt(tvi(L_p))`: the allocation that
 //!   minimises `Err = mean sigma_p^2 / (n_p tvi(L_p))` for a fixed total, by Lagrange
@@ -364,6 +365,11 @@ impl Estimator for PmcIp {
             t.note("ht_share", ht);
         }
         Ok(trace.estimate)
+    }
+    /// `pooled` is declared biased (its weights are counts drawn from the earlier samples); every
+    /// other combination keeps the entry's unbiased declaration.
+    fn bias(&self) -> Option<mcbench_core::estimator::Bias> {
+        (self.combine == Combine::Pooled).then_some(mcbench_core::estimator::Bias::Biased)
     }
 }
 

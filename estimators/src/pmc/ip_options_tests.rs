@@ -98,6 +98,12 @@ fn allocation_options_change_the_kernel_weights_as_documented() {
         assert!(e.contains(bad.0), "{e}");
     }
     assert_eq!(PmcIp::from_params(&with_text("combine", "pooled")).unwrap().combine, Combine::Pooled);
+    // Only the pooled reading changes the entry's unbiased declaration.
+    use mcbench_core::estimator::{Bias, Estimator};
+    assert_eq!(PmcIp::from_params(&with_text("combine", "pooled")).unwrap().bias(), Some(Bias::Biased));
+    for kept in ["fixed", "unweighted", "inverse_variance"] {
+        assert_eq!(PmcIp::from_params(&with_text("combine", kept)).unwrap().bias(), None, "{kept}");
+    }
     assert!(PmcIp::from_params(&with_text("combine", "mean")).unwrap_err().to_string().contains("combine"));
 }
 

@@ -146,7 +146,7 @@ pub fn families_of_run(plan: &Plan, registry: &Registry) -> Vec<Family> {
                 estimator: plan.estimators[ei].spec.clone(),
                 samples: budget.amount,
                 reps: s.reps,
-                bias: plan.estimators[ei].entry.bias,
+                bias: plan.estimators[ei].bias(),
             });
         }
     }

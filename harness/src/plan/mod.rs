@@ -51,6 +51,14 @@ pub struct PreparedEstimator {
     pub params_json: String,
 }
 
+impl PreparedEstimator {
+    /// What its expectation is declared to be: the configured estimator's own declaration where its
+    /// parameters change it ([`Estimator::bias`]), else its registry entry's.
+    pub fn bias(&self) -> mcbench_core::estimator::Bias {
+        self.estimator.bias().unwrap_or(self.entry.bias)
+    }
+}
+
 /// A pair that does not run, and why.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Skipped {
@@ -247,5 +255,23 @@ mod tests {
         assert_eq!(first, again);
         let good = sweep("[[estimators]]\nid='delta_tracking'\n");
         assert_eq!(Plan::prepare(good, &registry).expect("a majorant").pairs.len(), 1);
+    }
+
+    /// A parameter that selects a biased reading changes the declaration the tests judge against;
+    /// the same estimator with its other parameters keeps its entry's.
+    #[test]
+    fn a_configured_estimator_may_declare_its_own_bias() {
+        use mcbench_core::estimator::Bias;
+        let registry = Registry::new().with_catalog(mcbench_papers::catalog());
+        let text = "name='v'\nreps=2\nbudgets=[10]\n[[testbeds]]\nid='checker-image'\nparams={resolution=48}\n\
+                    [[estimators]]\nid='pmc_ip'\n[[estimators]]\nid='pmc_ip'\nparams={combine='pooled'}\n";
+        let sweep = toml::from_str::<SweepFile>(text).unwrap().apply(None, Mode::Quick).unwrap();
+        let plan = Plan::prepare(sweep, &registry).expect("plan");
+        let declared: Vec<(String, Bias)> = plan.estimators.iter().map(|e| (e.name.clone(), e.bias())).collect();
+        assert_eq!(
+            declared,
+            vec![("pmc_ip".to_string(), Bias::Unbiased), ("pmc_ip[combine=pooled]".to_string(), Bias::Biased)]
+        );
+        assert!(plan.estimators.iter().all(|e| e.entry.bias == Bias::Unbiased), "the entry is unchanged");
     }
 }

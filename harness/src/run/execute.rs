@@ -147,7 +147,7 @@ pub fn finish(
         if Some(cell.key.budget.amount) == last_budget {
             let group = analysis::Gate::group_of(est.estimator.as_ref(), bed.bed.as_ref());
             let gate = previous_budget_gate(run, *bi, *ei, cell).map(|g| g.with_group(group));
-            tests.extend(analysis::unbiasedness(cell, reference, est.entry.bias, gate.as_ref(), sweep.tolerance()));
+            tests.extend(analysis::unbiasedness(cell, reference, est.bias(), gate.as_ref(), sweep.tolerance()));
             integrals.extend(integral_rows(cell, bed, est));
         }
     }

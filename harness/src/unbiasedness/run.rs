@@ -39,7 +39,7 @@ pub(crate) fn judge_cell(
     alpha: f64,
 ) -> (Vec<TestRow>, Option<&'static str>, bool) {
     let bed = plan.beds[bi].bed.as_ref();
-    let bias = plan.estimators[ei].entry.bias;
+    let bias = plan.estimators[ei].bias();
     let group = crate::analysis::Gate::group_of(plan.estimators[ei].estimator.as_ref(), bed);
     let gate = crate::analysis::Gate::from_cell(pilot_cell, "pilot", 1.0).with_group(group);
     let mut tests =
@@ -73,7 +73,7 @@ fn rows_of(plan: &Plan, run: &RunResults, pilot: &RunResults, report: &mut RunRe
     let mut rows = Vec::new();
     for ((bi, ei, cell), (_, _, pilot_cell)) in run.cells.iter().zip(&pilot.cells) {
         let (tests, exempt, _) = judge_cell(plan, (*bi, *ei), cell, pilot_cell, registry, UNBIASEDNESS_ALPHA);
-        rows.push(table::row_from_tests(cell, plan.estimators[*ei].entry.bias, &tests, exempt));
+        rows.push(table::row_from_tests(cell, plan.estimators[*ei].bias(), &tests, exempt));
         replace_tests(report, cell, tests);
     }
     rows
@@ -291,7 +291,7 @@ fn in_rounds(
     // A look: the entry's tests at the level of a look, whether it stays open, what it needs.
     let look = |e: &mut Entry<'_>| {
         let (tests, exempt, can_pass) = judge_cell(e.plan, (e.bi, e.ei), &e.cell, &e.pilot, registry, alpha);
-        e.control = e.plan.estimators[e.ei].entry.bias == mcbench_core::estimator::Bias::Biased && exempt.is_none();
+        e.control = e.plan.estimators[e.ei].bias() == mcbench_core::estimator::Bias::Biased && exempt.is_none();
         e.open = rounds::stays_open(&tests, e.cell.key.reps, e.looks, can_pass, e.control);
         e.needed = rounds::needed(&tests);
     };
@@ -314,7 +314,7 @@ fn in_rounds(
             rows.extend(invalid);
         }
         let (tests, exempt, _) = judge_cell(e.plan, (e.bi, e.ei), &e.cell, &e.pilot, registry, alpha);
-        let mut row = table::row_from_tests(&e.cell, e.plan.estimators[e.ei].entry.bias, &tests, exempt);
+        let mut row = table::row_from_tests(&e.cell, e.plan.estimators[e.ei].bias(), &tests, exempt);
         row.repetitions = "rounds".into();
         row.rounds = e.looks;
         rows.push(row);

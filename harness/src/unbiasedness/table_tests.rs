@@ -170,7 +170,7 @@ fn a_tiny_sweep_passes_the_estimator_and_flags_the_control() {
         .zip(&pilot.cells)
         .map(|((_, ei, cell), (_, _, p))| {
             let gate = crate::analysis::Gate::from_cell(p, "pilot", 1.0);
-            let bias = plan.estimators[*ei].entry.bias;
+            let bias = plan.estimators[*ei].bias();
             let tests = crate::analysis::unbiasedness(cell, reference, bias, Some(&gate), 0.1);
             row_from_tests(cell, bias, &tests, None)
         })
