@@ -50,7 +50,8 @@ pub fn re_estimate(cfg: &Config, frame: usize, log_z: f64, log_ref: f64) -> Opti
 /// The drift rule: `tau > 0` and `|log_z - log_ref| > tau` (a carried estimate of zero, or one
 /// that is not a number, has drifted).
 pub fn drifted(tau: f64, log_z: f64, log_ref: f64) -> bool {
-    tau > 0.0 && !((log_z - log_ref).abs() <= tau)
+    let moved = (log_z - log_ref).abs();
+    tau > 0.0 && (moved.is_nan() || moved > tau)
 }
 
 /// The unbiased `log mean(p~ / q)` of M fresh environment-map candidates, replacing the carried
