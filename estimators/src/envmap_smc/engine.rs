@@ -8,6 +8,7 @@
 //! estimates use `L_c = L_ns * E_p[(p~_c / p~) V]` (Eq. 9 per channel), which is the same estimator
 //! when the channels agree.
 
+use super::drift;
 use super::mh::{MhKernel, State};
 use super::resampling::{effective_sample_size, log_sum_exp, normalise_log_weights, resample, Scheme};
 use mcbench_core::error::EstimateError;
@@ -59,6 +60,12 @@ pub struct Config {
     /// bidirectional importance sampling with `candidates` M instead of carried forward as a
     /// product of ratios; the particles stay. 0: never.
     pub recompute: usize,
+    /// The drift rule's threshold tau ([`super::drift`]): `L_ns` is estimated afresh from
+    /// `recompute_candidates` candidates on any frame where the carried estimate is more than a
+    /// factor `e^tau` from the last one computed explicitly. 0: never.
+    pub drift: f64,
+    /// Environment-map candidates M of a re-estimate the drift rule calls for.
+    pub recompute_candidates: usize,
 }
 
 /// Weighted particles approximating `p_n`, with `log L_ns,n` (the normaliser estimate).
@@ -67,6 +74,9 @@ struct Population {
     t: Vec<Rgb>,
     log_w: Vec<f64>,
     log_z: f64,
+    /// `log L_ns` as last computed explicitly (bidirectionally, at the start or at a re-estimate):
+    /// the drift rule's reference.
+    log_ref: f64,
 }
 
 fn ln(x: f64) -> f64 {
@@ -115,11 +125,13 @@ fn bidirectional(probe: &EnvProbe<'_>, n: usize, m: usize, rng: &mut StreamRng) 
         return (None, lns);
     };
     let idx = resample(Scheme::Multinomial, &weights, n, rng);
+    let log_z = lse - (m as f64).ln();
     let pop = Population {
         w: idx.iter().map(|&i| cand[i]).collect(),
         t: idx.iter().map(|&i| targets[i]).collect(),
         log_w: vec![-(n as f64).ln(); n],
-        log_z: lse - (m as f64).ln(),
+        log_z,
+        log_ref: log_z,
     };
     (Some(pop), lns)
 }
@@ -127,7 +139,7 @@ fn bidirectional(probe: &EnvProbe<'_>, n: usize, m: usize, rng: &mut StreamRng) 
 /// M candidates from the environment map with their targets `p~`, log weights `ln(p~ / q)` and
 /// the per-channel estimate `mean(p~_c / q)` of `L_ns`.
 #[allow(clippy::type_complexity)]
-fn candidates(probe: &EnvProbe<'_>, m: usize, rng: &mut StreamRng) -> (Vec<Vec3>, Vec<Rgb>, Vec<f64>, Rgb) {
+pub(super) fn candidates(probe: &EnvProbe<'_>, m: usize, rng: &mut StreamRng) -> (Vec<Vec3>, Vec<Rgb>, Vec<f64>, Rgb) {
     let (mut cand, mut targets, mut log_w) = (Vec::with_capacity(m), Vec::with_capacity(m), Vec::with_capacity(m));
     let mut lns = Rgb::ZERO;
     for _ in 0..m {
@@ -140,16 +152,6 @@ fn candidates(probe: &EnvProbe<'_>, m: usize, rng: &mut StreamRng) -> (Vec<Vec3>
         targets.push(t);
     }
     (cand, targets, log_w, lns / m as f64)
-}
-
-/// Paper 004 §7 keeps `L_ns` from drifting by computing it explicitly from time to time: the
-/// unbiased `log mean(p~ / q)` of M fresh environment-map candidates, replacing the carried
-/// product of Eq. 10 (or Eq. 16) increments. The weighted particle mean of Eq. 9 then multiplies
-/// an independent normaliser, so the estimate is consistent (its bias falls as 1/N), no longer
-/// unbiased.
-fn recomputed_log_normaliser(probe: &EnvProbe<'_>, m: usize, rng: &mut StreamRng) -> f64 {
-    let (_, _, log_w, _) = candidates(probe, m, rng);
-    log_sum_exp(&log_w) - (m as f64).ln()
 }
 
 /// Eq. 9 per channel: `L_ns * sum_j W_j (p~_c / p~)(w_j) [V(w_j)]` (one ray per particle with
@@ -183,8 +185,9 @@ pub fn run_sequence(cfg: &Config, tasks: &[Task<'_>], rng: &mut StreamRng) -> Re
         };
         let estimate_now = match carried {
             Some(mut p) => {
-                if cfg.recompute > 0 && probe.frame().is_multiple_of(cfg.recompute) {
-                    p.log_z = recomputed_log_normaliser(&probe, cfg.candidates, rng);
+                if let Some(m) = drift::re_estimate(cfg, probe.frame(), p.log_z, p.log_ref) {
+                    p.log_z = drift::recomputed_log_normaliser(&probe, m, rng);
+                    p.log_ref = p.log_z;
                     probe.note("recomputed", 1.0);
                 }
                 let e = estimate(&p, &probe);

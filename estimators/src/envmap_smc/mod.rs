@@ -4,6 +4,7 @@
 //! - [`resampling`]: multinomial, residual, stratified and systematic resampling; ESS in log space;
 //! - [`mh`]: the Metropolis-Hastings mixture kernel of Eq. 6-8;
 //! - [`engine`]: bidirectional importance sampling, Algorithm 1 and Algorithm 2 in log space;
+//! - [`drift`]: when the carried `L_ns` is estimated afresh (a fixed schedule, or the drift rule);
 //! - the estimators: [`bidirectional_is`], [`bidirectional_is_sn`] (biased control), [`smc`],
 //!   [`smc_bridge`], [`smc_path`], [`smc_adaptive`], and their parameters ([`params`]).
 //!
@@ -12,6 +13,7 @@
 
 pub mod bidirectional_is;
 pub mod bidirectional_is_sn;
+pub mod drift;
 pub mod engine;
 pub mod mh;
 pub mod params;

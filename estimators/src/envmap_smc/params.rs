@@ -62,6 +62,8 @@ impl Common {
             threshold: self.threshold,
             transition,
             recompute: 0,
+            drift: 0.0,
+            recompute_candidates: super::drift::DEFAULT_RECOMPUTE_CANDIDATES,
         })
     }
 }
@@ -71,6 +73,13 @@ fn check_recompute(k: usize) -> Result<(), ConfigError> {
     if k > 1000 {
         return Err(ConfigError::invalid("recompute", k, "must be a whole number in [0, 1000] (0: never)"));
     }
+    Ok(())
+}
+
+/// `drift` 0 (never) to 50 and `recompute_candidates` 1 to 2^20.
+fn check_drift(tau: f64, m: usize) -> Result<(), ConfigError> {
+    check_range("drift", tau, 0.0, 50.0)?;
+    check_count("recompute_candidates", m, 1 << 20)?;
     Ok(())
 }
 
@@ -183,6 +192,16 @@ pub struct SmcParams {
     /// 0 to 1000. Above 0 the estimate is consistent, not unbiased (the self-normalised particle
     /// mean times an independent normaliser), and each re-estimate costs M target evaluations.
     pub recompute: usize,
+    /// The drift rule's threshold tau: on any frame where the carried `L_ns` estimate is more than a
+    /// factor `e^tau` from the last one computed explicitly (the first frame's, or the last
+    /// re-estimate's), `L_ns` is estimated afresh from `recompute_candidates` environment-map
+    /// candidates (paper 004 §7: "whenever the ratio L_ns,n / L_ns,1 altered significantly"); the
+    /// particles stay. 0 (the default): never; 0 to 50. Above 0 the estimate is consistent, not
+    /// unbiased (the decision reads the carried estimate itself; book: paper-004.md).
+    pub drift: f64,
+    /// Environment-map candidates M of a re-estimate the drift rule calls for (1 to 2^20, default
+    /// 1024): M target evaluations each.
+    pub recompute_candidates: usize,
     /// Environment-map candidates, M, of the bidirectional step that starts a pixel's sequence (and
     /// restarts it when every particle weight is zero); 1 to 2^20.
     pub candidates: usize,
@@ -202,6 +221,8 @@ impl Default for SmcParams {
         SmcParams {
             moves: 5,
             recompute: 0,
+            drift: 0.0,
+            recompute_candidates: super::drift::DEFAULT_RECOMPUTE_CANDIDATES,
             candidates: c.candidates,
             cone: c.cone,
             p_independent: c.p_independent,
@@ -212,6 +233,18 @@ impl Default for SmcParams {
 }
 
 impl SmcParams {
+    /// The engine's configuration with this `transition`: the common parameters and both re-estimate
+    /// rules.
+    pub fn config(&self, owner: &str, transition: Transition) -> Result<Config, ConfigError> {
+        let c = self.common().config(owner, Some(transition))?;
+        Ok(Config {
+            recompute: self.recompute,
+            drift: self.drift,
+            recompute_candidates: self.recompute_candidates,
+            ..c
+        })
+    }
+
     /// The common parameters.
     pub fn common(&self) -> Common {
         Common {
@@ -228,6 +261,7 @@ impl ParamSet for SmcParams {
     fn validate(&self, owner: &str) -> Result<(), ConfigError> {
         check_count("moves", self.moves, 10_000)?;
         check_recompute(self.recompute)?;
+        check_drift(self.drift, self.recompute_candidates)?;
         self.common().validate(owner)
     }
 }
@@ -244,6 +278,16 @@ pub struct SmcBridgeParams {
     /// 0 to 1000. Above 0 the estimate is consistent, not unbiased (the self-normalised particle
     /// mean times an independent normaliser), and each re-estimate costs M target evaluations.
     pub recompute: usize,
+    /// The drift rule's threshold tau: on any frame where the carried `L_ns` estimate is more than a
+    /// factor `e^tau` from the last one computed explicitly (the first frame's, or the last
+    /// re-estimate's), `L_ns` is estimated afresh from `recompute_candidates` environment-map
+    /// candidates (paper 004 §7: "whenever the ratio L_ns,n / L_ns,1 altered significantly"); the
+    /// particles stay. 0 (the default): never; 0 to 50. Above 0 the estimate is consistent, not
+    /// unbiased (the decision reads the carried estimate itself; book: paper-004.md).
+    pub drift: f64,
+    /// Environment-map candidates M of a re-estimate the drift rule calls for (1 to 2^20, default
+    /// 1024): M target evaluations each.
+    pub recompute_candidates: usize,
     /// Environment-map candidates, M, of the bidirectional step that starts a pixel's sequence (and
     /// restarts it when every particle weight is zero); 1 to 2^20.
     pub candidates: usize,
@@ -263,6 +307,8 @@ impl Default for SmcBridgeParams {
         SmcBridgeParams {
             bridges: 5,
             recompute: 0,
+            drift: 0.0,
+            recompute_candidates: super::drift::DEFAULT_RECOMPUTE_CANDIDATES,
             candidates: c.candidates,
             cone: c.cone,
             p_independent: c.p_independent,
@@ -273,6 +319,18 @@ impl Default for SmcBridgeParams {
 }
 
 impl SmcBridgeParams {
+    /// The engine's configuration with this `transition`: the common parameters and both re-estimate
+    /// rules.
+    pub fn config(&self, owner: &str, transition: Transition) -> Result<Config, ConfigError> {
+        let c = self.common().config(owner, Some(transition))?;
+        Ok(Config {
+            recompute: self.recompute,
+            drift: self.drift,
+            recompute_candidates: self.recompute_candidates,
+            ..c
+        })
+    }
+
     /// The common parameters.
     pub fn common(&self) -> Common {
         Common {
@@ -289,6 +347,7 @@ impl ParamSet for SmcBridgeParams {
     fn validate(&self, owner: &str) -> Result<(), ConfigError> {
         check_count("bridges", self.bridges, 10_000)?;
         check_recompute(self.recompute)?;
+        check_drift(self.drift, self.recompute_candidates)?;
         self.common().validate(owner)
     }
 }

@@ -5,7 +5,10 @@
 //! mean is the unbiased SMC estimate (Del Moral, Doucet and Jasra 2006), so the claim is unbiased.
 //! Parameters: `moves` (K, default 5), `recompute` (every that many frames `L_ns` is estimated
 //! afresh by bidirectional importance sampling with M candidates, paper 004 §7; default 0, never:
-//! above 0 the estimate is consistent, the claim holds for the default) and the common ones
+//! above 0 the estimate is consistent, the claim holds for the default),
+//! `drift` (tau of the drift rule, [`super::drift`]: `L_ns` estimated afresh from
+//! `recompute_candidates` M, default 1024, whenever the carried estimate moves more than
+//! `e^tau` from the last explicit one; default 0, never; above 0 consistent) and the common ones
 //! ([`super::params::SmcParams`]).
 
 use super::engine::Transition;
@@ -27,8 +30,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     build: |p| {
         let p = parse::<SmcParams>("smc", p)?;
         let transition = Transition::Single { moves: p.moves };
-        let config = p.common().config("smc", Some(transition))?;
-        Ok(Box::new(super::SmcEstimator(super::engine::Config { recompute: p.recompute, ..config })))
+        Ok(Box::new(super::SmcEstimator(p.config("smc", transition)?)))
     },
     params: ParamSpec::of::<SmcParams>().display("SMC, one distribution").words(crate::words::param),
     checks: Checks::DEFAULT,

@@ -3,7 +3,10 @@
 //! Eq. 12 (annealed importance sampling per particle), `L_ns` by the standard ratio (Eq. 10):
 //! unbiased. Parameters: `bridges` (P, default 5), `recompute` (every that many frames `L_ns` is
 //! estimated afresh by bidirectional importance sampling with M candidates, paper 004 §7; default
-//! 0, never: above 0 the estimate is consistent, the claim holds for the default) and the common
+//! 0, never: above 0 the estimate is consistent, the claim holds for the default),
+//! `drift` (tau of the drift rule, [`super::drift`]: `L_ns` estimated afresh from
+//! `recompute_candidates` M, default 1024, whenever the carried estimate moves more than
+//! `e^tau` from the last explicit one; default 0, never; above 0 consistent) and the common
 //! ones.
 
 use super::engine::Transition;
@@ -25,8 +28,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     build: |p| {
         let p = parse::<SmcBridgeParams>("smc_bridge", p)?;
         let transition = Transition::Bridged { bridges: p.bridges, path: false };
-        let config = p.common().config("smc_bridge", Some(transition))?;
-        Ok(Box::new(super::SmcEstimator(super::engine::Config { recompute: p.recompute, ..config })))
+        Ok(Box::new(super::SmcEstimator(p.config("smc_bridge", transition)?)))
     },
     params: ParamSpec::of::<SmcBridgeParams>().display("SMC, ratio").words(crate::words::param),
     checks: Checks::DEFAULT,

@@ -4,7 +4,10 @@
 //! the Riemann sum) makes it consistent, not unbiased: the claim is `consistent` and the test
 //! decides. Parameters: `bridges` (P, default 5), `recompute` (every that many frames `L_ns` is
 //! estimated afresh by bidirectional importance sampling with M candidates, paper 004 §7; default
-//! 0, never) and the common ones.
+//! 0, never),
+//! `drift` (tau of the drift rule, [`super::drift`]: `L_ns` estimated afresh from
+//! `recompute_candidates` M, default 1024, whenever the carried estimate moves more than
+//! `e^tau` from the last explicit one; default 0, never; above 0 consistent) and the common ones.
 
 use super::engine::Transition;
 use super::params::SmcBridgeParams;
@@ -25,8 +28,7 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     build: |p| {
         let p = parse::<SmcBridgeParams>("smc_path", p)?;
         let transition = Transition::Bridged { bridges: p.bridges, path: true };
-        let config = p.common().config("smc_path", Some(transition))?;
-        Ok(Box::new(super::SmcEstimator(super::engine::Config { recompute: p.recompute, ..config })))
+        Ok(Box::new(super::SmcEstimator(p.config("smc_path", transition)?)))
     },
     params: ParamSpec::of::<SmcBridgeParams>().display("SMC, path sampling").words(crate::words::param),
     checks: Checks::DEFAULT,

@@ -14,7 +14,7 @@
 //!
 //! Visibility (an infinite ground plane at z = -1, `V = 1` iff `w_z >= 0`) coincides with the
 //! equator, a row edge of every map with an even number of rows. A wall beside the sphere (the
-//! `moving-wall` variant) hides the directions on one side of a great circle through each shading
+//! `-wall` variants) hides the directions on one side of a great circle through each shading
 //! point; texels it crosses are split in `phi` where it crosses their `theta` edges and integrated
 //! in `theta` over the visible part, as at the horizon (checked at 1e-5 relative, the brute
 //! force's own accuracy at that kink).

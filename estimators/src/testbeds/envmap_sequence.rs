@@ -5,7 +5,8 @@
 //! 1.5 degrees a frame about +z for F = 10 frames; an infinite ground plane at z = -1 gives
 //! `V = 1` iff `w_z >= 0`.
 //!
-//! Integral `pixel * F + frame` is `L_r` (variants `specular`, `mixed`, `moving`, `moving-wall`) or `L_ns`
+//! Integral `pixel * F + frame` is `L_r` (variants `specular`, `mixed`, `moving`, `moving-wall`,
+//! `moving-specular-wall`) or `L_ns`
 //! (variants `specular-lns`, `mixed-lns`, `moving-lns`) of that pixel in that frame; references
 //! are exact per texel ([`super::envmap_reference`]).
 //!
@@ -21,6 +22,9 @@
 //! degrees of elevation towards +x on the pixels nearest the wall). Paper 004 §7's scenes are
 //! lit through such occlusion: every sample's visibility is a shadow ray, and the rotating lobes
 //! pass behind the wall.
+//!
+//! `moving-specular-wall` is `moving-wall` with the `specular` BRDF (paper 004 Fig. 4's case: no
+//! diffuse part, Phong exponent 50), so the target is a narrow lobe the SMC particles can follow.
 //!
 //! Parameters: `resolution` (32), `frames` (10), `rotation` (degrees per frame, 1.5), `sun` (peak
 //! radiance of the sun, or of the `moving` map's key lobe, 1e3: dynamic range > 1e4), `dawn_dusk`
@@ -61,12 +65,12 @@ const ENVMAP_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1500, 
 /// ```
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "envmap-sequence",
-    variants: &["specular", "mixed", "specular-lns", "mixed-lns", "moving", "moving-lns", "moving-wall"],
+    variants: &["specular", "mixed", "specular-lns", "mixed-lns", "moving", "moving-lns", "moving-wall", "moving-specular-wall"],
     // Not `SURFACE`: its integrals are per-frame environment integrals reached through
     // `env_sequence()`, not the hemisphere probe the surface estimators need.
     provides: Needs::ENV_SEQUENCE,
     summary:
-        "Phong sphere under a rotating HDR sky (`moving`: narrow bright lobes that move with it; `moving-wall`: and a wall that hides part of it), L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
+        "Phong sphere under a rotating HDR sky (`moving`: narrow bright lobes that move with it; `moving-wall`: and a wall that hides part of it; `moving-specular-wall`: that with the specular BRDF), L_r or L_ns per pixel and frame, exact per-texel reference (paper 004)",
     build: |variant, params, refs| Ok(Box::new(EnvmapSequence::with_references(variant, params, refs)?)),
     compute_reference: None,
     params: ParamSpec::of::<EnvmapSequenceParams>().display("environment-map sequence (paper 004)").words(crate::words::variant),
@@ -84,6 +88,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "moving", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving-wall", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "moving-specular-wall", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
     ],
 };
 
@@ -148,10 +153,10 @@ const METHOD: &str = "per-texel exact solid angles; closed-form diffuse moments 
 /// Half-width of the orthographic image (inside the unit disc's inscribed square).
 const HALF_WIDTH: f64 = 0.7;
 
-/// The `moving-wall` variant's occluder: a black wall in the plane `x = WALL_X`, infinite in `y`,
+/// The `-wall` variants' occluder: a black wall in the plane `x = WALL_X`, infinite in `y`,
 /// from the ground (`z = -1`) up to `z = WALL_TOP`: beside the sphere (radius 1) and as tall.
 pub const WALL_X: f64 = 1.5;
-/// Top edge of the `moving-wall` variant's wall.
+/// Top edge of the `-wall` variants' wall.
 pub const WALL_TOP: f64 = 1.0;
 
 /// The wall's silhouette seen from `position` (below the wall's top, in front of its plane): a
@@ -171,7 +176,7 @@ pub struct EnvmapSequence {
     quantity: EnvQuantity,
     maps: Vec<EnvMap>,
     points: Vec<ShadingPoint>,
-    /// Per pixel, the wall's silhouette ([`wall_normal`]) in the `moving-wall` variant.
+    /// Per pixel, the wall's silhouette ([`wall_normal`]) in the `-wall` variants.
     walls: Option<Vec<Vec3>>,
     /// Everything the exact pixel references depend on (parameters and BRDF), for the memo.
     setup: String,
@@ -180,7 +185,8 @@ pub struct EnvmapSequence {
     key: ReferenceKey,
 }
 
-/// The BRDF and quantity of a variant (book: testbeds.md); the `moving` ones have the `mixed` BRDF.
+/// The BRDF and quantity of a variant (book: testbeds.md); the `moving` ones have the `mixed` BRDF
+/// but `moving-specular-wall`, which has the `specular` one.
 pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError> {
     let phong = |kd: f64, ks: f64| Phong { kd: Rgb::splat(kd), ks: Rgb::splat(ks), n: 50.0 };
     match variant {
@@ -191,6 +197,7 @@ pub fn variant_setup(variant: &str) -> Result<(Phong, EnvQuantity), ConfigError>
         "moving" => Ok((phong(0.5, 0.5), EnvQuantity::Reflected)),
         "moving-lns" => Ok((phong(0.5, 0.5), EnvQuantity::Unoccluded)),
         "moving-wall" => Ok((phong(0.5, 0.5), EnvQuantity::Reflected)),
+        "moving-specular-wall" => Ok((phong(0.0, 1.0), EnvQuantity::Reflected)),
         _ => {
             Err(ConfigError::unknown("variant", &format!("envmap-sequence/{variant}"), ENTRY.variants.iter().copied()))
         }
@@ -250,7 +257,7 @@ impl EnvmapSequence {
                 points.push(ShadingPoint { position: p, normal: p, wo: Vec3::new(0.0, -1.0, 0.0), brdf });
             }
         }
-        let walls = (variant == "moving-wall").then(|| points.iter().map(|p| wall_normal(p.position)).collect());
+        let walls = variant.ends_with("-wall").then(|| points.iter().map(|p| wall_normal(p.position)).collect());
         Ok(EnvmapSequence {
             variant: variant.to_string(),
             size,

@@ -77,6 +77,46 @@ fn wall_reference_matches_refined_brute_force() {
     }
 }
 
+/// `moving-specular-wall`: the `specular` BRDF under the `moving` map behind the same wall. Its
+/// references match the refined brute force (at 1e-5 for `L_r`, as the wall's kink allows; 1e-7
+/// for `L_ns`); its `L_ns` is the `specular` BRDF's under the moving map (the wall hides nothing
+/// from `L_ns`), and the wall darkens every pixel against the open scene with the same BRDF.
+#[test]
+fn specular_wall_variant_has_the_specular_brdf_and_exact_references() {
+    let bed = small("moving-specular-wall", Params::new());
+    let (specular, wall) = (small("specular", Params::new()), small("moving-wall", Params::new()));
+    assert_eq!(bed.points[4].brdf, specular.points[4].brdf);
+    assert_ne!(bed.points[4].brdf, wall.points[4].brdf);
+    assert_eq!(bed.maps[0].texels(), wall.maps[0].texels());
+    assert_eq!(bed.walls, wall.walls);
+    assert_eq!(bed.quantity, EnvQuantity::Reflected);
+    let refs = bed.pixel_references();
+    for i in [0, 8, 17] {
+        let (lns, lr) = brute(&bed, i, 8);
+        for c in 0..3 {
+            let scale = refs[i].lns[c].abs().max(1e-3);
+            assert!((lns[c] - refs[i].lns[c]).abs() <= 1e-7 * scale, "integral {i} ch {c}: L_ns {}", lns[c]);
+            let err = (lr[c] - refs[i].lr[c]).abs() / scale;
+            assert!(err <= WALL_QUADRATURE_REL_ERROR, "integral {i} ch {c}: L_r error {err:.2e}");
+        }
+    }
+    for (v, r) in bed.reference.value.iter().zip(&refs) {
+        assert_eq!(*v, r.lr);
+    }
+    // Open: the moving map with the specular BRDF and no wall (the `moving` scene's geometry).
+    let open = small("moving", Params::new());
+    let mut open_specular = small("moving", Params::new());
+    open_specular.points.iter_mut().for_each(|p| p.brdf = bed.points[0].brdf);
+    open_specular.setup = format!("{}|specular-open", open.setup);
+    let open_refs = open_specular.pixel_references();
+    for (w, o) in refs.iter().zip(&open_refs) {
+        assert_eq!(w.lns, o.lns);
+        // Within the quadrature's bound: pixels whose lobe points at the ground see about 1e-16.
+        assert!(w.lr.0.iter().zip(o.lr.0).all(|(a, b)| *a <= b + w.bound + o.bound), "{w:?} against {o:?}");
+    }
+    assert!(refs.iter().zip(&open_refs).any(|(w, o)| w.lr.0[1] < 0.9 * o.lr.0[1]), "the wall hides a lobe somewhere");
+}
+
 #[test]
 fn reference_matches_brute_force_quadrature() {
     // The moving map's bright texels make the brute force's horizon texels converge more slowly:
