@@ -8,7 +8,8 @@
 //!   has no rows);
 //! - `integrals.csv`: `mcbench::output::integrals::COLUMNS`, and the run's header starts with them and ends
 //!   with `estimator_id`;
-//! - `timing columns`: `mcbench::analysis::metrics::TIMING_COLUMNS`;
+//! - `timing columns`: `mcbench::analysis::metrics::TIMING_COLUMNS` (and `scripts/perf/timing_columns.txt`,
+//!   the list the scaling script strips);
 //! - `summary.json` and `summary.json meta`: the run's top-level and `meta` field names;
 //! - `reference json`: the fields of a file `mcbench reference` wrote;
 //! - `subcommands`: the `Commands:` of `mcbench --help`;
@@ -154,4 +155,14 @@ fn the_subcommands_and_exit_codes_are_the_chapters() {
     assert_eq!(o.status.code(), Some(EXIT_BAD_INPUT));
     assert_eq!(String::from_utf8_lossy(&o.stderr).trim_end().lines().count(), 1);
     assert!(!dir.path().join("results").exists() && !dir.path().join("plots").exists(), "bad input wrote nothing");
+}
+
+/// `scripts/perf/measure.sh` strips the timing columns it reads from `scripts/perf/timing_columns.txt`
+/// before it compares runs at different thread counts: that list is the code's.
+#[test]
+fn the_scaling_script_strips_the_codes_timing_columns() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/perf/timing_columns.txt");
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let listed: Vec<String> = text.lines().map(str::trim).filter(|l| !l.is_empty()).map(str::to_string).collect();
+    assert_eq!(listed, strs(mcbench::analysis::metrics::TIMING_COLUMNS), "{}", path.display());
 }

@@ -9,16 +9,22 @@ OUT="${OUT:-/tmp/mcbench-perf}"
 EXPERIMENTS="surface-smc media-smc transmittance particle-sweep pmc-hi pmc-ip envmap-smc single-scatter canonical-sweep"
 mkdir -p "$OUT"
 
-# Strips the timing columns (docs/src/outputs.md: seconds, efficiency, seconds_median, efficiency_mse, p_eff)
-# from summary.csv so two runs can be compared byte for byte.
+# Strips the timing columns from summary.csv so two runs can be compared byte for byte. The list is
+# timing_columns.txt beside this script, one name a line: the harness's TIMING_COLUMNS
+# (harness/src/analysis/metrics.rs), which tests/contract.rs checks it equals.
+TIMING_COLUMNS="$(dirname "$0")/timing_columns.txt"
 strip_timing() {
-  python3 - "$1" <<'PY'
+  python3 - "$TIMING_COLUMNS" "$1" <<'PY'
 import csv, sys
-timing = {"seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff"}
-rows = list(csv.reader(open(sys.argv[1])))
+timing = {l.strip() for l in open(sys.argv[1]) if l.strip()}
+rows = list(csv.reader(open(sys.argv[2], newline="")))
+missing = timing - set(rows[0])
+if missing:
+    sys.exit(f"{sys.argv[2]}: no timing column {sorted(missing)[0]} (is {sys.argv[1]} current?)")
 keep = [i for i, h in enumerate(rows[0]) if h not in timing]
+w = csv.writer(sys.stdout, lineterminator="\n")
 for r in rows:
-    print(",".join(r[i] for i in keep))
+    w.writerow([r[i] for i in keep])
 PY
 }
 
@@ -44,10 +50,16 @@ scaling)
       "cells $(python3 -c "import json,sys; print(round(json.load(open(sys.argv[1]))['meta']['wall_seconds'],1))" "$OUT/scale-$e-$t/results/$e/summary.json") s (summary.json wall_seconds)"
   done
   a="$OUT/scale-$e-1/results/$e" b="$OUT/scale-$e-2/results/$e"
-  if cmp -s <(strip_timing "$a/summary.csv") <(strip_timing "$b/summary.csv") && cmp -s <(zcat "$a/integrals.csv.gz") <(zcat "$b/integrals.csv.gz"); then
+  for t in 1 2; do
+    strip_timing "$OUT/scale-$e-$t/results/$e/summary.csv" > "$OUT/scale-$e-$t.summary.csv"
+  done
+  differ=""
+  cmp -s "$OUT/scale-$e-1.summary.csv" "$OUT/scale-$e-2.summary.csv" || differ="summary.csv (timing columns aside)"
+  cmp -s <(zcat "$a/integrals.csv.gz") <(zcat "$b/integrals.csv.gz") || differ="${differ:+$differ and }integrals.csv"
+  if [ -z "$differ" ]; then
     echo "$e: summary.csv (timing columns aside) and integrals.csv identical at 1 and 2 threads"
   else
-    echo "$e: RESULTS DIFFER between 1 and 2 threads"; exit 1
+    echo "$e: RESULTS DIFFER between 1 and 2 threads: $differ"; exit 1
   fi
   ;;
 *)

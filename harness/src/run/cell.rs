@@ -182,8 +182,9 @@ pub struct CellResult {
     pub estimates: u64,
     /// Estimate times on the wall clock.
     pub time: TimeStats,
-    /// Estimate times on the estimating thread's CPU clock ([`crate::run::cputime::thread_seconds`]):
-    /// what time-based metrics use, since load from other processes does not inflate it. `None`
+    /// Estimate times on the estimating thread's CPU clock, read per work item and spread over its
+    /// estimates by their wall-clock times ([`crate::run::cputime`]): what time-based metrics use,
+    /// since load from other processes does not inflate it. `None`
     /// in cells stored before it was measured (their metrics fall back to [`Self::time`]).
     #[serde(default)]
     pub cpu_time: Option<TimeStats>,

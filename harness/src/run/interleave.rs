@@ -12,7 +12,7 @@
 use crate::error::Result;
 use crate::plan::Plan;
 use crate::run::cell::{add_diagnostics, rep_block_count, rep_block_size, CellKey, CellResult, RepBlock, TimeStats};
-use crate::run::runner::{calibrated_samples, cell_key, run_sequence, CellRun, Item, REP_BLOCK};
+use crate::run::runner::{calibrated_samples, cell_key, run_item, CellRun, Item, REP_BLOCK};
 use mcbench_core::budget::Budget;
 use mcbench_core::stats::{Moments, NeumaierSum};
 use mcbench_core::task::Costs;
@@ -115,11 +115,7 @@ pub fn run_group_at(
         let items: Vec<Result<Item>> = work
             .par_iter()
             .map(|&(k, _, rep, batch)| {
-                let mut out = Item::default();
-                for s in batch * per_item..((batch + 1) * per_item).min(sequences) {
-                    run_sequence(&runs[k], rep as u64, s * frames, &mut out)?;
-                }
-                Ok(out)
+                run_item(&runs[k], rep as u64, batch * per_item..((batch + 1) * per_item).min(sequences), frames)
             })
             .collect();
         let mut parts: Vec<Vec<CellResult>> = cells

@@ -2,7 +2,7 @@
 //! estimate on its own counter-derived stream, reduced in index order so results are bit-identical
 //! whatever the thread count; the cells of one (test bed, budget) run interleaved
 //! ([`crate::run::interleave`]) so that machine load falls on the estimators they compare alike; each
-//! estimate's wall and CPU time are measured; finished cells are stored and read back on a re-run
+//! estimate's wall and CPU time are measured ([`crate::run::cputime`]); finished cells are stored and read back on a re-run
 //! (resume).
 
 use crate::error::{HarnessError, Result};
@@ -75,9 +75,37 @@ pub(crate) struct Item {
     pub(crate) costs: Costs,
     /// Wall-clock seconds per estimate.
     pub(crate) time: TimeStats,
-    /// The estimating thread's CPU seconds per estimate.
+    /// The estimating thread's CPU seconds per estimate, filled by [`Item::settle`].
     pub(crate) cpu_time: TimeStats,
     pub(crate) diagnostics: Vec<(String, f64)>,
+    /// Each sequence's wall-clock seconds per estimate and its estimates, until the item's CPU
+    /// fraction is known.
+    unsettled: Vec<(f64, usize)>,
+}
+
+impl Item {
+    /// Charges each estimate run since the last call its wall-clock seconds times `cpu_fraction`
+    /// (the item's CPU seconds over its wall-clock seconds, [`crate::run::cputime`]) as CPU time.
+    pub(crate) fn settle(&mut self, cpu_fraction: f64) {
+        for (seconds, n) in self.unsettled.drain(..) {
+            for _ in 0..n {
+                self.cpu_time.push(seconds * cpu_fraction);
+            }
+        }
+    }
+}
+
+/// Runs the sequences `sequences` (each `frames` integrals) of repetition `rep` as one work item:
+/// [`run_sequence`] for each, with the thread CPU clock read once at each end of the item and its
+/// CPU time apportioned over the estimates by their wall-clock times ([`crate::run::cputime`]).
+pub(crate) fn run_item(cell: &CellRun<'_>, rep: u64, sequences: std::ops::Range<usize>, frames: usize) -> Result<Item> {
+    let mut out = Item::default();
+    let clock = crate::run::cputime::ItemClock::start();
+    for s in sequences {
+        run_sequence(cell, rep, s * frames, &mut out)?;
+    }
+    out.settle(clock.cpu_fraction());
+    Ok(out)
 }
 
 /// Repetition index of the pilot stream that calibrates fetch budgets (never a real repetition).
@@ -105,8 +133,9 @@ pub(crate) struct CellRun<'a> {
 }
 
 /// One sequence of integrals (`frames` long, from integral `first`) estimated on its own stream;
-/// its wall-clock and CPU time (the calling thread's clock, which does not advance while the thread
-/// waits for a core or sleeps) are split evenly over its estimates.
+/// its wall-clock time is split evenly over its estimates, and so is its CPU time once the item's
+/// CPU fraction is known ([`Item::settle`]; the thread CPU clock does not advance while the thread
+/// waits for a core or sleeps).
 pub(crate) fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut Item) -> Result<()> {
     let CellRun { plan, label, bi, ei, budget, samples } = *cell;
     let (b, e) = (&plan.beds[bi], &plan.estimators[ei]);
@@ -125,10 +154,9 @@ pub(crate) fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut
         None => Task::new(b.bed.as_ref(), i, budget),
     };
     let tasks: Vec<Task<'_>> = (first..first + frames).map(task).collect();
-    let (t0, c0) = (Instant::now(), crate::run::cputime::thread_seconds());
+    let t0 = Instant::now();
     let values = e.estimator.estimate_sequence(&tasks, &mut rng);
     let seconds = t0.elapsed().as_secs_f64() / frames as f64;
-    let cpu_seconds = (crate::run::cputime::thread_seconds() - c0).max(0.0) / frames as f64;
     let wrap = |source| HarnessError::Estimate { estimator: e.name.clone(), testbed: label.to_string(), source };
     let values = values.map_err(wrap)?;
     if values.len() != frames {
@@ -143,11 +171,11 @@ pub(crate) fn run_sequence(cell: &CellRun<'_>, rep: u64, first: usize, out: &mut
             task.note("samples_per_estimate", n as f64);
         }
         out.time.push(seconds);
-        out.cpu_time.push(cpu_seconds);
         out.costs += task.costs();
         add_diagnostics(&mut out.diagnostics, &task.diagnostics());
         out.values.push(v);
     }
+    out.unsettled.push((seconds, frames));
     Ok(())
 }
 
