@@ -239,6 +239,9 @@ mod tests {
         assert!(e.err().unwrap().to_string().contains("light_samples"));
         let e = CheckerImage::without_reference("nope", &Params::new());
         assert!(e.err().unwrap().to_string().contains("checker-image/nope"));
+        // `checker-direct` builds `lattice`; this bed has no stored reference for it.
+        let e = CheckerImage::without_reference("lattice", &Params::new()).err().unwrap().to_string();
+        assert!(e.contains("checker-image/lattice") && e.contains("soft-shadow"), "{e}");
         // No reference is stored at resolution 7 (the error names the resolution, or the missing
         // file when no reference is stored at all).
         let e =
