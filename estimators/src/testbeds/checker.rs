@@ -19,6 +19,9 @@
 //!   table, where "the cone function" helps "in partially shadowed regions"): diffuse direct
 //!   lighting with a wide penumbra over most of the image; see [`SOFT_SHADOW_LIGHT`] and
 //!   [`SOFT_SHADOW_LEAVES`] for the constants and why;
+//! - variant `lattice`: the light of `soft-shadow` seen through a lattice of wide bars (a screen
+//!   with square openings) halfway up, so that each floor point sees one small, point-specific
+//!   window of the light and most light samples are blocked; see [`LATTICE`];
 //! - pinhole at (0, -3.2, 4.6) looking at (0, 0.1, 0), vertical field of view 44 degrees, square
 //!   image (default 48 x 48), pixel centres; the top rows see past the board.
 
@@ -37,7 +40,7 @@ use serde::{Deserialize, Serialize};
 /// Registry entry.
 pub static ENTRY: TestBedEntry = TestBedEntry {
     id: "checker-direct",
-    variants: &["default", "occluded", "soft-shadow"],
+    variants: &["default", "occluded", "soft-shadow", "lattice"],
     provides: Needs::SURFACE.and(Needs::AREA_LIGHTS),
     summary:
         "checkerboard of diffuse/glossy squares under two area lights, direct lighting (paper 003 Fig. 6, Table 2)",
@@ -123,23 +126,57 @@ pub const SOFT_SHADOW_LIGHT: (f64, f64, f64, f64, f64, f64) = (0.0, 0.4, 2.4, 1.
 pub const SOFT_SHADOW_LEAVES: [(f64, f64, f64, f64); 5] =
     [(-0.9, -0.6, 0.6, 1.0), (0.6, -0.8, 0.6, 0.8), (0.0, 0.3, 0.7, 1.3), (-0.8, 1.0, 0.6, 1.1), (0.9, 0.9, 0.6, 0.9)];
 
+/// The lattice of `lattice`: `(height, pitch, opening, x of an opening's centre, y of an
+/// opening's centre)`; the light is [`SOFT_SHADOW_LIGHT`] and every square is diffuse.
+///
+/// - Bars parallel to the light (so the exact reference applies) at height 1.2, half the light's
+///   2.4: from a floor point the lattice's shadow on the light's plane is the lattice scaled by
+///   `s = 2.4 / 1.2 = 2`, its openings `0.3 s = 0.6` wide at pitch `0.9 s = 1.8`.
+/// - That pitch is the light's side plus an opening (1.2 + 0.6): along each axis exactly one
+///   opening's image overlaps the light whatever the point, so each point sees one rectangle of
+///   it (a whole 0.6 x 0.6 window or a part clipped by the light's edge), which moves across the
+///   light as the point moves (one period per 1.8 / (s - 1) = 1.8 of floor). A single window is
+///   what the cone component of PMC-HI (paper 003 Eq. 7: one axis and one half-angle, §5.2) can
+///   learn; thin bars at a fine pitch would leave several strips spread over the light in view,
+///   and a cone covering them all is no narrower than the light.
+/// - On average a point sees `(0.6 / 1.8)^2 = 1/9` of the light's area, so about nine in ten
+///   uniform light samples are blocked (a test measures the share over the pixels).
+/// - The bars span `[-2.5, 2.5]` at both axes, past every ray from the board to the light.
+pub const LATTICE: (f64, f64, f64, f64, f64) = (1.2, 0.9, 0.3, 0.0, 0.4);
+
+/// The bars of [`LATTICE`]: strips along `y` between the openings' columns, strips along `x`
+/// between their rows (they overlap at the crossings).
+fn lattice_bars() -> Vec<Occluder> {
+    let (z, pitch, opening, ox, oy) = LATTICE;
+    let (lo, hi) = (-2.5, 2.5);
+    let mut bars = Vec::new();
+    for k in -4..4 {
+        let (x0, x1) = (ox + k as f64 * pitch + 0.5 * opening, ox + (k + 1) as f64 * pitch - 0.5 * opening);
+        bars.push(Occluder { min: [x0.max(lo), lo], max: [x1.min(hi), hi], z });
+        let (y0, y1) = (oy + k as f64 * pitch + 0.5 * opening, oy + (k + 1) as f64 * pitch - 0.5 * opening);
+        bars.push(Occluder { min: [lo, y0.max(lo)], max: [hi, y1.min(hi)], z });
+    }
+    bars.retain(|b| b.min[0] < b.max[0] && b.min[1] < b.max[1]);
+    bars
+}
+
 /// The static geometry of the checker scene (shared with `checker-image`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CheckerGeometry {
     /// The lights (`default` and `occluded`: the large dim one first, then the small bright one).
     pub lights: Vec<RectLight>,
     /// The shadow casters: none (`default`), the square of `occluded`, the leaves of
-    /// `soft-shadow`.
+    /// `soft-shadow`, the bars of `lattice`.
     pub occluders: Vec<Occluder>,
-    /// Whether the board alternates diffuse and glossy squares (`soft-shadow`: every square
-    /// diffuse).
+    /// Whether the board alternates diffuse and glossy squares (`soft-shadow` and `lattice`:
+    /// every square diffuse).
     pub glossy: bool,
     /// The camera.
     pub camera: Pinhole,
 }
 
 impl CheckerGeometry {
-    /// The geometry of a variant (`default`, `occluded` or `soft-shadow`).
+    /// The geometry of a variant (`default`, `occluded`, `soft-shadow` or `lattice`).
     pub fn new(variant: &str) -> Result<Self, ConfigError> {
         let two_lights = || {
             vec![
@@ -147,11 +184,14 @@ impl CheckerGeometry {
                 RectLight::centred(1.0, 0.9, 1.2, 0.15, 0.15, Rgb::splat(400.0)),
             ]
         };
+        let soft_light = || {
+            let (cx, cy, z, wx, wy, radiance) = SOFT_SHADOW_LIGHT;
+            vec![RectLight::centred(cx, cy, z, wx, wy, Rgb::splat(radiance))]
+        };
         let (lights, occluders, glossy) = match variant {
             "default" => (two_lights(), Vec::new(), true),
             "occluded" => (two_lights(), vec![Occluder { min: [0.0, -0.3], max: [1.0, 0.7], z: 0.6 }], true),
             "soft-shadow" => {
-                let (cx, cy, z, wx, wy, radiance) = SOFT_SHADOW_LIGHT;
                 let leaves = SOFT_SHADOW_LEAVES
                     .iter()
                     .map(|&(x, y, side, z)| Occluder {
@@ -160,8 +200,9 @@ impl CheckerGeometry {
                         z,
                     })
                     .collect();
-                (vec![RectLight::centred(cx, cy, z, wx, wy, Rgb::splat(radiance))], leaves, false)
+                (soft_light(), leaves, false)
             }
+            "lattice" => (soft_light(), lattice_bars(), false),
             _ => {
                 return Err(ConfigError::unknown(
                     "variant",

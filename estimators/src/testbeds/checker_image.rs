@@ -19,7 +19,7 @@
 //! checker-image --variant V` ([`super::checker_image_reference`]) and looked up by variant and
 //! resolution in the reference source the caller gives.
 
-use super::checker::{CheckerGeometry, ENTRY as DIRECT};
+use super::checker::CheckerGeometry;
 use mcbench_core::entry::{BedCase, CaseRole, TestBedEntry};
 use mcbench_core::error::ConfigError;
 use mcbench_core::lighting::{light_selection, mis_round, MisStrategy};
@@ -108,9 +108,14 @@ impl CheckerImage {
     pub fn without_reference(variant: &str, params: &Params) -> Result<Self, ConfigError> {
         let p = parse::<CheckerImageParams>("checker-image", params)?;
         let (size, light_samples) = (p.resolution, p.light_samples);
-        let geometry = CheckerGeometry::new(variant).map_err(|_| {
-            ConfigError::unknown("variant", &format!("{}/{variant}", ENTRY.id), DIRECT.variants.iter().copied())
-        })?;
+        // `checker-direct`'s `lattice` has no stored pixel-footprint reference: only this
+        // bed's own variants are built.
+        let unknown =
+            || ConfigError::unknown("variant", &format!("{}/{variant}", ENTRY.id), ENTRY.variants.iter().copied());
+        if !ENTRY.variants.contains(&variant) {
+            return Err(unknown());
+        }
+        let geometry = CheckerGeometry::new(variant).map_err(|_| unknown())?;
         let select = light_selection(&geometry.lights);
         Ok(CheckerImage {
             variant: variant.to_string(),
@@ -234,6 +239,9 @@ mod tests {
         assert!(e.err().unwrap().to_string().contains("light_samples"));
         let e = CheckerImage::without_reference("nope", &Params::new());
         assert!(e.err().unwrap().to_string().contains("checker-image/nope"));
+        // `checker-direct` builds `lattice`; this bed has no stored reference for it.
+        let e = CheckerImage::without_reference("lattice", &Params::new()).err().unwrap().to_string();
+        assert!(e.contains("checker-image/lattice") && e.contains("soft-shadow"), "{e}");
         // No reference is stored at resolution 7 (the error names the resolution, or the missing
         // file when no reference is stored at all).
         let e =

@@ -200,3 +200,59 @@ fn uncovered_rectangles_tile_the_lit_part_of_the_light() {
     let area: f64 = parts.iter().map(|r| (r.x1 - r.x0) * (r.y1 - r.y0)).sum();
     assert!(area > 0.0 && area < 4.0 && parts.len() < 20, "{} parts, area {area}", parts.len());
 }
+
+/// `lattice`: every point that sees the board sees exactly one rectangle of the light through
+/// the bars, most uniform light samples are blocked, and the quadrature agrees with the
+/// ray-cast brute force.
+#[test]
+fn lattice_shows_one_window_blocks_most_light_samples_and_its_reference_splits_exactly() {
+    use rand::Rng;
+    let start = std::time::Instant::now();
+    let bed = CheckerDirect::new("lattice", &Params::new().with("resolution", 24.0)).unwrap();
+    let built = start.elapsed().as_secs_f64();
+    let geo = bed.geometry();
+    assert_eq!(geo.lights.len(), 1);
+    let light = geo.lights[0];
+    let free = CheckerGeometry { occluders: Vec::new(), ..geo.clone() };
+    let mut rng = mcbench_core::rng::stream(5, "lattice");
+    let (mut board, mut blocked_share, mut area_share) = (Vec::new(), 0.0, 0.0);
+    let (samples, mut smallest, mut largest) = (2000, 1.0f64, 0.0f64);
+    for i in 0..bed.integrals() {
+        let p = bed.shading(i);
+        assert_eq!(p.brdf.ks[0], 0.0, "every square is diffuse");
+        if p.brdf.kd[0] == 0.0 {
+            continue;
+        }
+        let parts = visible_parts(&light, p.position, geo);
+        assert_eq!(parts.len(), 1, "pixel {i} sees one window: {parts:?}");
+        let lit = parts.iter().map(|r| (r.x1 - r.x0) * (r.y1 - r.y0)).sum::<f64>() / (1.2 * 1.2);
+        (smallest, largest) = (smallest.min(lit), largest.max(lit));
+        area_share += 1.0 - lit;
+        // Uniform points on the light, as MIS's light sampler draws them, cast against the bars.
+        let mut blocked = 0;
+        for _ in 0..samples {
+            let (u, v) = (rng.gen_range(light.min[0]..light.max[0]), rng.gen_range(light.min[1]..light.max[1]));
+            let w = (Vec3::new(u, v, light.z) - p.position).normalize();
+            blocked += usize::from(geo.incident(p.position, w)[0] == 0.0);
+        }
+        blocked_share += blocked as f64 / samples as f64;
+        board.push(i);
+    }
+    let (blocked_share, area_share) = (blocked_share / board.len() as f64, area_share / board.len() as f64);
+    eprintln!(
+        "lattice: built with its reference in {built:.3} s, {} board pixels, mean blocked share of light samples {blocked_share:.3} (area {area_share:.3}), \
+         visible share of the light from {smallest:.3} to {largest:.3}",
+        board.len()
+    );
+    assert!(board.len() > 300, "{}", board.len());
+    assert!(blocked_share > 0.8 && (blocked_share - area_share).abs() < 0.01, "{blocked_share} vs {area_share}");
+    assert!(largest <= 0.25 + 1e-12 && smallest < 0.05, "{smallest}..{largest}");
+    for &i in board.iter().step_by(board.len() / 4).take(4) {
+        let p = bed.shading(i);
+        let r = bed.reference().value[i][0];
+        let b = brute(geo, &p, 384, 384);
+        let unoccluded = direct_lighting(&free, &p, REL_TOL).0;
+        eprintln!("lattice pixel {i}: quadrature {r:.9e}, ray-cast brute force {b:.9e}, unoccluded {unoccluded:.6e}");
+        assert!(r > 0.0 && (r - b).abs() <= 1e-3 * unoccluded, "pixel {i}: {r} vs {b}");
+    }
+}
