@@ -105,3 +105,20 @@ fn bad_drift_parameters_are_refused_naming_the_field() {
         assert!(build(&Params::new().with("drift", 0.3).with("recompute_candidates", 4096.0)).is_ok());
     }
 }
+
+/// A normaliser estimated afresh (by the drift rule, which decides from the carried estimate, or
+/// every K frames) makes the estimate consistent, and the configuration declares so; without
+/// either each estimator keeps its entry's declaration.
+#[test]
+fn the_drift_rule_declares_the_estimate_consistent() {
+    use mcbench_core::estimator::Bias;
+    for (id, entry) in [("smc", Bias::Unbiased), ("smc_bridge", Bias::Unbiased), ("smc_path", Bias::Consistent)] {
+        let e = builtins::estimator(id).unwrap();
+        assert_eq!(e.bias, entry, "{id}");
+        let off = (e.build)(&Params::new()).unwrap();
+        assert_eq!(off.bias(), None, "{id}");
+        for on in [Params::new().with("drift", 0.1), Params::new().with("recompute", 2.0)] {
+            assert_eq!((e.build)(&on).unwrap().bias(), Some(Bias::Consistent), "{id}");
+        }
+    }
+}

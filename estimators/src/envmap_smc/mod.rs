@@ -44,4 +44,11 @@ impl Estimator for SmcEstimator {
     fn estimate_sequence(&self, tasks: &[Task<'_>], rng: &mut StreamRng) -> Result<Vec<Rgb>, EstimateError> {
         engine::run_sequence(&self.0, tasks, rng)
     }
+    /// `L_ns` estimated afresh (every `recompute` frames, or by the drift rule of [`drift`], which
+    /// decides from the carried estimate) makes the estimate a self-normalised mean times an
+    /// independent normaliser: consistent, not unbiased. Without either the entry's declaration
+    /// stands.
+    fn bias(&self) -> Option<mcbench_core::estimator::Bias> {
+        (self.0.drift > 0.0 || self.0.recompute > 0).then_some(mcbench_core::estimator::Bias::Consistent)
+    }
 }
