@@ -232,17 +232,21 @@ impl Default for SmcParams {
     }
 }
 
+/// `c` with the two rules that estimate `L_ns` afresh: every `recompute` frames, and on drift.
+fn re_estimating(c: Config, recompute: usize, drift: f64, recompute_candidates: usize) -> Config {
+    Config { recompute, drift, recompute_candidates, ..c }
+}
+
 impl SmcParams {
     /// The engine's configuration with this `transition`: the common parameters and both re-estimate
     /// rules.
     pub fn config(&self, owner: &str, transition: Transition) -> Result<Config, ConfigError> {
-        let c = self.common().config(owner, Some(transition))?;
-        Ok(Config {
-            recompute: self.recompute,
-            drift: self.drift,
-            recompute_candidates: self.recompute_candidates,
-            ..c
-        })
+        Ok(re_estimating(
+            self.common().config(owner, Some(transition))?,
+            self.recompute,
+            self.drift,
+            self.recompute_candidates,
+        ))
     }
 
     /// The common parameters.
@@ -322,13 +326,12 @@ impl SmcBridgeParams {
     /// The engine's configuration with this `transition`: the common parameters and both re-estimate
     /// rules.
     pub fn config(&self, owner: &str, transition: Transition) -> Result<Config, ConfigError> {
-        let c = self.common().config(owner, Some(transition))?;
-        Ok(Config {
-            recompute: self.recompute,
-            drift: self.drift,
-            recompute_candidates: self.recompute_candidates,
-            ..c
-        })
+        Ok(re_estimating(
+            self.common().config(owner, Some(transition))?,
+            self.recompute,
+            self.drift,
+            self.recompute_candidates,
+        ))
     }
 
     /// The common parameters.
