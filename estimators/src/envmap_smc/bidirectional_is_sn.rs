@@ -38,12 +38,18 @@ pub static ENTRY: EstimatorEntry = EstimatorEntry {
     // -20% and every seed can.
     checks: Checks {
         params: &[("candidates", 5.0)],
-        exempt: &[Exemption {
-            testbed: "envmap-sequence",
-            variants: &["*-lns"],
-            reason:
-                "not a control here: its L_ns estimate is the unnormalised (unbiased) one; only L_r is self-normalised",
-        }],
+        exempt: &[
+            Exemption {
+                testbed: "envmap-sequence",
+                variants: &["*-lns"],
+                reason: "not a control here: its L_ns estimate is the unnormalised (unbiased) one; only L_r is self-normalised",
+            },
+            Exemption {
+                testbed: "envmap-sequence",
+                variants: &["moving-specular-wall"],
+                reason: "biased too little for this case to find: under the specular lobe behind the wall its 4-particle L_r is so noisy that 1500 repetitions detect only about 24% (its bias measured -6.7% +- 4.5%)",
+            },
+        ],
     },
 };
 

@@ -55,6 +55,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "default", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
         BedCase { variant: "occluded", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
         BedCase { variant: "soft-shadow", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
+        BedCase { variant: "lattice", params: &[("resolution", 4.0)], role: super::gradient_plane::SURFACE_PART },
     ],
 };
 

@@ -88,6 +88,7 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "moving", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving-wall", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "moving-specular-wall", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
     ],
 };
 
