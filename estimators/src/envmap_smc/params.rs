@@ -232,34 +232,39 @@ impl Default for SmcParams {
     }
 }
 
-/// `c` with the two rules that estimate `L_ns` afresh: every `recompute` frames, and on drift.
-fn re_estimating(c: Config, recompute: usize, drift: f64, recompute_candidates: usize) -> Config {
-    Config { recompute, drift, recompute_candidates, ..c }
-}
+/// The engine's configuration and the common parameters of the SMC estimators' parameter sets
+/// (the same fields but for their transition's own).
+macro_rules! smc_config {
+    ($params:ty) => {
+        impl $params {
+            /// The engine's configuration with this `transition`: the common parameters and both
+            /// rules that estimate `L_ns` afresh (every `recompute` frames, and on drift).
+            pub fn config(&self, owner: &str, transition: Transition) -> Result<Config, ConfigError> {
+                let c = self.common().config(owner, Some(transition))?;
+                Ok(Config {
+                    recompute: self.recompute,
+                    drift: self.drift,
+                    recompute_candidates: self.recompute_candidates,
+                    ..c
+                })
+            }
 
-impl SmcParams {
-    /// The engine's configuration with this `transition`: the common parameters and both re-estimate
-    /// rules.
-    pub fn config(&self, owner: &str, transition: Transition) -> Result<Config, ConfigError> {
-        Ok(re_estimating(
-            self.common().config(owner, Some(transition))?,
-            self.recompute,
-            self.drift,
-            self.recompute_candidates,
-        ))
-    }
-
-    /// The common parameters.
-    pub fn common(&self) -> Common {
-        Common {
-            candidates: self.candidates,
-            cone: self.cone,
-            p_independent: self.p_independent,
-            resampling: self.resampling,
-            threshold: self.threshold,
+            /// The common parameters.
+            pub fn common(&self) -> Common {
+                Common {
+                    candidates: self.candidates,
+                    cone: self.cone,
+                    p_independent: self.p_independent,
+                    resampling: self.resampling,
+                    threshold: self.threshold,
+                }
+            }
         }
-    }
+    };
 }
+
+smc_config!(SmcParams);
+smc_config!(SmcBridgeParams);
 
 impl ParamSet for SmcParams {
     fn validate(&self, owner: &str) -> Result<(), ConfigError> {
@@ -318,30 +323,6 @@ impl Default for SmcBridgeParams {
             p_independent: c.p_independent,
             resampling: c.resampling,
             threshold: c.threshold,
-        }
-    }
-}
-
-impl SmcBridgeParams {
-    /// The engine's configuration with this `transition`: the common parameters and both re-estimate
-    /// rules.
-    pub fn config(&self, owner: &str, transition: Transition) -> Result<Config, ConfigError> {
-        Ok(re_estimating(
-            self.common().config(owner, Some(transition))?,
-            self.recompute,
-            self.drift,
-            self.recompute_candidates,
-        ))
-    }
-
-    /// The common parameters.
-    pub fn common(&self) -> Common {
-        Common {
-            candidates: self.candidates,
-            cone: self.cone,
-            p_independent: self.p_independent,
-            resampling: self.resampling,
-            threshold: self.threshold,
         }
     }
 }
