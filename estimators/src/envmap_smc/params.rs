@@ -83,6 +83,25 @@ fn check_drift(tau: f64, m: usize) -> Result<(), ConfigError> {
     Ok(())
 }
 
+/// `common()`, the parameters every paper 004 estimator shares, for a parameter set that has them
+/// as fields.
+macro_rules! common_params {
+    ($params:ty) => {
+        impl $params {
+            /// The common parameters.
+            pub fn common(&self) -> Common {
+                Common {
+                    candidates: self.candidates,
+                    cone: self.cone,
+                    p_independent: self.p_independent,
+                    resampling: self.resampling,
+                    threshold: self.threshold,
+                }
+            }
+        }
+    };
+}
+
 /// Parameters of `bidirectional_is`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields, default)]
@@ -112,18 +131,7 @@ impl Default for BidirectionalParams {
     }
 }
 
-impl BidirectionalParams {
-    /// The common parameters.
-    pub fn common(&self) -> Common {
-        Common {
-            candidates: self.candidates,
-            cone: self.cone,
-            p_independent: self.p_independent,
-            resampling: self.resampling,
-            threshold: self.threshold,
-        }
-    }
-}
+common_params!(BidirectionalParams);
 
 impl ParamSet for BidirectionalParams {
     fn validate(&self, owner: &str) -> Result<(), ConfigError> {
@@ -161,18 +169,7 @@ impl Default for BidirectionalSnParams {
     }
 }
 
-impl BidirectionalSnParams {
-    /// The common parameters.
-    pub fn common(&self) -> Common {
-        Common {
-            candidates: self.candidates,
-            cone: self.cone,
-            p_independent: self.p_independent,
-            resampling: self.resampling,
-            threshold: self.threshold,
-        }
-    }
-}
+common_params!(BidirectionalSnParams);
 
 impl ParamSet for BidirectionalSnParams {
     fn validate(&self, owner: &str) -> Result<(), ConfigError> {
@@ -232,7 +229,7 @@ impl Default for SmcParams {
     }
 }
 
-/// The engine's configuration and the common parameters of the SMC estimators' parameter sets
+/// The engine's configuration (and the common parameters) of the SMC estimators' parameter sets
 /// (the same fields but for their transition's own).
 macro_rules! smc_config {
     ($params:ty) => {
@@ -248,18 +245,8 @@ macro_rules! smc_config {
                     ..c
                 })
             }
-
-            /// The common parameters.
-            pub fn common(&self) -> Common {
-                Common {
-                    candidates: self.candidates,
-                    cone: self.cone,
-                    p_independent: self.p_independent,
-                    resampling: self.resampling,
-                    threshold: self.threshold,
-                }
-            }
         }
+        common_params!($params);
     };
 }
 
@@ -372,18 +359,7 @@ impl Default for SmcAdaptiveParams {
     }
 }
 
-impl SmcAdaptiveParams {
-    /// The common parameters.
-    pub fn common(&self) -> Common {
-        Common {
-            candidates: self.candidates,
-            cone: self.cone,
-            p_independent: self.p_independent,
-            resampling: self.resampling,
-            threshold: self.threshold,
-        }
-    }
-}
+common_params!(SmcAdaptiveParams);
 
 impl ParamSet for SmcAdaptiveParams {
     fn validate(&self, owner: &str) -> Result<(), ConfigError> {
