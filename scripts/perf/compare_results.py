@@ -18,12 +18,14 @@ import json
 import pathlib
 import sys
 
-# TIMING_COLUMNS of harness/src/analysis/metrics.rs, and the summary.json fields and table columns that are
+# TIMING_COLUMNS of harness/src/analysis/metrics.rs (timing_columns.txt beside this script, which a
+# test keeps equal to the code's list), and the summary.json fields and table columns that are
 # derived from measured time (as scripts/slurm/smoke_test.sh strips them).
-TIMING = {"seconds", "efficiency", "seconds_median", "efficiency_mse", "p_eff", "cpu_seconds", "efficiency_wall",
-          "efficiency_renderer", "wall_seconds", "overhead", "speedup", "run_id", "overhead_wall", "speedup_wall",
-          "cpu_seconds_total", "speedup_ci_low", "speedup_ci_high", "overhead_renderer", "speedup_renderer",
-          "speedup_renderer_ci_low", "speedup_renderer_ci_high", "break_even_ray_ns", "git_commit", "notes"}
+TIMING_COLUMNS = set((pathlib.Path(__file__).parent / "timing_columns.txt").read_text().split())
+TIMING = TIMING_COLUMNS | {"wall_seconds", "overhead", "speedup", "run_id", "overhead_wall", "speedup_wall",
+                          "cpu_seconds_total", "speedup_ci_low", "speedup_ci_high", "overhead_renderer",
+                          "speedup_renderer", "speedup_renderer_ci_low", "speedup_renderer_ci_high",
+                          "break_even_ray_ns", "git_commit", "notes"}
 
 # Tables that repeat summary.json's `tests` and `paper` (compared there, time-derived claims apart).
 COPIES = {"tests.csv", "claims.csv"}
