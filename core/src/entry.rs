@@ -103,13 +103,22 @@ pub enum CaseRole {
     Check,
     /// A case of the `unbiasedness` experiment: every estimator that runs on it, at `samples` per
     /// estimate, with `reps` repetitions (quick, full). Cases of equal samples and repetitions run
-    /// as one part.
+    /// as one part. Quick repetitions of 0 leave the case out of the quick mode (for a case no
+    /// row of which can decide at a quick size; the declaring constant says why): it runs in
+    /// the full mode only.
     Unbiasedness {
         /// Samples per estimate.
         samples: u64,
-        /// Repetitions: (quick, full).
+        /// Repetitions: (quick, full); 0 quick repetitions: the full mode only.
         reps: (usize, usize),
     },
+}
+
+impl CaseRole {
+    /// Whether an `unbiasedness` case runs in the full mode only (0 quick repetitions).
+    pub fn full_only(&self) -> bool {
+        matches!(self, CaseRole::Unbiasedness { reps: (0, _), .. })
+    }
 }
 
 impl BedCase {

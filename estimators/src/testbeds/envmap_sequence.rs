@@ -50,6 +50,14 @@ use serde::{Deserialize, Serialize};
 /// repetitions (quick) or 20000 (full).
 const ENVMAP_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1500, 20_000) };
 
+/// The same part's cases that run in the full mode only: at 1500 repetitions no row of them can
+/// decide. `specular-lns`: the unbiased rows detect 3-6% and would need 12,000-55,000 repetitions
+/// to resolve 1%; `moving-specular-wall`: 4-9%, 25,000-130,000. The control is exempt on both
+/// (on `specular-lns` its `L_ns` estimate is the unbiased one; on `moving-specular-wall` 1500
+/// repetitions detect only about 24%). Their ingredients are decided on `specular`, `mixed-lns`
+/// and `moving-wall`.
+const ENVMAP_FULL_ONLY: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (0, 20_000) };
+
 /// Registry entry.
 ///
 /// ```
@@ -83,12 +91,12 @@ pub static ENTRY: TestBedEntry = TestBedEntry {
         BedCase { variant: "mixed", params: &[("resolution", 2.0), ("frames", 2.0)], role: CaseRole::Check },
         BedCase { variant: "specular", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "mixed", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
-        BedCase { variant: "specular-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "specular-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_FULL_ONLY },
         BedCase { variant: "mixed-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving-lns", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
         BedCase { variant: "moving-wall", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
-        BedCase { variant: "moving-specular-wall", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_PART },
+        BedCase { variant: "moving-specular-wall", params: &[("resolution", 2.0), ("frames", 4.0)], role: ENVMAP_FULL_ONLY },
     ],
 };
 

@@ -51,14 +51,18 @@ pub struct Part {
 }
 
 /// The parts for a mode, in registry order of their first case (the first is the experiment's
-/// sweep): every `Unbiasedness` case of every test bed, grouped by (samples, repetitions), each
-/// with every estimator whose static needs one of its cases provides.
+/// sweep): every `Unbiasedness` case of every test bed that runs in the mode (the quick mode
+/// leaves out the cases of 0 quick repetitions, [`CaseRole::full_only`]), grouped by (samples,
+/// repetitions), each with every estimator whose static needs one of its cases provides.
 pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
     type Group = ((u64, (usize, usize)), Vec<TestBedSpec>);
     let mut groups: Vec<Group> = Vec::new();
     for bed in registry.test_beds() {
         for case in bed.cases {
             let CaseRole::Unbiasedness { samples, reps } = case.role else { continue };
+            if mode == Mode::Quick && case.role.full_only() {
+                continue;
+            }
             let spec = TestBedSpec { id: bed.id.into(), variant: Some(case.variant.into()), params: case.params() };
             match groups.iter_mut().find(|g| g.0 == (samples, reps)) {
                 Some(g) => g.1.push(spec),
@@ -105,6 +109,17 @@ pub fn parts(registry: &Registry, mode: Mode) -> Vec<Part> {
         .collect()
 }
 
+/// The `unbiasedness` cases the quick mode leaves out (`test bed/variant`, registry order).
+pub fn full_only(registry: &Registry) -> Vec<String> {
+    registry
+        .test_beds()
+        .iter()
+        .flat_map(|bed| {
+            bed.cases.iter().filter(|c| c.role.full_only()).map(move |c| format!("{}/{}", bed.id, c.variant))
+        })
+        .collect()
+}
+
 /// The experiment's own sweep: the first part.
 fn first_part(registry: &Registry, mode: Mode) -> Sweep {
     let mut all = parts(registry, mode);
@@ -138,13 +153,25 @@ mod tests {
     #[test]
     fn parts_cover_every_case_and_every_estimator_that_can_run() {
         let registry = Registry::new().with_catalog(mcbench_papers::catalog());
+        let count = |quick: bool| -> usize {
+            registry
+                .test_beds()
+                .iter()
+                .map(|t| {
+                    t.cases
+                        .iter()
+                        .filter(|c| matches!(c.role, CaseRole::Unbiasedness { .. }) && !(quick && c.role.full_only()))
+                        .count()
+                })
+                .sum()
+        };
+        let full = parts(&registry, Mode::Full);
+        assert_eq!(full.iter().map(|p| p.sweep.testbeds.len()).sum::<usize>(), count(false));
         let parts = parts(&registry, Mode::Quick);
-        let cases: usize = registry
-            .test_beds()
-            .iter()
-            .map(|t| t.cases.iter().filter(|c| matches!(c.role, CaseRole::Unbiasedness { .. })).count())
-            .sum();
-        assert_eq!(parts.iter().map(|p| p.sweep.testbeds.len()).sum::<usize>(), cases);
+        assert_eq!(parts.iter().map(|p| p.sweep.testbeds.len()).sum::<usize>(), count(true));
+        // The quick mode leaves out exactly the full-only cases.
+        assert_eq!(count(false) - count(true), full_only(&registry).len());
+        assert!(!full_only(&registry).is_empty());
         for e in registry.estimators() {
             assert!(parts.iter().any(|p| p.sweep.estimators.iter().any(|s| s.id == e.id)), "{} is in no part", e.id);
         }

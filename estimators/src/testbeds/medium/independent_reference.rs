@@ -23,10 +23,9 @@
 //! adaptive reference quadrature of [`super::reference`] (test `perlin_optical_depth_error`). Either error changes the radiance by a relative amount of order
 //! (flights per path) x (optical-depth error), far below the references' standard errors.
 //!
-//! Stored files: `eq21-medium_multiple.json` is made here (2^16 paths per pixel). The Perlin file
-//! in the repository still comes from delta tracking: at panels of 1/16 a Perlin path costs about
-//! 1.5 ms, and a standard error below that file's needs about 2^13 paths per pixel (an hour on
-//! two cores); 512 paths gave RMS 0.14 and an image mean 0.2 % from the delta-tracking one.
+//! Stored files, both made here: `eq21-medium_multiple.json` (2^16 paths per pixel) and
+//! `perlin-medium_multiple.json` (4096 paths per pixel: at panels of 1/16 a Perlin path costs
+//! about 1.5 ms, so that took 55 minutes on two cores).
 
 use super::{Field, MediumBed, CENTRE, RADIUS};
 use mcbench_core::error::ConfigError;

@@ -64,9 +64,13 @@ pub static EQ21: TestBedEntry = TestBedEntry {
 const TRACKING_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1024, 32_768) };
 /// The single-scattering part: 4 samples per estimate, 1024 or 8192 repetitions.
 const SCATTER_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (1024, 8192) };
-/// The multiple-scattering part: 4 paths per estimate, 256 or 1024 repetitions (at 64 the
-/// per-repetition sums of a heavy-tailed image are too skewed for the pooled test in most seeds).
-const MULTIPLE_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (256, 1024) };
+/// The multiple-scattering part: 4 paths per estimate, 1024 repetitions, in the full mode only (at
+/// 64 the per-repetition sums of a heavy-tailed image are too skewed for the pooled test in most
+/// seeds). No row of it can decide at a quick size: on `perlin-medium` the stored reference's own
+/// error keeps every row's detectable bias above 1% at any number of repetitions, and on
+/// `eq21-medium` the rows detect about 4-6% at 256 repetitions and would need 5,000-11,000 to
+/// resolve 1%; the biased control is flagged on `gradient-box` as well.
+const MULTIPLE_PART: CaseRole = CaseRole::Unbiasedness { samples: 4, reps: (0, 1024) };
 
 /// `perlin-medium` registry entry.
 pub static PERLIN: TestBedEntry = TestBedEntry {
