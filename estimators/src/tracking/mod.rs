@@ -272,6 +272,8 @@ pub fn ray_moments(
 /// unbiased for any `sigma_samp`, but their second moment `exp(int sigma_samp ((1 - r)^2 - 1))`
 /// is `exp(7e5)` there, so no run of any length estimates anything). Checks the exact moments
 /// ([`mcbench_core::estimator::Estimator::sample_moments`]) of up to 16 transmittance integrals spread over the bed.
+/// The integrals are checked in parallel (their moments take seconds of quadrature on the Perlin
+/// field); the refusal names the first that fails, whatever the thread count.
 pub fn check_finite_variance(
     id: &str,
     est: &dyn mcbench_core::estimator::Estimator,
@@ -281,29 +283,38 @@ pub fn check_finite_variance(
     if bed.medium().is_none() {
         return Ok(());
     }
-    let budget = mcbench_core::budget::Budget::samples(1)?;
+    first_infinite_variance(est, bed).map_or(Ok(()), |i| Err(infinite_variance(id, sigma_samp, bed, i)))
+}
+
+/// The first integral checked whose one-ray variance is not finite, if any (see
+/// [`check_finite_variance`]).
+fn first_infinite_variance(est: &dyn mcbench_core::estimator::Estimator, bed: &dyn TestBed) -> Option<usize> {
+    let budget = mcbench_core::budget::Budget::samples(1).ok()?;
     let n = bed.integrals();
     let step = n.div_ceil(16).max(1);
-    for i in (0..n).step_by(step) {
-        let Some(m) = est.sample_moments(&Task::new(bed, i, budget)) else { continue };
-        if !m.rel_variance.is_finite() {
-            let (field, value) = match sigma_samp {
-                SigmaSamp::Ratio(v) => ("sigma_samp_ratio", v),
-                SigmaSamp::Absolute(v) => ("sigma_samp", v),
-                SigmaSamp::Majorant => ("sigma_samp", bed.medium().map_or(1.0, |m| m.majorant())),
-            };
-            return Err(ConfigError::invalid(
-                format!("{id}.{field}"),
-                value,
-                format!(
-                    "the variance of one ray overflows f64 on {}/{} integral {i} (paper 002 §3.4 moments): no run can estimate with it; use a sigma_samp nearer the extinction",
-                    bed.id(),
-                    bed.variant()
-                ),
-            ));
-        }
-    }
-    Ok(())
+    let checked: Vec<usize> = (0..n).step_by(step).collect();
+    let infinite = mcbench_core::parallel::map_indices(checked.len(), 0, |k| {
+        est.sample_moments(&Task::new(bed, checked[k], budget)).is_some_and(|m| !m.rel_variance.is_finite())
+    });
+    checked.iter().zip(infinite).find_map(|(&i, inf)| inf.then_some(i))
+}
+
+/// The refusal of [`check_finite_variance`] at integral `i`.
+fn infinite_variance(id: &str, sigma_samp: SigmaSamp, bed: &dyn TestBed, i: usize) -> ConfigError {
+    let (field, value) = match sigma_samp {
+        SigmaSamp::Ratio(v) => ("sigma_samp_ratio", v),
+        SigmaSamp::Absolute(v) => ("sigma_samp", v),
+        SigmaSamp::Majorant => ("sigma_samp", bed.medium().map_or(1.0, |m| m.majorant())),
+    };
+    ConfigError::invalid(
+        format!("{id}.{field}"),
+        value,
+        format!(
+            "the variance of one ray overflows f64 on {}/{} integral {i} (paper 002 §3.4 moments): no run can estimate with it; use a sigma_samp nearer the extinction",
+            bed.id(),
+            bed.variant()
+        ),
+    )
 }
 
 /// A `sigma_samp` parameter, refused unless positive (`None` when absent).

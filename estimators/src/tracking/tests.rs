@@ -263,3 +263,32 @@ fn sample_moments_match_one_ray_estimates() {
         .sample_moments(&Task::new(&radiance, 0, Budget::samples(1).unwrap()))
         .is_none());
 }
+
+/// The finite-variance check (its integrals checked in parallel) refuses a sampling extinction far
+/// below the extinction (the second moment `exp(7e5)`) by its parameter and the first integral
+/// that fails, the same on every call, and accepts one near the extinction.
+#[test]
+fn the_finite_variance_check_refuses_by_parameter_and_first_integral() {
+    let bed = MediumBed::new(
+        Field::Eq21,
+        "central-ray",
+        &Params::new().with("points", 8.0),
+        &crate::built_in_references::BUILT_IN,
+    )
+    .unwrap();
+    for id in ["double_particle", "single_particle_nonterminating"] {
+        let tiny = build(id, Params::new().with("sigma_samp", 1e-6));
+        for _ in 0..2 {
+            let err = tiny.validate(&bed).unwrap_err().to_string();
+            assert!(
+                err.contains(&format!("{id}.sigma_samp"))
+                    && err.contains("overflows f64 on eq21-medium/central-ray integral 0"),
+                "{err}"
+            );
+        }
+        let near = build(id, Params::new().with("sigma_samp", 1.0));
+        for _ in 0..2 {
+            near.validate(&bed).unwrap();
+        }
+    }
+}
