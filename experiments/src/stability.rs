@@ -129,8 +129,13 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
             error_text: one_line(&o.text),
         });
     };
-    for c in file.cases(plan.sweep.mode) {
-        let o = sc::run(&c, seed, registry);
+    // The cases are independent (each runs from its own seed): run on the pool, pushed in order.
+    let cases = file.cases(plan.sweep.mode);
+    let outcomes: Vec<Outcome> = {
+        use rayon::prelude::*;
+        cases.par_iter().map(|c| sc::run(c, seed, registry)).collect()
+    };
+    for (c, o) in cases.into_iter().zip(outcomes) {
         let bed_params = params_text(&c.bed);
         let est_params = params_text(&c.params);
         let params = match (est_params.is_empty(), bed_params.is_empty()) {
