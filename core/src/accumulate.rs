@@ -16,6 +16,7 @@ impl RgbMean {
         Self::default()
     }
     /// Adds one sample.
+    #[inline]
     pub fn push(&mut self, x: Rgb) {
         for (s, v) in self.sums.iter_mut().zip(x.0) {
             s.add(v);

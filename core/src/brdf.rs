@@ -4,10 +4,9 @@
 //! `f(w_i, w_o) = kd / pi + ks (n + 2) / (2 pi) max(0, w_r . w_i)^n`, with `w_r = 2 (n . w_o) n - w_o`
 //! the mirror of the view direction about the normal (book: testbeds.md).
 
-use crate::math::{Frame, Rgb, Vec3};
-use crate::samplers::{cosine_hemisphere, phong_lobe};
+use crate::math::{Rgb, Vec3};
+pub use crate::phong_at::PhongAt;
 use rand::Rng;
-use std::f64::consts::PI;
 
 /// Modified Phong parameters (per channel kd and ks, one exponent).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -31,13 +30,18 @@ pub struct DirectionSample {
 
 impl Phong {
     /// Evaluates `f(w_i, w_o)` for the unit normal `normal` (zero below the horizon).
+    #[inline]
     pub fn eval(&self, wi: Vec3, wo: Vec3, normal: Vec3) -> Rgb {
-        if wi.dot(normal) <= 0.0 {
-            return Rgb::ZERO;
-        }
-        let r = wo.reflect(normal);
-        let lobe = r.dot(wi).max(0.0).powf(self.n) * (self.n + 2.0) / (2.0 * PI);
-        self.kd / PI + self.ks * lobe
+        PhongAt::new(*self, wo, normal).eval(wi)
+    }
+
+    /// `f(w_i, w_o)` and [`Phong::pdf`] at one direction, bit for bit as the two calls give them,
+    /// computing the lobe's power `(w_r . w_i)^n` once (or not at all where it changes neither:
+    /// `ks = 0`, or `P_d = 1` in the pdf; see [`PhongAt`]). At many directions from one point,
+    /// [`PhongAt::eval_pdf`] also shares the point's constants.
+    #[inline]
+    pub fn eval_pdf(&self, wi: Vec3, wo: Vec3, normal: Vec3) -> (Rgb, f64) {
+        PhongAt::new(*self, wo, normal).eval_pdf(wi)
     }
 
     /// Probability of choosing the diffuse component in [`Phong::sample`]: the share of the
@@ -53,22 +57,24 @@ impl Phong {
 
     /// Density of [`Phong::sample`] per unit solid angle: the exact mixture
     /// `P_d cos(theta) / pi + (1 - P_d) (n + 1) / (2 pi) max(0, w_r . w)^n`.
+    #[inline]
     pub fn pdf(&self, wi: Vec3, wo: Vec3, normal: Vec3) -> f64 {
-        let pd = self.diffuse_weight();
-        let r = wo.reflect(normal);
-        pd * cosine_hemisphere::pdf(wi.dot(normal)) + (1.0 - pd) * phong_lobe::pdf(r.dot(wi), self.n)
+        PhongAt::new(*self, wo, normal).pdf(wi)
     }
 
     /// BRDF importance sampling: the cosine lobe with probability `P_d`, otherwise the Phong lobe
     /// around the mirror direction (which may fall below the horizon, where `f = 0`).
     pub fn sample<R: Rng + ?Sized>(&self, wo: Vec3, normal: Vec3, rng: &mut R) -> DirectionSample {
-        let pd = self.diffuse_weight();
-        let w = if rng.gen::<f64>() < pd {
-            Frame::around(normal).to_world(cosine_hemisphere::sample_local(rng))
-        } else {
-            Frame::around(wo.reflect(normal)).to_world(phong_lobe::sample_local(self.n, rng))
-        };
-        DirectionSample { w, pdf: self.pdf(w, wo, normal) }
+        let at = PhongAt::new(*self, wo, normal);
+        let w = at.sample_direction(rng);
+        DirectionSample { w, pdf: at.pdf(w) }
+    }
+
+    /// The direction of [`Phong::sample`] without its density (the same draws and bits), for a
+    /// caller that takes the density from [`Phong::eval_pdf`].
+    #[inline]
+    pub fn sample_direction<R: Rng + ?Sized>(&self, wo: Vec3, normal: Vec3, rng: &mut R) -> Vec3 {
+        PhongAt::new(*self, wo, normal).sample_direction(rng)
     }
 }
 
@@ -76,10 +82,80 @@ impl Phong {
 mod tests {
     use super::*;
     use crate::quadrature::gauss_legendre;
+    use crate::samplers::{cosine_hemisphere, phong_lobe};
+    use std::f64::consts::PI;
 
     fn glossy() -> (Phong, Vec3) {
         let brdf = Phong { kd: Rgb::splat(0.5), ks: Rgb::splat(0.3), n: 20.0 };
         (brdf, Vec3::new(0.0, -0.8, 0.6).normalize())
+    }
+
+    /// The formulas of `f` and the pdf as written out, with the lobe's power always computed.
+    fn formula_eval_pdf(b: &Phong, wi: Vec3, wo: Vec3, normal: Vec3) -> (Rgb, f64) {
+        let r = wo.reflect(normal);
+        let f = if wi.dot(normal) <= 0.0 {
+            Rgb::ZERO
+        } else {
+            let lobe = r.dot(wi).max(0.0).powf(b.n) * (b.n + 2.0) / (2.0 * PI);
+            b.kd / PI + b.ks * lobe
+        };
+        let pd = b.diffuse_weight();
+        (f, pd * cosine_hemisphere::pdf(wi.dot(normal)) + (1.0 - pd) * phong_lobe::pdf(r.dot(wi), b.n))
+    }
+
+    fn bits(f: Rgb, pdf: f64) -> [u64; 4] {
+        [f[0].to_bits(), f[1].to_bits(), f[2].to_bits(), pdf.to_bits()]
+    }
+
+    /// `eval`, `pdf` and `eval_pdf` give the bits of the written-out formulas (which skipping the
+    /// lobe's power must not change) for diffuse, glossy, black and odd materials, at random
+    /// directions over the whole sphere and at the mirror direction and the horizon; `sample` is
+    /// `sample_direction` with `pdf`.
+    #[test]
+    fn shared_and_skipped_lobe_powers_keep_every_bit() {
+        use rand::Rng;
+        let materials = [
+            Phong { kd: Rgb::splat(0.7), ks: Rgb::ZERO, n: 1.0 },
+            Phong { kd: Rgb::splat(0.05), ks: Rgb::splat(0.8), n: 10.0 },
+            Phong { kd: Rgb::splat(0.05), ks: Rgb::splat(0.8), n: 5000.0 },
+            Phong { kd: Rgb::ZERO, ks: Rgb::ZERO, n: 1.0 },
+            Phong { kd: Rgb([0.3, -0.0, 0.0]), ks: Rgb([0.0, -0.0, 0.0]), n: 3.0 },
+            Phong { kd: Rgb::splat(0.4), ks: Rgb([0.2, 0.0, 0.1]), n: 123.4 },
+            Phong { kd: Rgb::ZERO, ks: Rgb::splat(0.5), n: 0.0 },
+        ];
+        let mut rng = crate::rng::stream(5, "phong bits");
+        let unit = |rng: &mut crate::rng::StreamRng| {
+            let z: f64 = rng.gen_range(-1.0..1.0);
+            crate::samplers::spherical_direction(z, rng.gen_range(0.0..2.0 * PI))
+        };
+        let mut skipped = 0;
+        for b in &materials {
+            for _ in 0..2000 {
+                let wo = unit(&mut rng);
+                let wo = Vec3::new(wo.x, wo.y, wo.z.abs());
+                let r = wo.reflect(Vec3::Z);
+                // One point's constants, shared by all its directions.
+                let at = PhongAt::new(*b, wo, Vec3::Z);
+                for wi in [unit(&mut rng), r, Vec3::new(r.x, r.y, 0.0), Vec3::new(wo.x, -0.0, -0.0)] {
+                    let (f, pdf) = formula_eval_pdf(b, wi, wo, Vec3::Z);
+                    let want = bits(f, pdf);
+                    assert_eq!(bits(b.eval(wi, wo, Vec3::Z), b.pdf(wi, wo, Vec3::Z)), want, "{b:?} {wi:?} {wo:?}");
+                    let (g, q) = b.eval_pdf(wi, wo, Vec3::Z);
+                    assert_eq!(bits(g, q), want, "{b:?} {wi:?} {wo:?}");
+                    assert_eq!(bits(at.eval(wi), at.pdf(wi)), want);
+                    let (g, q) = at.eval_pdf(wi);
+                    assert_eq!(bits(g, q), want);
+                    skipped += usize::from(at.lobe_drops_from_value(r.dot(wi)));
+                }
+                let mut a = rng.clone();
+                let s = b.sample(wo, Vec3::Z, &mut rng);
+                assert_eq!(b.sample_direction(wo, Vec3::Z, &mut a.clone()), s.w);
+                assert_eq!(at.sample_direction(&mut a), s.w);
+                assert_eq!(s.pdf.to_bits(), b.pdf(s.w, wo, Vec3::Z).to_bits());
+            }
+        }
+        // The diffuse and black materials skip the power (the -0 diffuse channel does not).
+        assert_eq!(skipped, 2 * 2000 * 4);
     }
 
     /// The mixture pdf integrates to one over the sphere (product Gauss-Legendre in (cos theta, phi)).

@@ -42,6 +42,7 @@ pub mod parallel;
 pub mod params;
 pub mod perception;
 pub mod phase;
+pub mod phong_at;
 pub mod quadrature;
 pub mod references;
 pub mod rng;

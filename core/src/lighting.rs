@@ -1,8 +1,8 @@
 //! Analytic lighting shared by the test beds.
 
 use crate::math::{Rgb, Vec3};
+use crate::phong_at::PhongAt;
 use crate::samplers::{mixture::pick, rect_light};
-use crate::testbed::ShadingPoint;
 use rand::Rng;
 use serde::{Deserialize, Serialize};
 
@@ -79,11 +79,13 @@ impl RectLight {
         RectLight { min: [cx - 0.5 * wx, cy - 0.5 * wy], max: [cx + 0.5 * wx, cy + 0.5 * wy], z, radiance }
     }
     /// Area.
+    #[inline]
     pub fn area(&self) -> f64 {
         (self.max[0] - self.min[0]) * (self.max[1] - self.min[1])
     }
     /// Ray parameter `t` where the ray `p + t w` (unit `w`) crosses the light's rectangle from
     /// below, if it does (`p.z < z`).
+    #[inline]
     pub fn hit(&self, p: Vec3, w: Vec3) -> Option<f64> {
         if w.z <= 0.0 || p.z >= self.z {
             return None;
@@ -134,31 +136,36 @@ impl MisStrategy<'_> {
     }
 }
 
-/// One MIS round at `point`: a BRDF sample and, when `light` is set, a light sample, each weighted
-/// by the heuristic: `f(x_b) w_b / p_b + f(x_l) w_l / p_l`, an unbiased estimate of the direct
+/// One MIS round at `position`, where the surface's BRDF is `brdf` (bound to the point's view
+/// direction and normal): a BRDF sample and, when `light` is set, a light sample, each weighted by
+/// the heuristic: `f(x_b) w_b / p_b + f(x_l) w_l / p_l`, an unbiased estimate of the direct
 /// lighting. Without the light sample it is the BRDF-only estimate `f / p_b`. `integrand` gives
-/// `L_in f cos` of a direction (the caller counts it).
+/// `L_in f cos` of a direction given the BRDF value `f` there (zero below the horizon; the caller
+/// counts it): the round evaluates the BRDF and its density together ([`PhongAt::eval_pdf`], one
+/// power of the lobe for both).
 pub fn mis_round<R: Rng + ?Sized>(
-    point: &ShadingPoint,
+    position: Vec3,
+    brdf: &PhongAt,
     strategy: &MisStrategy<'_>,
     light: bool,
-    mut integrand: impl FnMut(Vec3) -> Rgb,
+    mut integrand: impl FnMut(Vec3, Rgb) -> Rgb,
     rng: &mut R,
 ) -> Rgb {
-    let p = point;
     let (lights, select) = (strategy.lights, strategy.select);
-    let b = p.brdf.sample(p.wo, p.normal, rng);
-    let fb = integrand(b.w);
+    let wb = brdf.sample_direction(rng);
+    let (f_b, pdf_b) = brdf.eval_pdf(wb);
+    let fb = integrand(wb, f_b);
     if !light {
-        return if b.pdf > 0.0 { fb / b.pdf } else { Rgb::ZERO };
+        return if pdf_b > 0.0 { fb / pdf_b } else { Rgb::ZERO };
     }
-    let mut est = fb * strategy.weight(b.pdf, light_pdf(lights, select, p.position, b.w));
+    let mut est = fb * strategy.weight(pdf_b, light_pdf(lights, select, position, wb));
     let j = pick(select, rng);
-    let ls = rect_light::sample(&lights[j], p.position, rng);
-    let fl = integrand(ls.w);
-    let pl = light_pdf(lights, select, p.position, ls.w);
+    let wl = rect_light::sample_direction(&lights[j], position, rng);
+    let (f_l, pdf_bl) = brdf.eval_pdf(wl);
+    let fl = integrand(wl, f_l);
+    let pl = light_pdf(lights, select, position, wl);
     if pl > 0.0 {
-        est += fl * strategy.weight(pl, p.brdf.pdf(ls.w, p.wo, p.normal));
+        est += fl * strategy.weight(pl, pdf_bl);
     }
     est
 }

@@ -24,22 +24,27 @@ impl Vec3 {
         Vec3 { x, y, z }
     }
     /// Dot product.
+    #[inline]
     pub fn dot(self, o: Vec3) -> f64 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
     /// Cross product.
+    #[inline]
     pub fn cross(self, o: Vec3) -> Vec3 {
         Vec3::new(self.y * o.z - self.z * o.y, self.z * o.x - self.x * o.z, self.x * o.y - self.y * o.x)
     }
     /// Euclidean length.
+    #[inline]
     pub fn length(self) -> f64 {
         self.dot(self).sqrt()
     }
     /// The vector scaled to unit length.
+    #[inline]
     pub fn normalize(self) -> Vec3 {
         self / self.length()
     }
     /// Mirror of `self` about the unit normal `n`: `2 (n . v) n - v`.
+    #[inline]
     pub fn reflect(self, n: Vec3) -> Vec3 {
         n * (2.0 * n.dot(self)) - self
     }
@@ -47,30 +52,35 @@ impl Vec3 {
 
 impl Add for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn add(self, o: Vec3) -> Vec3 {
         Vec3::new(self.x + o.x, self.y + o.y, self.z + o.z)
     }
 }
 impl Sub for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn sub(self, o: Vec3) -> Vec3 {
         Vec3::new(self.x - o.x, self.y - o.y, self.z - o.z)
     }
 }
 impl Mul<f64> for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn mul(self, s: f64) -> Vec3 {
         Vec3::new(self.x * s, self.y * s, self.z * s)
     }
 }
 impl Div<f64> for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn div(self, s: f64) -> Vec3 {
         Vec3::new(self.x / s, self.y / s, self.z / s)
     }
 }
 impl Neg for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn neg(self) -> Vec3 {
         Vec3::new(-self.x, -self.y, -self.z)
     }
@@ -89,6 +99,7 @@ pub struct Frame {
 
 impl Frame {
     /// A frame around the unit vector `w` (branchless construction of Duff et al. 2017).
+    #[inline]
     pub fn around(w: Vec3) -> Frame {
         let sign = 1.0f64.copysign(w.z);
         let a = -1.0 / (sign + w.z);
@@ -98,10 +109,12 @@ impl Frame {
         Frame { u, v, w }
     }
     /// Local coordinates `(x, y, z)` to world.
+    #[inline]
     pub fn to_world(&self, l: Vec3) -> Vec3 {
         self.u * l.x + self.v * l.y + self.w * l.z
     }
     /// World to local coordinates.
+    #[inline]
     pub fn to_local(&self, d: Vec3) -> Vec3 {
         Vec3::new(d.dot(self.u), d.dot(self.v), d.dot(self.w))
     }
@@ -115,18 +128,22 @@ impl Rgb {
     /// All channels zero.
     pub const ZERO: Rgb = Rgb([0.0; 3]);
     /// The same value in every channel.
+    #[inline]
     pub const fn splat(v: f64) -> Rgb {
         Rgb([v, v, v])
     }
     /// Mean over channels.
+    #[inline]
     pub fn mean(self) -> f64 {
         (self.0[0] + self.0[1] + self.0[2]) / 3.0
     }
     /// Applies `f` to every channel.
+    #[inline]
     pub fn map(self, f: impl Fn(f64) -> f64) -> Rgb {
         Rgb([f(self.0[0]), f(self.0[1]), f(self.0[2])])
     }
     /// True when every channel is finite.
+    #[inline]
     pub fn is_finite(self) -> bool {
         self.0.iter().all(|c| c.is_finite())
     }
@@ -134,41 +151,48 @@ impl Rgb {
 
 impl Add for Rgb {
     type Output = Rgb;
+    #[inline]
     fn add(self, o: Rgb) -> Rgb {
         Rgb([self.0[0] + o.0[0], self.0[1] + o.0[1], self.0[2] + o.0[2]])
     }
 }
 impl AddAssign for Rgb {
+    #[inline]
     fn add_assign(&mut self, o: Rgb) {
         *self = *self + o;
     }
 }
 impl Sub for Rgb {
     type Output = Rgb;
+    #[inline]
     fn sub(self, o: Rgb) -> Rgb {
         Rgb([self.0[0] - o.0[0], self.0[1] - o.0[1], self.0[2] - o.0[2]])
     }
 }
 impl Mul<f64> for Rgb {
     type Output = Rgb;
+    #[inline]
     fn mul(self, s: f64) -> Rgb {
         self.map(|c| c * s)
     }
 }
 impl Mul for Rgb {
     type Output = Rgb;
+    #[inline]
     fn mul(self, o: Rgb) -> Rgb {
         Rgb([self.0[0] * o.0[0], self.0[1] * o.0[1], self.0[2] * o.0[2]])
     }
 }
 impl Div<f64> for Rgb {
     type Output = Rgb;
+    #[inline]
     fn div(self, s: f64) -> Rgb {
         self.map(|c| c / s)
     }
 }
 impl Index<usize> for Rgb {
     type Output = f64;
+    #[inline]
     fn index(&self, i: usize) -> &f64 {
         &self.0[i]
     }

@@ -7,12 +7,14 @@
 //! cargo bench -p mcbench-papers --bench cpu -- media 1024 is0_cv0 is1_cv2      # gradient-box albedo 0.8, 16x16
 //! cargo bench -p mcbench-papers --bench cpu -- surface 1024 brdf_is0_cv0 is1_cv2 brdf_is1_cv2   # gradient-plane 16x16
 //! cargo bench -p mcbench-papers --bench cpu -- envmap 10 bidirectional_is smc smc_bridge   # envmap-sequence mixed 16x16, 10 frames, N = 16
+//! cargo bench -p mcbench-papers --bench cpu -- image 4 uniform_image pmc_ip threshold_image   # checker-image default 48x48, CPU per pixel sample
 //! cargo bench -p mcbench-papers --bench cpu -- tracking 20000 bare bare_chained delta_tracking ratio_tracking   # eq21-medium, CPU per fetch
 //! ```
 //! Options after the ids: `storage=f32` (the caches' cell precision), `reps=K` (repeat K times,
 //! each line its own measurement), `res=R` (the image side of gradient-plane and envmap-sequence,
-//! default 16), `variant=V` (of envmap-sequence, default `mixed`), any other `name=number` (an estimator parameter, e.g.
-//! `candidates=256`). Media report CPU per path, surfaces per sample, envmap per pixel and frame
+//! default 16; checker-image default 48), `variant=V` (of envmap-sequence, default `mixed`; of
+//! checker-image, default `default`), any other `name=number` (an estimator parameter, e.g.
+//! `candidates=256`). Media report CPU per path, surfaces and images per (pixel) sample, envmap per pixel and frame
 //! (with `samples` = target evaluations).
 
 use mcbench_core::budget::Budget;
@@ -21,6 +23,7 @@ use mcbench_core::rng::stream;
 use mcbench_core::task::Task;
 use mcbench_core::testbed::TestBed;
 use mcbench_papers::builtins;
+use mcbench_papers::testbeds::checker_image::CheckerImage;
 use mcbench_papers::testbeds::gradient_box::GradientBox;
 
 fn thread_cpu_seconds() -> f64 {
@@ -121,15 +124,17 @@ fn main() {
     }
     // Run by `cargo bench -p mcbench-papers -- <criterion options>` (no mode, or an option's value
     // first): nothing to measure.
-    let Some(mode) = args.first().filter(|m| ["media", "surface", "envmap"].contains(&m.as_str())) else {
-        eprintln!("usage: cpu <media|surface|envmap|tracking> <spp|frames|estimates> <ids...> [storage=f32] [reps=K]");
+    let Some(mode) = args.first().filter(|m| ["media", "surface", "envmap", "image"].contains(&m.as_str())) else {
+        eprintln!(
+            "usage: cpu <media|surface|envmap|image|tracking> <spp|frames|estimates> <ids...> [storage=f32] [reps=K]"
+        );
         return;
     };
     let size: u64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1024);
     let mut params = Params::new();
     let mut reps = 1;
-    let mut res = 16.0;
-    let mut variant = "mixed".to_string();
+    let mut res = if mode == "image" { 48.0 } else { 16.0 };
+    let mut variant = (if mode == "image" { "default" } else { "mixed" }).to_string();
     let mut ids = Vec::new();
     for a in &args[2..] {
         match a.split_once('=') {
@@ -164,6 +169,11 @@ fn main() {
             .expect("bed"),
             16,
             "frame",
+        ),
+        "image" => (
+            Box::new(CheckerImage::without_reference(&variant, &Params::new().with("resolution", res)).expect("bed")),
+            size,
+            "sample",
         ),
         other => panic!("unknown mode {other}"),
     };

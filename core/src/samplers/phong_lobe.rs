@@ -12,7 +12,16 @@ pub fn pdf(cos_alpha: f64, n: f64) -> f64 {
     if cos_alpha <= 0.0 {
         return 0.0;
     }
-    (n + 1.0) / (2.0 * PI) * cos_alpha.powf(n)
+    pdf_of_power(cos_alpha, n, cos_alpha.powf(n))
+}
+
+/// [`pdf`] given `power = cos_alpha^n` (any value where `cos_alpha <= 0`, where the density is
+/// zero): for a caller that needs the same power elsewhere (the Phong BRDF's value).
+pub fn pdf_of_power(cos_alpha: f64, n: f64, power: f64) -> f64 {
+    if cos_alpha <= 0.0 {
+        return 0.0;
+    }
+    (n + 1.0) / (2.0 * PI) * power
 }
 
 /// A direction about the lobe axis (+z) in local coordinates.

@@ -11,6 +11,13 @@ use rand::Rng;
 /// A direction from `p` towards a uniform point on `light`, with its solid-angle density.
 /// `p` must lie below the light's plane (every point of the floor scenes does).
 pub fn sample<R: Rng + ?Sized>(light: &RectLight, p: Vec3, rng: &mut R) -> DirectionSample {
+    let w = sample_direction(light, p, rng);
+    DirectionSample { w, pdf: pdf(light, p, w) }
+}
+
+/// The direction of [`sample`] without its density (the same draws and the same bits), for a
+/// caller that needs the density of a mixture of lights at it instead.
+pub fn sample_direction<R: Rng + ?Sized>(light: &RectLight, p: Vec3, rng: &mut R) -> Vec3 {
     let (u, v): (f64, f64) = (rng.gen(), rng.gen());
     let y = Vec3::new(
         light.min[0] + u * (light.max[0] - light.min[0]),
@@ -18,8 +25,7 @@ pub fn sample<R: Rng + ?Sized>(light: &RectLight, p: Vec3, rng: &mut R) -> Direc
         light.z,
     );
     let d = y - p;
-    let w = d.normalize();
-    DirectionSample { w, pdf: pdf(light, p, w) }
+    d.normalize()
 }
 
 /// The solid-angle density of [`sample`] at the unit direction `w` (zero off the light).

@@ -27,6 +27,7 @@ impl NeumaierSum {
     }
 
     /// Adds one term.
+    #[inline]
     pub fn add(&mut self, x: f64) {
         let t = self.sum + x;
         if self.sum.abs() >= x.abs() {

@@ -173,7 +173,9 @@ impl<'a> Task<'a> {
     /// The hemispherical-integral probe of this integral, when the scene has one.
     pub fn hemisphere(&self) -> Option<HemisphereProbe<'_>> {
         let scene = self.bed.hemisphere()?;
-        Some(HemisphereProbe { point: scene.shading(self.integral), scene, task: self })
+        let point = scene.shading(self.integral);
+        let brdf = crate::phong_at::PhongAt::new(point.brdf, point.wo, point.normal);
+        Some(HemisphereProbe { point, brdf, scene, task: self })
     }
     /// The counted medium probe of this integral, when the scene has a medium.
     pub fn medium(&self) -> Option<MediumProbe<'_>> {

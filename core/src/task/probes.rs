@@ -27,12 +27,17 @@ pub struct HemisphereProbe<'a> {
     pub(super) scene: &'a dyn HemisphereScene,
     pub(super) task: &'a Task<'a>,
     pub(super) point: ShadingPoint,
+    pub(super) brdf: crate::phong_at::PhongAt,
 }
 
 impl HemisphereProbe<'_> {
     /// The shading point (geometry and BRDF are known locally and cost nothing).
     pub fn point(&self) -> &ShadingPoint {
         &self.point
+    }
+    /// The point's BRDF bound to its view direction and normal (free).
+    pub fn brdf(&self) -> &crate::phong_at::PhongAt {
+        &self.brdf
     }
     /// Counts `n` radiance-cache operations on this integral ([`Task::count_cache_ops`]).
     pub fn count_cache_ops(&self, n: u64) {
@@ -46,14 +51,19 @@ impl HemisphereProbe<'_> {
     /// The integrand `L_in(w_i) f(w_i, w_o) cos(theta_i)`: one sample and one ray. Zero below the
     /// horizon (still one sample: the estimator drew it).
     pub fn integrand(&self, wi: Vec3) -> Rgb {
+        self.integrand_with_brdf(wi, self.brdf.eval(wi))
+    }
+    /// [`HemisphereProbe::integrand`] given the BRDF value `f = f(w_i, w_o)` at `wi` (from
+    /// [`crate::phong_at::PhongAt::eval_pdf`], which shares its work with the density): the same
+    /// count and bits.
+    pub fn integrand_with_brdf(&self, wi: Vec3, f: Rgb) -> Rgb {
         self.task.count(|c| c.samples += 1);
-        let p = &self.point;
-        let cos = wi.dot(p.normal);
+        let cos = wi.dot(self.point.normal);
         if cos <= 0.0 {
             return Rgb::ZERO;
         }
         self.task.count(|c| c.rays += 1);
-        self.scene.incident(self.task.integral, wi) * p.brdf.eval(wi, p.wo, p.normal) * cos
+        self.scene.incident(self.task.integral, wi) * f * cos
     }
 }
 

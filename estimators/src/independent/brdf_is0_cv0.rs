@@ -33,15 +33,18 @@ pub struct BrdfIs0Cv0;
 impl Estimator for BrdfIs0Cv0 {
     fn estimate(&self, task: &Task<'_>, rng: &mut StreamRng) -> Result<Rgb, EstimateError> {
         super::average(task, rng, |probe, _frame, rng| {
-            let p = probe.point();
-            let s = p.brdf.sample(p.wo, p.normal, rng);
+            // The BRDF's value and density at the drawn direction from one call (one power of
+            // the lobe for both, as `Phong::sample` and the integrand would give them).
+            let brdf = probe.brdf();
+            let w = brdf.sample_direction(rng);
+            let (f, pdf) = brdf.eval_pdf(w);
             // The mixture pdf is positive wherever the integrand is non-zero (the cosine lobe
             // covers the hemisphere when kd > 0, the Phong lobe covers its support when kd = 0);
             // a zero pdf can only come with a zero integrand, which contributes nothing.
-            if s.pdf > 0.0 {
-                probe.integrand(s.w) / s.pdf
+            if pdf > 0.0 {
+                probe.integrand_with_brdf(w, f) / pdf
             } else {
-                probe.integrand(s.w) * 0.0
+                probe.integrand_with_brdf(w, f) * 0.0
             }
         })
     }

@@ -52,7 +52,7 @@ impl Mis {
     /// ([`mcbench_core::lighting::mis_round`] through the counted integrand).
     pub fn round(&self, probe: &HemisphereProbe<'_>, select: &[f64], light: bool, rng: &mut StreamRng) -> Rgb {
         let strategy = MisStrategy { lights: probe.lights(), select, power: self.power };
-        mis_round(probe.point(), &strategy, light, |w| probe.integrand(w), rng)
+        mis_round(probe.point().position, probe.brdf(), &strategy, light, |w, f| probe.integrand_with_brdf(w, f), rng)
     }
 }
 

@@ -154,22 +154,23 @@ impl SmcSurface {
     fn tracked_step<S: Scalar>(&self, state: &mut State<S>, probe: &HemisphereProbe<'_>, rng: &mut StreamRng) -> Rgb {
         let cache = &mut state.cache;
         let domain = cache.domain();
-        let point = probe.point();
-        let brdf = &point.brdf;
+        let brdf = probe.brdf();
         let big_g = cache.integral(self.cv);
         let use_smc = state.tracker.prefers_smc();
-        // The drawn direction, its parameters and cell (the one the record goes to), both pdfs.
-        let (w, st, p_cache, p_brdf) = if use_smc {
+        // The drawn direction, its parameters and cell (the one the record goes to), the cache's
+        // pdf; the BRDF's value and pdf come from one call (one power of the lobe for both).
+        let (w, st, p_cache) = if use_smc {
             let s = cache.sample(rng);
             let w = state.frame.to_world(domain.direction(s.st));
-            (w, Some((s.st, cache.grid().cell_at(s.st))), s.pdf, brdf.pdf(w, point.wo, point.normal))
+            (w, Some((s.st, cache.grid().cell_at(s.st))), s.pdf)
         } else {
-            let d = brdf.sample(point.wo, point.normal, rng);
+            let w = brdf.sample_direction(rng);
             // Below the horizon the direction is outside the cache's domain (and f = 0 there).
-            let st = domain.st_of(state.frame.to_local(d.w)).map(|st| (st, cache.grid().cell_at(st)));
-            (d.w, st, st.map_or(0.0, |(_, cell)| cache.pdf_of_cell(cell)), d.pdf)
+            let st = domain.st_of(state.frame.to_local(w)).map(|st| (st, cache.grid().cell_at(st)));
+            (w, st, st.map_or(0.0, |(_, cell)| cache.pdf_of_cell(cell)))
         };
-        let f = probe.integrand(w);
+        let (f_brdf, p_brdf) = brdf.eval_pdf(w);
+        let f = probe.integrand_with_brdf(w, f_brdf);
         let (smc, g) = match st {
             // p_cache > 0 on the whole hemisphere (uniform, or every tree leaf >= 1).
             Some((st, _)) if p_cache > 0.0 => {

@@ -25,6 +25,7 @@ use mcbench_core::error::ConfigError;
 use mcbench_core::lighting::{light_selection, mis_round, MisStrategy};
 use mcbench_core::math::{Rgb, Vec3};
 use mcbench_core::params::{check_count, parse, ParamSet, ParamSpec, Params};
+use mcbench_core::phong_at::PhongAt;
 use mcbench_core::references::{ReferenceKey, ReferenceSource};
 use mcbench_core::rng::StreamRng;
 use mcbench_core::testbed::{ImagePlaneScene, Needs, Reference, ShadingPoint, TestBed};
@@ -186,17 +187,19 @@ impl ImagePlaneScene for CheckerImage {
             return (Rgb::ZERO, 1);
         };
         let strategy = MisStrategy { lights: &self.geometry.lights, select: &self.select, power: 1.0 };
+        let brdf = PhongAt::new(point.brdf, point.wo, point.normal);
         let mut rays = 1u64;
         let mut sum = Rgb::ZERO;
         for _ in 0..self.light_samples {
-            let integrand = |w: Vec3| {
+            // `f` is the BRDF value at `w` (`brdf.eval`, computed with its density).
+            let integrand = |w: Vec3, f: Rgb| {
                 if w.dot(point.normal) <= 0.0 {
                     return Rgb::ZERO;
                 }
                 rays += 1;
-                self.geometry.incident(point.position, w) * point.brdf.eval(w, point.wo, point.normal) * w.z
+                self.geometry.incident(point.position, w) * f * w.z
             };
-            sum += mis_round(&point, &strategy, true, integrand, rng);
+            sum += mis_round(point.position, &brdf, &strategy, true, integrand, rng);
         }
         (sum / self.light_samples as f64, rays)
     }
