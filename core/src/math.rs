@@ -20,10 +20,12 @@ impl Vec3 {
     /// The unit vector +z.
     pub const Z: Vec3 = Vec3 { x: 0.0, y: 0.0, z: 1.0 };
     /// Builds a vector from its components.
+    #[inline]
     pub const fn new(x: f64, y: f64, z: f64) -> Self {
         Vec3 { x, y, z }
     }
     /// Dot product.
+    #[inline]
     pub fn dot(self, o: Vec3) -> f64 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
@@ -47,30 +49,35 @@ impl Vec3 {
 
 impl Add for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn add(self, o: Vec3) -> Vec3 {
         Vec3::new(self.x + o.x, self.y + o.y, self.z + o.z)
     }
 }
 impl Sub for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn sub(self, o: Vec3) -> Vec3 {
         Vec3::new(self.x - o.x, self.y - o.y, self.z - o.z)
     }
 }
 impl Mul<f64> for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn mul(self, s: f64) -> Vec3 {
         Vec3::new(self.x * s, self.y * s, self.z * s)
     }
 }
 impl Div<f64> for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn div(self, s: f64) -> Vec3 {
         Vec3::new(self.x / s, self.y / s, self.z / s)
     }
 }
 impl Neg for Vec3 {
     type Output = Vec3;
+    #[inline]
     fn neg(self) -> Vec3 {
         Vec3::new(-self.x, -self.y, -self.z)
     }
@@ -115,6 +122,7 @@ impl Rgb {
     /// All channels zero.
     pub const ZERO: Rgb = Rgb([0.0; 3]);
     /// The same value in every channel.
+    #[inline]
     pub const fn splat(v: f64) -> Rgb {
         Rgb([v, v, v])
     }
@@ -123,6 +131,7 @@ impl Rgb {
         (self.0[0] + self.0[1] + self.0[2]) / 3.0
     }
     /// Applies `f` to every channel.
+    #[inline]
     pub fn map(self, f: impl Fn(f64) -> f64) -> Rgb {
         Rgb([f(self.0[0]), f(self.0[1]), f(self.0[2])])
     }
@@ -134,46 +143,54 @@ impl Rgb {
 
 impl Add for Rgb {
     type Output = Rgb;
+    #[inline]
     fn add(self, o: Rgb) -> Rgb {
         Rgb([self.0[0] + o.0[0], self.0[1] + o.0[1], self.0[2] + o.0[2]])
     }
 }
 impl AddAssign for Rgb {
+    #[inline]
     fn add_assign(&mut self, o: Rgb) {
         *self = *self + o;
     }
 }
 impl Sub for Rgb {
     type Output = Rgb;
+    #[inline]
     fn sub(self, o: Rgb) -> Rgb {
         Rgb([self.0[0] - o.0[0], self.0[1] - o.0[1], self.0[2] - o.0[2]])
     }
 }
 impl Mul<f64> for Rgb {
     type Output = Rgb;
+    #[inline]
     fn mul(self, s: f64) -> Rgb {
         self.map(|c| c * s)
     }
 }
 impl Mul for Rgb {
     type Output = Rgb;
+    #[inline]
     fn mul(self, o: Rgb) -> Rgb {
         Rgb([self.0[0] * o.0[0], self.0[1] * o.0[1], self.0[2] * o.0[2]])
     }
 }
 impl Div<f64> for Rgb {
     type Output = Rgb;
+    #[inline]
     fn div(self, s: f64) -> Rgb {
         self.map(|c| c / s)
     }
 }
 impl Index<usize> for Rgb {
     type Output = f64;
+    #[inline]
     fn index(&self, i: usize) -> &f64 {
         &self.0[i]
     }
 }
 impl IndexMut<usize> for Rgb {
+    #[inline]
     fn index_mut(&mut self, i: usize) -> &mut f64 {
         &mut self.0[i]
     }
