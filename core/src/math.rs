@@ -20,6 +20,7 @@ impl Vec3 {
     /// The unit vector +z.
     pub const Z: Vec3 = Vec3 { x: 0.0, y: 0.0, z: 1.0 };
     /// Builds a vector from its components.
+    #[inline]
     pub const fn new(x: f64, y: f64, z: f64) -> Self {
         Vec3 { x, y, z }
     }
@@ -198,6 +199,7 @@ impl Index<usize> for Rgb {
     }
 }
 impl IndexMut<usize> for Rgb {
+    #[inline]
     fn index_mut(&mut self, i: usize) -> &mut f64 {
         &mut self.0[i]
     }

@@ -59,12 +59,24 @@ impl Phase {
         }
     }
 
-    /// A new unit direction around the unit propagation direction `dir`, with its density.
+    /// A new unit direction drawn from the phase function around the unit propagation direction
+    /// `dir`, with the phase function's value at the drawn scattering cosine. Two random numbers:
+    /// the cosine ([`Phase::sample_cos`]), then the azimuth `phi = 2 pi u`.
+    ///
+    /// A uniform cosine (isotropic, and Henyey-Greenstein with `|g| < 1e-6`, which
+    /// [`Phase::sample_cos`] draws as isotropic) gives a direction uniform on the sphere whatever
+    /// the axis, so it is built directly in world coordinates (`z = cos`, azimuth `phi` about
+    /// `+z`) with no frame around `dir`; other phase functions rotate the local direction into
+    /// the frame around `dir` (Duff et al. 2017).
     pub fn sample<R: Rng + ?Sized>(self, dir: Vec3, rng: &mut R) -> (Vec3, f64) {
         let cos = self.sample_cos(rng);
         let phi = 2.0 * PI * rng.gen::<f64>();
-        let w = Frame::around(dir).to_world(spherical_direction(cos, phi));
-        (w, self.eval(cos))
+        let local = spherical_direction(cos, phi);
+        match self {
+            Phase::Isotropic => (local, ISOTROPIC),
+            Phase::HenyeyGreenstein(g) if g.abs() < 1e-6 => (local, self.eval(dir.dot(local))),
+            _ => (Frame::around(dir).to_world(local), self.eval(cos)),
+        }
     }
 
     /// A short name for tables (`isotropic`, `hg(0.1)`, `rayleigh`).
@@ -90,6 +102,24 @@ mod tests {
             let total: f64 = x.iter().zip(&w).map(|(&c, &wi)| wi * 2.0 * PI * phase.eval(c)).sum();
             assert!((total - 1.0).abs() < 1e-9, "{phase:?}: {total}");
         }
+    }
+
+    /// A uniform cosine draws in world coordinates: the same numbers give the same direction
+    /// whatever the propagation direction (isotropic and near-zero `g`), with `z` the drawn cosine;
+    /// HG(0.1) still turns with `dir`.
+    #[test]
+    fn uniform_cosines_draw_without_a_frame() {
+        use crate::rng::StreamKey;
+        let key = StreamKey { seed: 5, testbed: "t", estimator: "e", budget: 0, rep: 0, integral: 0 };
+        let dirs = [Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.3, -0.5, 0.8).normalize()];
+        for phase in [Phase::Isotropic, Phase::HenyeyGreenstein(1e-7)] {
+            let draws: Vec<Vec3> = dirs.iter().map(|&d| phase.sample(d, &mut key.rng()).0).collect();
+            assert!(draws.iter().all(|&w| w == draws[0]), "{phase:?}: {draws:?}");
+            let u: f64 = key.rng().gen();
+            assert_eq!(draws[0].z, 1.0 - 2.0 * u, "{phase:?}");
+        }
+        let hg = Phase::HenyeyGreenstein(0.1);
+        assert_ne!(hg.sample(dirs[0], &mut key.rng()).0, hg.sample(dirs[1], &mut key.rng()).0);
     }
 
     /// Teeth: HG(0.1) samples checked against the isotropic density are rejected.

@@ -142,6 +142,7 @@ impl<'a> Task<'a> {
         self.costs.get()
     }
     /// True while the budget is not spent (checked before each sample).
+    #[inline]
     pub fn more(&self) -> bool {
         let c = self.costs.get();
         if let Stop::Samples(n) = self.stop {

@@ -199,10 +199,12 @@ pub struct MediumProbe<'a> {
 
 impl MediumProbe<'_> {
     /// The ray of this integral.
+    #[inline]
     pub fn ray(&self) -> &MediumRay {
         &self.ray
     }
     /// Starts one sample (a transmittance ray or a particle path): one sample and one ray.
+    #[inline]
     pub fn start_sample(&self) {
         self.task.count(|c| {
             c.samples += 1;
@@ -222,6 +224,7 @@ impl MediumProbe<'_> {
     }
     /// Counts one more free-flight segment of the current path (the ray leaving a scattering
     /// vertex): a renderer traces it like any other ray, so `rays` counts segments, not paths.
+    #[inline]
     pub fn scattered_ray(&self) {
         self.task.count(|c| {
             c.rays += 1;
@@ -229,6 +232,7 @@ impl MediumProbe<'_> {
         });
     }
     /// Real extinction at `p`: one fetch.
+    #[inline]
     pub fn sigma_t(&self, p: Vec3) -> f64 {
         self.task.count(|c| c.fetches += 1);
         self.scene.sigma_t(p)
@@ -245,22 +249,27 @@ impl MediumProbe<'_> {
         }
     }
     /// The majorant the scene declares.
+    #[inline]
     pub fn majorant(&self) -> f64 {
         self.scene.majorant()
     }
     /// The albedo.
+    #[inline]
     pub fn albedo(&self) -> f64 {
         self.scene.albedo()
     }
     /// Clips a ray to the medium's bounding volume (geometry only: free).
+    #[inline]
     pub fn clip(&self, origin: Vec3, dir: Vec3) -> Option<(f64, f64)> {
         self.scene.clip(origin, dir)
     }
     /// Environment radiance from direction `w` leaving the scene (free: analytic lighting).
+    #[inline]
     pub fn environment(&self, w: Vec3) -> Rgb {
         self.scene.environment(w)
     }
     /// The phase function (a scene constant: free).
+    #[inline]
     pub fn phase(&self) -> crate::phase::Phase {
         self.scene.phase()
     }
@@ -269,6 +278,7 @@ impl MediumProbe<'_> {
         self.task.note(name, value);
     }
     /// True while this integral's budget is not spent ([`Task::more`]).
+    #[inline]
     pub fn more(&self) -> bool {
         self.task.more()
     }
