@@ -18,6 +18,7 @@
 //! 0.5 in single). Time: the scan reads one 128-byte run of coefficients (two cache lines) instead
 //! of the `log2 B` deepest levels of the tree, each on its own cache line in a large cache.
 
+use super::huge_pages::Span;
 use super::partial_sum_tree::PartialSumTree;
 use super::storage::Scalar;
 use rand::Rng;
@@ -45,6 +46,9 @@ pub struct CellSampler {
 }
 
 impl CellSampler {
+    /// Bytes of block sums prefetched before a descent: the levels above 64 blocks (the whole tree
+    /// up to 1 024 cells in double precision).
+    const PREFETCH_TREE_BYTES: usize = 512;
     /// Headroom (as a power of two) between the largest `q` after a rescale and the cap.
     const HEADROOM_BITS: u32 = 12;
     /// A rescale is due when the total falls this many powers of two below the target.
@@ -148,13 +152,46 @@ impl CellSampler {
     /// (so its probability, [`CellSampler::probability_of_weight`], needs no second quantisation).
     #[inline]
     pub fn sample_weighted<S: Scalar, R: Rng + ?Sized>(&self, coefficients: &[S], rng: &mut R) -> Option<(usize, u64)> {
+        self.draw::<false, S, R>(coefficients, rng, |_| {})
+    }
+
+    /// [`CellSampler::sample_weighted`] for storage larger than the caches (the same cell for the
+    /// same random numbers): the block sums are prefetched before the descent, the block's
+    /// coefficients before the scan, and `block_found` gets the range of cells the scan is about
+    /// to read (to prefetch what the caller reads after the draw). For a small cache, whose lines
+    /// are in L1 already, the prefetches are only extra instructions.
+    #[inline]
+    pub fn sample_weighted_prefetching<S: Scalar, R: Rng + ?Sized>(
+        &self,
+        coefficients: &[S],
+        rng: &mut R,
+        block_found: impl FnOnce(std::ops::Range<usize>),
+    ) -> Option<(usize, u64)> {
+        self.draw::<true, S, R>(coefficients, rng, block_found)
+    }
+
+    #[inline(always)]
+    fn draw<const PREFETCH: bool, S: Scalar, R: Rng + ?Sized>(
+        &self,
+        coefficients: &[S],
+        rng: &mut R,
+        block_found: impl FnOnce(std::ops::Range<usize>),
+    ) -> Option<(usize, u64)> {
+        if PREFETCH {
+            self.blocks.prefetch(Self::PREFETCH_TREE_BYTES);
+        }
         let total = self.total();
         if total == 0 {
             return None;
         }
         let (b, x) = self.blocks.find(rng.gen_range(0..total));
         let start = b << self.block_shift;
-        let cells = &coefficients[start..(start + (1 << self.block_shift)).min(self.cells)];
+        let range = start..(start + (1 << self.block_shift)).min(self.cells);
+        let cells = &coefficients[range.clone()];
+        if PREFETCH {
+            super::prefetch::lines(cells, BLOCK_BYTES);
+            block_found(range);
+        }
         let sum = self.blocks.weight(b);
         let (i, q) = if x < sum / 2 { self.scan_up(cells, x) } else { self.scan_down(cells, sum - x) };
         Some((start + i, q))
@@ -200,6 +237,10 @@ impl CellSampler {
     /// Heap bytes held.
     pub fn bytes(&self) -> usize {
         self.blocks.bytes()
+    }
+    /// The heap buffer of the block sums.
+    pub fn storage_span(&self) -> Span {
+        self.blocks.storage_span()
     }
 }
 

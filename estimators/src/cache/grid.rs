@@ -19,6 +19,7 @@
 //! divides the counters by a divisor (4 on surfaces), never rounding a counter down to zero.
 
 use super::domain::{Domain, St};
+use super::huge_pages::{span_of, Span};
 use super::storage::Scalar;
 use mcbench_core::math::Rgb;
 use mcbench_core::stats::NeumaierSum;
@@ -148,6 +149,19 @@ impl<S: Scalar> Grid<S> {
     /// The stored PDF coefficients, in cell order.
     pub fn pdf_slice(&self) -> &[S] {
         &self.pdf
+    }
+    /// Requests the lines of the RGB coefficients and counters of cells `first..first + count`
+    /// (clamped to the grid: nothing when `first` is past its end).
+    #[inline]
+    pub fn prefetch_cells(&self, first: usize, count: usize) {
+        if first < self.cells.len() {
+            let end = first.saturating_add(count).min(self.cells.len());
+            super::prefetch::lines(&self.cells[first..end], usize::MAX);
+        }
+    }
+    /// The heap buffers of the cells (RGB and counters, PDF coefficients).
+    pub fn storage_spans(&self) -> [Span; 2] {
+        [span_of(&self.cells), span_of(&self.pdf)]
     }
     /// The record counter of a cell.
     pub fn count(&self, cell: usize) -> u32 {

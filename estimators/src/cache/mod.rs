@@ -8,7 +8,9 @@
 //! - [`cell_sampler`]: samples cells for `is1` (sums of blocks of cells in a flat
 //!   [`partial_sum_tree`], the cells' weights recomputed from the coefficients);
 //! - [`domain`]: the equal-solid-angle `(s, t)` parameterisations;
-//! - [`storage`]: the precision switch.
+//! - [`storage`]: the precision switch;
+//! - [`prefetch`]: software prefetch of the lines a draw reads next;
+//! - [`huge_pages`]: 2 MiB pages behind large storage (the octree of a medium).
 //!
 //! The cache PDF (`is1`, §4.2) picks a cell with probability proportional to its PDF coefficient
 //! and then a point uniformly inside it (order 0). The [`cell_sampler`] quantises the coefficients
@@ -20,7 +22,9 @@
 pub mod cell_sampler;
 pub mod domain;
 pub mod grid;
+pub mod huge_pages;
 pub mod partial_sum_tree;
+pub mod prefetch;
 pub mod reconstruction;
 pub mod storage;
 
@@ -127,10 +131,36 @@ impl<S: Scalar> RadianceCache<S> {
     /// uniformly inside the cell; uniform over the domain before the first refinement.
     #[inline]
     pub fn sample<R: Rng + ?Sized>(&self, rng: &mut R) -> CacheSample {
+        self.draw::<false, R>(rng)
+    }
+
+    /// [`RadianceCache::sample`] (the same direction for the same random numbers) prefetching the
+    /// lines the draw and then `g` read, for a cache among more storage than the CPU caches hold
+    /// (a leaf of a large octree): see [`CellSampler::sample_weighted_prefetching`].
+    #[inline]
+    pub fn sample_prefetching<R: Rng + ?Sized>(&self, rng: &mut R) -> CacheSample {
+        self.draw::<true, R>(rng)
+    }
+
+    #[inline(always)]
+    fn draw<const PREFETCH: bool, R: Rng + ?Sized>(&self, rng: &mut R) -> CacheSample {
         let Some(tree) = self.tree_active() else {
             return self.sample_uniform(rng);
         };
-        let (cell, q) = tree.sample_weighted(self.grid.pdf_slice(), rng).expect("an active tree has a positive total");
+        let coefficients = self.grid.pdf_slice();
+        let (cell, q) = if PREFETCH {
+            // While the block's coefficients are scanned, its cells' RGB and those of the rows
+            // above and below (the bilinear `g` reads two rows) load.
+            tree.sample_weighted_prefetching(coefficients, rng, |r| {
+                let ns = self.grid.resolution().0;
+                self.grid.prefetch_cells(r.start, r.len());
+                self.grid.prefetch_cells(r.start + ns, r.len());
+                self.grid.prefetch_cells(r.start.wrapping_sub(ns), r.len());
+            })
+        } else {
+            tree.sample_weighted(coefficients, rng)
+        }
+        .expect("an active tree has a positive total");
         let (i, j) = self.grid.cell_ij(cell);
         let (ns, nt) = self.grid.resolution();
         let st = St { s: (i as f64 + rng.gen::<f64>()) / ns as f64, t: (j as f64 + rng.gen::<f64>()) / nt as f64 };
@@ -205,6 +235,11 @@ impl<S: Scalar> RadianceCache<S> {
         if let Some(tree) = &mut self.tree {
             tree.rebuild(self.grid.pdf_slice());
         }
+    }
+
+    /// The heap buffers of the cache: the cells' and, with `is1`, the block sums'.
+    pub fn storage_spans(&self) -> impl Iterator<Item = huge_pages::Span> + '_ {
+        self.grid.storage_spans().into_iter().chain(self.tree.as_ref().map(|t| t.storage_span()))
     }
 
     /// Heap bytes held: the cells plus the tree.

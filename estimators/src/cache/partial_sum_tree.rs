@@ -13,6 +13,7 @@
 //! reported probability is positive: a bias. The cache quantises its PDF coefficients instead; see
 //! [`super::RadianceCache`].)
 
+use super::huge_pages::{span_of, Span};
 use rand::Rng;
 
 /// A flat partial-sum tree over integer weights.
@@ -107,6 +108,16 @@ impl PartialSumTree {
     /// Heap bytes held.
     pub fn bytes(&self) -> usize {
         self.nodes.len() * std::mem::size_of::<u64>()
+    }
+    /// Requests the lines of the first `max_bytes` bytes of nodes (the levels nearest the root)
+    /// ahead of a descent, which otherwise waits for one level before reading the next.
+    #[inline]
+    pub fn prefetch(&self, max_bytes: usize) {
+        super::prefetch::lines(&self.nodes, max_bytes);
+    }
+    /// The heap buffer of the nodes.
+    pub fn storage_span(&self) -> Span {
+        span_of(&self.nodes)
     }
 }
 

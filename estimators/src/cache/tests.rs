@@ -114,3 +114,42 @@ fn long_runs_and_fireflies() {
     assert!(big_g.is_finite() && big_g[0] > 0.0);
     assert!(cache.grid().pdf_coefficients().all(|p| p > 0.0 && p.is_finite()));
 }
+
+/// The storage spans a cache reports (for huge pages) are exactly its heap bytes: cells, PDF
+/// coefficients and, with `is1`, the block sums.
+#[test]
+fn storage_spans_are_the_heap_bytes() {
+    let with = shaped_cache::<f64>(3);
+    let spans: Vec<_> = with.storage_spans().collect();
+    assert_eq!(spans.len(), 3);
+    assert_eq!(spans.iter().map(|s| s.1).sum::<usize>(), with.bytes());
+    assert!(spans.iter().all(|&(start, len)| start % std::mem::align_of::<f32>() == 0 && len > 0));
+    let without = RadianceCache::<f32>::new(CacheConfig::surface(false));
+    assert_eq!(without.storage_spans().map(|s| s.1).sum::<usize>(), without.bytes());
+    assert_eq!(without.storage_spans().count(), 2);
+}
+
+/// The prefetching draw is the same draw: the same cells, directions and densities for the same
+/// random numbers, in both precisions (prefetches change timing only).
+#[test]
+fn prefetching_draws_are_the_same_draws() {
+    fn check<S: Scalar>() {
+        let cache = shaped_cache::<S>(4);
+        let (mut a, mut b) = (stream(9, "prefetch"), stream(9, "prefetch"));
+        for _ in 0..50_000 {
+            assert_eq!(cache.sample(&mut a), cache.sample_prefetching(&mut b));
+        }
+        let tree = CellSampler::new(cache.grid().pdf_slice());
+        for _ in 0..10_000 {
+            let plain = tree.sample_weighted(cache.grid().pdf_slice(), &mut a);
+            let mut block = None;
+            let with = tree.sample_weighted_prefetching(cache.grid().pdf_slice(), &mut b, |r| block = Some(r));
+            assert_eq!(plain, with);
+            // The range handed out for prefetching is the drawn cell's block.
+            let (cell, q) = with.expect("a positive total");
+            assert!(q > 0 && block.is_some_and(|r| r.contains(&cell) && r.len() <= 32));
+        }
+    }
+    check::<f64>();
+    check::<f32>();
+}

@@ -8,12 +8,25 @@
 //! dimensionality of the split) but never rounded down to zero, and the node splits into eight
 //! children each holding a copy of that doubled cache. Only leaves hold caches, so a cache's
 //! resolution is tied to its depth.
+//!
+//! Past 4 MiB of cells, and again after every 1/16 of growth, the octree asks for 2 MiB pages
+//! behind its buffers ([`crate::cache::huge_pages`]); the contents, hence results, are unchanged.
 
+use crate::cache::huge_pages::{self, span_of, HUGE_PAGE};
 use crate::cache::{CacheConfig, RadianceCache, Scalar, St};
 use mcbench_core::math::{Rgb, Vec3};
 
 /// Counters are divided by the dimensionality of a split: 2 x 2 directional x 8 spatial = 32.
 pub const SPLIT_DIVISOR: u32 = 32;
+
+/// The storage, in bytes of cells (4 MiB), from which the octree asks for huge pages behind it
+/// (see [`huge_pages`]): past the 1 MiB L2, where each link of a vertex's chain of loads misses
+/// and a 4 KiB page per link also misses the TLB.
+const HUGE_PAGES_FROM: usize = 2 * HUGE_PAGE;
+
+/// The storage, in bytes of cells, from which a vertex's draw prefetches (see
+/// [`RadianceCache::sample_prefetching`]): the 1 MiB L2.
+const PREFETCH_FROM: usize = 1 << 20;
 
 /// One node, 32 bytes, so the descent of [`Octree::leaf_of`] walks a compact array (the caches
 /// live apart, in [`Octree::caches`]).
@@ -54,9 +67,15 @@ pub struct Octree<S: Scalar> {
     splits: usize,
     cells: usize,
     depth: u32,
+    /// The cell count at which the storage is next backed with huge pages (1/16 more than at the
+    /// last time, so the share of storage growth left on small pages stays small).
+    next_huge_pages: usize,
 }
 
 impl<S: Scalar> Octree<S> {
+    /// Bytes per cell: RGB and counter, PDF coefficient.
+    const CELL_BYTES: usize = 4 * std::mem::size_of::<S>() + 4;
+
     /// One node covering the cube of centre `center` and half-size `half`, holding an empty cache
     /// (two cells on the sphere). `config.counter_divisor` is set to [`SPLIT_DIVISOR`].
     pub fn new(center: Vec3, half: f64, config: CacheConfig) -> Self {
@@ -72,6 +91,7 @@ impl<S: Scalar> Octree<S> {
             splits: 0,
             cells,
             depth: 0,
+            next_huge_pages: HUGE_PAGES_FROM / Self::CELL_BYTES,
         }
     }
 
@@ -94,6 +114,13 @@ impl<S: Scalar> Octree<S> {
             let k = usize::from(p.x >= c.x) | usize::from(p.y >= c.y) << 1 | usize::from(p.z >= c.z) << 2;
             i = n.children as usize + k;
         }
+    }
+
+    /// Whether the storage outgrew the L2, so that a draw from a leaf's cache should prefetch
+    /// ([`RadianceCache::sample_prefetching`]; the drawn direction is the same either way).
+    #[inline]
+    pub fn prefetches(&self) -> bool {
+        self.cells * Self::CELL_BYTES >= PREFETCH_FROM
     }
 
     /// Leaf splits so far (each turns one leaf into eight), `O(1)`.
@@ -142,7 +169,20 @@ impl<S: Scalar> Octree<S> {
         }
         self.cells += cache.grid().cells() - before;
         self.split(leaf);
+        if self.cells >= self.next_huge_pages {
+            self.back_with_huge_pages();
+        }
         true
+    }
+
+    /// Asks for huge pages behind every buffer of the octree (the nodes, the caches and their
+    /// cells); the mapping changes, the contents do not.
+    #[cold]
+    #[inline(never)]
+    fn back_with_huge_pages(&mut self) {
+        self.next_huge_pages = self.cells + self.cells / 16;
+        let own = [span_of(&self.nodes), span_of(&self.depths), span_of(&self.caches)];
+        huge_pages::back_with_huge_pages(own.into_iter().chain(self.caches.iter().flat_map(|c| c.storage_spans())));
     }
 
     /// Replaces leaf `i` by eight children, each holding a copy of its (already doubled) cache: the

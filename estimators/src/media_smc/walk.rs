@@ -172,6 +172,7 @@ impl Vertex {
         let cache = tree.cache_of(leaf);
         let draw = match sampling {
             Sampling::Uniform => cache.sample_uniform(rng),
+            Sampling::Cache if tree.prefetches() => cache.sample_prefetching(rng),
             Sampling::Cache => cache.sample(rng),
         };
         // The reads of `g` (the cells around the drawn one) start before the direction's
