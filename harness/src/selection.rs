@@ -5,8 +5,8 @@
 //! The registry a run sees is narrowed ([`Selection::apply`]), so the experiments derived from it
 //! (`unbiasedness`, `calibration`) and the conformance suite run only the named plug-ins; when
 //! estimators are named, a test bed none of them runs on is left out with a one-line note, so a
-//! reference it would need is never asked for. Fixed sweeps keep only their named entries
-//! ([`Selection::filter_sweep`]).
+//! reference it would need is never asked for. Fixed sweeps keep only their named entries and the
+//! claims on them alone ([`Selection::filter_sweep`]; a note names each claim left out).
 //!
 //! ```
 //! use mcbench::selection::Selection;
@@ -21,6 +21,7 @@
 //! assert!(e.contains("--estimators") && e.contains("no_such*") && e.contains("integrand_mc"), "{e}");
 //! ```
 
+use crate::config::claim_spec::ClaimSpec;
 use crate::config::Sweep;
 use crate::registry::Registry;
 use mcbench_core::error::ConfigError;
@@ -119,11 +120,51 @@ impl Selection {
         Ok((out, notes))
     }
 
-    /// `sweep` with only the named estimators and test beds.
+    /// `sweep` with only the named estimators and test beds. Its claims that name an estimator or
+    /// a test bed left out (or a speed-up measured against a baseline left out) go with them
+    /// ([`Selection::claims_left_out`] says which), and a baseline left out is no longer the
+    /// sweep's, so a named experiment runs on any part of it.
     pub fn filter_sweep(&self, mut sweep: Sweep) -> Sweep {
+        let keep: Vec<bool> = sweep.claims.iter().map(|c| self.keeps_claim(&sweep, c)).collect();
+        let mut kept = keep.iter();
+        sweep.claims.retain(|_| *kept.next().unwrap_or(&true));
         sweep.estimators.retain(|e| any(&self.estimators, &e.id));
         sweep.testbeds.retain(|t| any(&self.testbeds, &t.id));
+        if sweep.baseline.as_ref().is_some_and(|b| !sweep.estimators.iter().any(|e| &e.name() == b)) {
+            sweep.baseline = None;
+        }
         sweep
+    }
+
+    /// One note per claim of `sweep` that [`Selection::filter_sweep`] leaves out, naming it.
+    pub fn claims_left_out(&self, sweep: &Sweep) -> Vec<String> {
+        sweep
+            .claims
+            .iter()
+            .filter(|c| !self.keeps_claim(sweep, c))
+            .map(|c| {
+                format!(
+                    "note: a claim on {} naming {} left out: it names an estimator or test bed outside the selection",
+                    c.testbed().unwrap_or("every test bed"),
+                    c.estimators().join(", ")
+                )
+            })
+            .collect()
+    }
+
+    /// Whether every estimator and test bed `claim` names (a speed-up's baseline, its own or the
+    /// sweep's, included) is in the selection.
+    fn keeps_claim(&self, sweep: &Sweep, claim: &ClaimSpec) -> bool {
+        let kept_estimator = |name: &str| {
+            sweep.estimators.iter().any(|e| e.name() == name && any(&self.estimators, &e.id))
+                || !sweep.estimators.iter().any(|e| e.name() == name)
+        };
+        let kept_bed = |bed: &str| any(&self.testbeds, bed.split('/').next().unwrap_or(bed));
+        let baseline = match claim {
+            ClaimSpec::Speedup { baseline: None, .. } => sweep.baseline.as_deref(),
+            _ => None,
+        };
+        claim.estimators().into_iter().chain(baseline).all(kept_estimator) && claim.testbed().is_none_or(kept_bed)
     }
 }
 
@@ -147,6 +188,71 @@ mod tests {
         ] {
             assert_eq!(glob(p, n), m, "{p} {n}");
         }
+    }
+
+    #[test]
+    fn a_sweep_keeps_only_the_claims_on_what_is_selected() {
+        let file: crate::config::SweepFile = toml::from_str(
+            r#"
+            name = "x"
+            reps = 4
+            budgets = [4, 16, 64]
+            baseline = "is0_cv0"
+            [[testbeds]]
+            id = "gradient-plane"
+            [[testbeds]]
+            id = "gradient-box"
+            variant = "albedo-0.5"
+            [[estimators]]
+            id = "is0_cv0"
+            [[estimators]]
+            id = "is1_cv2"
+            [[claims]]
+            kind = "slope"
+            testbed = "gradient-plane/default"
+            estimator = "is0_cv0"
+            value = -0.5
+            text = "independent MC converges with slope -0.5"
+            [[claims]]
+            kind = "slope"
+            testbed = "gradient-box/albedo-0.5"
+            estimator = "is0_cv0"
+            value = -0.5
+            text = "the same in the box"
+            [[claims]]
+            kind = "speedup"
+            testbed = "gradient-plane/default"
+            estimator = "is1_cv2"
+            value = 2.0
+            text = "is1_cv2 against the sweep's baseline"
+            "#,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        let sweep = file.apply(None, crate::config::Mode::Quick).unwrap();
+        sweep.validate().unwrap();
+        let texts = |s: &Sweep| s.claims.iter().map(|c| c.testbed().unwrap_or("-").to_string()).collect::<Vec<_>>();
+
+        // Only is0_cv0: the speed-up (is1_cv2 against is0_cv0) leaves, the slopes stay.
+        let only = Selection::new(Some("is0_cv0"), None);
+        let notes = only.claims_left_out(&sweep);
+        let narrowed = only.filter_sweep(sweep.clone());
+        assert_eq!(texts(&narrowed), ["gradient-plane/default", "gradient-box/albedo-0.5"]);
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(notes[0].contains("is1_cv2") && notes[0].contains("left out"), "{notes:?}");
+        narrowed.validate().expect("the narrowed sweep is valid");
+
+        // Only is1_cv2: the baseline is left out, so is the speed-up measured against it.
+        let narrowed = Selection::new(Some("is1_cv2"), None).filter_sweep(sweep.clone());
+        assert!(narrowed.claims.is_empty() && narrowed.baseline.is_none(), "{narrowed:?}");
+        narrowed.validate().expect("valid without a baseline");
+
+        // Only the box: the plane's claims leave.
+        let narrowed = Selection::new(None, Some("gradient-box")).filter_sweep(sweep.clone());
+        assert_eq!(texts(&narrowed), ["gradient-box/albedo-0.5"]);
+
+        // Nothing named: the sweep as it was.
+        assert_eq!(Selection::new(None, None).filter_sweep(sweep.clone()), sweep);
+        assert!(Selection::new(None, None).claims_left_out(&sweep).is_empty());
     }
 
     #[test]

@@ -19,7 +19,7 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
                 format!("name one (valid: {}) or give --config", valid_experiments(registry)),
             )
         })?;
-        plans.push((None, selection(args).filter_sweep(file.apply(None, mode)?)));
+        plans.push((None, narrowed(args, file.apply(None, mode)?)));
     } else {
         for name in names {
             let def = registry.experiment(name)?;
@@ -28,7 +28,7 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
                 Some(f) => f.clone().apply(Some(sweep), mode)?,
                 None => sweep,
             };
-            plans.push((Some(def), selection(args).filter_sweep(sweep)));
+            plans.push((Some(def), narrowed(args, sweep)));
         }
     }
     let (mut prepared, mut times) = (Vec::new(), Vec::new());
@@ -201,6 +201,15 @@ pub(super) fn in_config(e: HarnessError, args: &RunArgs, file_claims: bool) -> H
 /// The `--estimators` and `--testbeds` of a run.
 pub(super) fn selection(args: &RunArgs) -> Selection {
     Selection::new(args.estimators.as_deref(), args.testbeds.as_deref())
+}
+
+/// `sweep` narrowed to the run's selection, printing a note for each claim left out.
+fn narrowed(args: &RunArgs, sweep: crate::config::Sweep) -> crate::config::Sweep {
+    let only = selection(args);
+    for n in only.claims_left_out(&sweep) {
+        eprintln!("{n}");
+    }
+    only.filter_sweep(sweep)
 }
 
 /// `registry` narrowed to `only`, printing a note for each test bed left out.
