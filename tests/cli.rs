@@ -49,6 +49,25 @@ fn bad_input_exits_2_with_one_line_and_writes_nothing() {
     );
     assert_bad_input(d, &["run", "surface-smc", "--repetitions", "rounds"], "only the unbiasedness experiment");
     assert_bad_input(d, &["run", "unbiasedness", "--repetitions", "sometimes"], "--repetitions");
+    // A share of the rounds' budget: a number in (0, 1], with the rounds, not for calibration.
+    let rounds = ["run", "unbiasedness", "--repetitions", "rounds", "--rounds-budget"];
+    assert_bad_input(d, &[&rounds[..], &["abc"]].concat(), "--rounds-budget");
+    assert_bad_input(d, &[&rounds[..], &["nan"]].concat(), "--rounds-budget = NaN");
+    assert_bad_input(d, &[&rounds[..], &["0"]].concat(), "--rounds-budget = 0: must lie in (0, 1]");
+    assert_bad_input(d, &[&rounds[..], &["-0.5"]].concat(), "--rounds-budget = -0.5");
+    assert_bad_input(d, &[&rounds[..], &["1.5"]].concat(), "--rounds-budget = 1.5");
+    assert_bad_input(d, &[&rounds[..], &["inf"]].concat(), "--rounds-budget = inf");
+    assert_bad_input(d, &["run", "unbiasedness", "--rounds-budget", "0.3"], "needs --repetitions rounds");
+    assert_bad_input(
+        d,
+        &["run", "unbiasedness", "--repetitions", "fixed", "--rounds-budget", "0.3"],
+        "--rounds-budget = 0.3: a budget of the rounds needs --repetitions rounds",
+    );
+    assert_bad_input(
+        d,
+        &["run", "calibration", "--repetitions", "rounds", "--rounds-budget", "0.5"],
+        "--rounds-budget = 0.5: calibration measures the rule of the rounds without a shared budget",
+    );
     assert_bad_input(d, &["conformance", "--testbeds", "no-such-bed"], "--testbeds = no-such-bed");
     assert_bad_input(d, &["conformance", "no_such_estimator"], "integrand_mc");
     assert_bad_input(d, &["run"], "experiment");

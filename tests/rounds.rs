@@ -1,6 +1,7 @@
 //! `unbiasedness --repetitions rounds` end to end on a small selection: bit-identical tables at 1
-//! and 2 threads, the planted biased control flagged, and a row stopped at `R` repetitions equal to
-//! the fixed mode's row at `--reps R`.
+//! and 2 threads, the planted biased control flagged, a row stopped at `R` repetitions equal to
+//! the fixed mode's row at `--reps R`, and a share of the budget (`--rounds-budget`) bounding the
+//! work the rounds spend.
 
 use mcbench::registry::Registry;
 use std::path::Path;
@@ -75,4 +76,40 @@ fn rounds_are_deterministic_flag_the_control_and_stop_where_the_fixed_mode_would
     let columns = ["reps", "mse", "variance", "bias"];
     let variant = &row["variant"];
     assert_eq!(summary(dirs[0].path(), variant, &columns), summary(dirs[2].path(), variant, &columns));
+}
+
+/// The work the rounds spent and the fixed mode's work, from the run's note in summary.json
+/// (`work S of the fixed mode's F`, or `work S of the budget B (share X of the fixed mode's F)`).
+fn work(root: &Path) -> (u64, u64) {
+    let text = std::fs::read_to_string(root.join("results/unbiasedness/summary.json")).expect("summary.json");
+    let summary: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let notes = summary["meta"]["notes"].as_array().expect("notes");
+    let note = notes.iter().filter_map(|n| n.as_str()).find(|n| n.contains("rounds: ")).expect("rounds note");
+    let number_after = |key: &str| -> u64 {
+        let at = note.find(key).unwrap_or_else(|| panic!("'{key}' in {note}")) + key.len();
+        note[at..].split(|c: char| !c.is_ascii_digit()).next().and_then(|d| d.parse().ok()).expect(note)
+    };
+    (number_after("work "), number_after("of the fixed mode's "))
+}
+
+#[test]
+fn a_share_of_the_budget_bounds_the_work_of_the_rounds_whatever_the_threads() {
+    let dirs: Vec<tempfile::TempDir> = (0..3).map(|_| tempfile::tempdir().expect("tempdir")).collect();
+    let share = ["--repetitions", "rounds", "--rounds-budget", "0.3"];
+    let one = table(dirs[0].path(), &[&share[..], &["--threads", "1"]].concat());
+    let two = table(dirs[1].path(), &[&share[..], &["--threads", "2"]].concat());
+    assert_eq!(one, two, "the same table at 1 and 2 threads");
+    assert_eq!(work(dirs[0].path()), work(dirs[1].path()), "the same work at 1 and 2 threads");
+    let whole = table(dirs[2].path(), &["--repetitions", "rounds", "--threads", "2"]);
+    let ((spent, fixed), (whole_spent, whole_fixed)) = (work(dirs[0].path()), work(dirs[2].path()));
+    assert_eq!(fixed, whole_fixed, "the same fixed-mode work");
+    assert!(spent as f64 <= 0.3 * fixed as f64, "spent {spent} of a share 0.3 of {fixed}");
+    assert!(spent < whole_spent, "spent {spent} at a share 0.3, {whole_spent} at the whole budget");
+    let rows = |t: &[std::collections::BTreeMap<String, String>]| -> Vec<(String, String)> {
+        t.iter().map(|r| (r["estimator"].clone(), r["variant"].clone())).collect()
+    };
+    assert_eq!(rows(&one), rows(&whole), "the same rows in the same order");
+    for control in one.iter().filter(|r| r["estimator"].starts_with("clamped_is0_cv0")) {
+        assert_eq!(control["verdict"], "biased", "{control:?}");
+    }
 }

@@ -233,9 +233,14 @@ struct RunArgs {
     #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = clap::value_parser!(u64).range(1..=crate::config::limits::MAX_THREADS))]
     threads: Option<u64>,
     /// How `unbiasedness` spends its repetitions: fixed (every row its part's) or rounds (doubling
-    /// until decided, within the fixed mode's work; calibration measures that rule; no --shard)
+    /// until decided, within the fixed mode's work or the share --rounds-budget sets; calibration
+    /// measures that rule; no --shard)
     #[arg(long, value_name = "MODE", value_enum, default_value_t = RepetitionsArg::Fixed, hide_possible_values = true)]
     repetitions: RepetitionsArg,
+    /// With --repetitions rounds: the share of the fixed mode's work the rounds may spend
+    /// (0 < SHARE <= 1; default 1)
+    #[arg(long, value_name = "SHARE", allow_negative_numbers = true)]
+    rounds_budget: Option<f64>,
     /// Results root.
     #[arg(long, value_name = "DIR", default_value = "results")]
     results: PathBuf,

@@ -31,6 +31,7 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
             plans.push((Some(def), narrowed(args, sweep)));
         }
     }
+    let share = rounds_share(args)?;
     let (mut prepared, mut times) = (Vec::new(), Vec::new());
     for (def, mut sweep) in plans {
         if let Some(s) = args.seed {
@@ -40,7 +41,7 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
             sweep.reps = r as usize;
         }
         if args.repetitions == RepetitionsArg::Rounds {
-            in_rounds(&mut sweep, args)?;
+            in_rounds(&mut sweep, args, share)?;
         }
         // A config that reshapes a named experiment without claims of its own keeps the
         // experiment's, judged `not measured` where the reshaped sweep lacks their cells.
@@ -141,19 +142,42 @@ pub(super) fn run(names: &[String], args: &RunArgs, registry: &Registry) -> Resu
     Ok(())
 }
 
+/// `--rounds-budget`: the share of the fixed mode's work the rounds may spend, in `(0, 1]`, only
+/// with `--repetitions rounds`; 1 when not given.
+fn rounds_share(args: &RunArgs) -> Result<f64> {
+    let Some(share) = args.rounds_budget else { return Ok(1.0) };
+    let refuse = |reason: &str| Err(mcbench_core::error::ConfigError::invalid("--rounds-budget", share, reason).into());
+    if args.repetitions != RepetitionsArg::Rounds {
+        return refuse("a budget of the rounds needs --repetitions rounds");
+    }
+    if !(share > 0.0 && share <= 1.0) {
+        return refuse("must lie in (0, 1]: the share of the fixed mode's work the rounds may spend");
+    }
+    Ok(share)
+}
+
 /// `--repetitions rounds`: only `unbiasedness` runs in rounds (`calibration` measures its rule),
 /// and not sharded (a shard cannot see which rows the others left open); the first part runs its
-/// first round, the fixed-mode repetitions kept in the sweep's mode.
-fn in_rounds(sweep: &mut crate::config::Sweep, args: &RunArgs) -> Result<()> {
+/// first round, the fixed-mode repetitions and the budget's `share` kept in the sweep's mode.
+fn in_rounds(sweep: &mut crate::config::Sweep, args: &RunArgs, share: f64) -> Result<()> {
     let refuse = |reason: String| -> Result<()> {
         Err(mcbench_core::error::ConfigError::invalid("--repetitions", "rounds", reason).into())
     };
     if args.shard.is_some() {
         return refuse("a sharded run cannot follow the rounds (each round depends on every row's last look): run it without --shard".into());
     }
-    sweep.repetitions = crate::config::Repetitions::Rounds { fixed_reps: sweep.reps };
+    sweep.repetitions = crate::config::Repetitions::Rounds { fixed_reps: sweep.reps, budget_share: share };
     if sweep.experiment == crate::calibration::NAME {
-        // Calibration measures the rule of the rounds on its own seeds; its sweep runs as it is.
+        // Calibration measures the rule of the rounds on its own seeds, every row free to take all
+        // its looks: there is no shared budget to take a share of.
+        if let Some(given) = args.rounds_budget {
+            return Err(mcbench_core::error::ConfigError::invalid(
+                "--rounds-budget",
+                given,
+                "calibration measures the rule of the rounds without a shared budget (a budget only stops rows earlier): run it without --rounds-budget",
+            )
+            .into());
+        }
         return Ok(());
     }
     if sweep.experiment != crate::unbiasedness::NAME {

@@ -20,6 +20,7 @@
 pub mod claim_spec;
 pub mod declare;
 pub mod limits;
+mod repetitions;
 
 use crate::config::claim_spec::ClaimSpec;
 use crate::error::{HarnessError, Result};
@@ -27,6 +28,7 @@ pub use crate::plan::cost_model::CostModel;
 use mcbench_core::budget::{Budget, BudgetKind};
 use mcbench_core::error::ConfigError;
 use mcbench_core::params::{ParamValue, Params};
+pub use repetitions::Repetitions;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -142,36 +144,6 @@ pub struct Sweep {
     /// (fixed) in files written before it existed and in every fixed sweep.
     #[serde(default, skip_serializing_if = "Repetitions::is_fixed")]
     pub repetitions: Repetitions,
-}
-
-/// How the `unbiasedness` experiment spends its repetitions (`--repetitions`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Repetitions {
-    /// Every row runs its part's repetitions.
-    #[default]
-    Fixed,
-    /// Rows run in rounds of doubling repetitions until decided or the budget is spent
-    /// ([`crate::unbiasedness::rounds`]); `fixed_reps` is the first part's repetitions in the
-    /// fixed mode (what `--reps` set), from which every part's first round and the budget follow.
-    Rounds {
-        /// The first part's fixed-mode repetitions.
-        fixed_reps: usize,
-    },
-}
-
-impl Repetitions {
-    /// Whether this is the fixed mode.
-    pub fn is_fixed(&self) -> bool {
-        *self == Repetitions::Fixed
-    }
-    /// `fixed` or `rounds`.
-    pub fn name(&self) -> &'static str {
-        match self {
-            Repetitions::Fixed => "fixed",
-            Repetitions::Rounds { .. } => "rounds",
-        }
-    }
 }
 
 impl Sweep {

@@ -24,7 +24,8 @@
 //!
 //! The budget is deterministic: repetitions x integrals x samples per estimate, summed over every
 //! cell and pilot, at most what the fixed mode spends (each part's repetitions for the cell and as
-//! many for its pilot). Repetition `r` of a cell draws from the same stream in any round, and the
+//! many for its pilot), or a share of it ([`budget`]). The share does not enter the bound above:
+//! a budget only decides when rows stop. Repetition `r` of a cell draws from the same stream in any round, and the
 //! blocks of a grown cell are merged in block order, so a row stopped at `R` repetitions holds
 //! exactly the moments of a fixed-mode cell of `R` repetitions, whatever the thread count; its
 //! bootstrap blocks ([`rep_block_size`]) have the fixed-mode layout at `R` (adjacent blocks merge
@@ -59,6 +60,16 @@ pub fn look_alpha() -> f64 {
 pub fn first_round(fixed: usize) -> usize {
     let step = FIRST_ROUND_STEP;
     fixed.div_ceil(8).div_ceil(step).max(1).saturating_mul(step).max(MIN_FIRST_REPS.next_multiple_of(step))
+}
+
+/// The budget of the rounds: `share` of `fixed_work` (the fixed mode's work, [`Entry::fixed_cost`]
+/// summed), in whole millionths of it so that it is exact integer arithmetic; the whole of it at a
+/// share of 1 (`--rounds-budget`). The first round is run whatever the budget: a budget under its
+/// work grows no row.
+pub fn budget(fixed_work: u64, share: f64) -> u64 {
+    const MILLION: u64 = 1_000_000;
+    let millionths = (share * MILLION as f64).round().clamp(0.0, MILLION as f64) as u64;
+    (u128::from(fixed_work) * u128::from(millionths) / u128::from(MILLION)) as u64
 }
 
 /// One row of the rounds: a cell and its pilot (the gate) with the tests of their last look.

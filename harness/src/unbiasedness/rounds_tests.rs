@@ -69,6 +69,19 @@ fn first_rounds_are_an_eighth_in_whole_steps_and_at_least_the_minimum() {
     assert!(FIRST_ROUND_STEP.is_multiple_of(REP_BLOCK) && FIRST_ROUND_STEP.is_multiple_of(MAX_REP_BLOCKS));
 }
 
+#[test]
+fn a_budget_is_its_share_of_the_fixed_work_in_exact_integers() {
+    let fixed = 327_780_000_u64;
+    assert_eq!(budget(fixed, 1.0), fixed, "the whole share is the fixed work itself");
+    assert_eq!(budget(fixed, 0.3), 98_334_000);
+    assert_eq!(budget(fixed, 0.45), 147_501_000);
+    // Beyond f64's exact integers the whole share stays exact.
+    let huge = u64::MAX - 7;
+    assert_eq!(budget(huge, 1.0), huge);
+    assert!(budget(huge, 0.5) <= huge / 2 + 1);
+    assert_eq!(budget(0, 0.3), 0);
+}
+
 fn combined(verdict: &str, reps_needed: Option<f64>) -> Vec<TestRow> {
     let pooled = TestRow { test: "pooled_t".into(), p_value: 0.5, ..Default::default() };
     vec![pooled, TestRow { test: "combined".into(), verdict: verdict.into(), reps_needed, ..Default::default() }]

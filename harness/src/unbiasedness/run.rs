@@ -150,7 +150,7 @@ fn other_parts(registry: &Registry, first: &Sweep) -> Vec<(String, Sweep, usize)
     let Some(default_reps) = all.first().map(|p| p.sweep.reps) else { return Vec::new() };
     let first_fixed = match first.repetitions {
         Repetitions::Fixed => first.reps,
-        Repetitions::Rounds { fixed_reps } => fixed_reps,
+        Repetitions::Rounds { fixed_reps, .. } => fixed_reps,
     };
     let reps_override = (first_fixed != default_reps).then_some(first_fixed);
     all.into_iter()
@@ -242,7 +242,7 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
             }
             all
         }
-        Repetitions::Rounds { fixed_reps } => {
+        Repetitions::Rounds { fixed_reps, .. } => {
             let first = (&first_pilot, fixed_reps);
             in_rounds(plan, run, first, others, report, registry, &mut notes)?
         }
@@ -269,9 +269,9 @@ pub fn post(cx: PostContext<'_>) -> Result<Vec<PathBuf>> {
 }
 
 /// The rounds mode ([`rounds`]): every row of every part from its first round (`first`: the first
-/// part's pilot cells and fixed-mode repetitions), grown until decided or the budget is
-/// spent; the table in the fixed mode's order, the report's summary rows and tests the rows' last
-/// looks.
+/// part's pilot cells and fixed-mode repetitions), grown until decided or the budget (the sweep's
+/// share of the fixed mode's work, [`rounds::budget`]) is spent; the table in the fixed mode's
+/// order, the report's summary rows and tests the rows' last looks.
 fn in_rounds(
     plan: &Plan,
     run: &RunResults,
@@ -303,15 +303,22 @@ fn in_rounds(
         e.needed = rounds::needed(&tests);
     };
     entries.iter_mut().for_each(&look);
-    let budget: u64 = entries.iter().map(Entry::fixed_cost).sum();
+    let fixed_work: u64 = entries.iter().map(Entry::fixed_cost).sum();
+    let share = plan.sweep.repetitions.budget_share();
+    let budget = rounds::budget(fixed_work, share);
     let t0 = Instant::now();
     let extra = rounds::grow(&mut entries, budget, report.meta.threads, |e| {
         look(e);
         Ok(())
     })?;
     let spent: u64 = entries.iter().map(Entry::spent).sum();
+    let of = if share == 1.0 {
+        format!("of the fixed mode's {budget}")
+    } else {
+        format!("of the budget {budget} (share {share} of the fixed mode's {fixed_work})")
+    };
     notes.push(format!(
-        "rounds: {extra} after the first, {:.1} s, work {spent} of the fixed mode's {budget} (repetitions x integrals x samples, cells and pilots)",
+        "rounds: {extra} after the first, {:.1} s, work {spent} {of} (repetitions x integrals x samples, cells and pilots)",
         t0.elapsed().as_secs_f64()
     ));
     let mut rows = Vec::new();
