@@ -265,6 +265,23 @@ fn a_custom_sweep_runs_end_to_end_and_plots_can_be_redrawn() {
 }
 
 #[test]
+fn a_selection_leaves_out_the_claims_on_what_it_leaves_out() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let claims = "[[claims]]\nkind = 'slope'\ntestbed = 'gradient-plane/default'\nestimator = 'is0_cv0'\nvalue = -0.5\ntext = 'plain'\n\
+                  [[claims]]\nkind = 'control_flagged'\nestimator = 'clamped_is0_cv0[clamp=1.5]'\n";
+    std::fs::write(d.join("tiny.toml"), format!("{SMALL}{claims}")).expect("write");
+    // Without a selection both claims are judged; with one, the claim on the estimator left out
+    // goes with it (one note), where it used to make the run refuse.
+    let o = mcbench(d, &["run", "--config", "tiny.toml", "--estimators", "is0_cv0", "--no-plots"]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let notes: Vec<String> = stderr(&o).lines().filter(|l| l.contains("left out")).map(String::from).collect();
+    assert!(notes.len() == 1 && notes[0].contains("clamped_is0_cv0[clamp=1.5]"), "{notes:?}");
+    let claims = std::fs::read_to_string(d.join("results/tiny/claims.csv")).expect("claims.csv");
+    assert!(claims.contains("plain") && !claims.contains("clamped"), "{claims}");
+}
+
+#[test]
 fn reference_command_stores_the_exact_reference() {
     let dir = tempfile::tempdir().expect("tempdir");
     let o = mcbench(dir.path(), &["reference", "gradient-plane", "--variant", "stiff"]);
