@@ -128,11 +128,13 @@ impl Selection {
         let keep: Vec<bool> = sweep.claims.iter().map(|c| self.keeps_claim(&sweep, c)).collect();
         let mut kept = keep.iter();
         sweep.claims.retain(|_| *kept.next().unwrap_or(&true));
-        sweep.estimators.retain(|e| any(&self.estimators, &e.id));
-        sweep.testbeds.retain(|t| any(&self.testbeds, &t.id));
-        if sweep.baseline.as_ref().is_some_and(|b| !sweep.estimators.iter().any(|e| &e.name() == b)) {
+        // Only a baseline the selection leaves out goes; one that names no estimator of the sweep
+        // stays, for validation to refuse.
+        if sweep.baseline.as_deref().is_some_and(|b| !self.keeps_estimator(&sweep, b)) {
             sweep.baseline = None;
         }
+        sweep.estimators.retain(|e| any(&self.estimators, &e.id));
+        sweep.testbeds.retain(|t| any(&self.testbeds, &t.id));
         sweep
     }
 
@@ -152,13 +154,17 @@ impl Selection {
             .collect()
     }
 
+    /// Whether the estimator `name` of `sweep` is selected (a name of no estimator of the sweep is
+    /// kept, for validation to refuse).
+    fn keeps_estimator(&self, sweep: &Sweep, name: &str) -> bool {
+        let mut named = sweep.estimators.iter().filter(|e| e.name() == name).peekable();
+        named.peek().is_none() || named.any(|e| any(&self.estimators, &e.id))
+    }
+
     /// Whether every estimator and test bed `claim` names (a speed-up's baseline, its own or the
     /// sweep's, included) is in the selection.
     fn keeps_claim(&self, sweep: &Sweep, claim: &ClaimSpec) -> bool {
-        let kept_estimator = |name: &str| {
-            sweep.estimators.iter().any(|e| e.name() == name && any(&self.estimators, &e.id))
-                || !sweep.estimators.iter().any(|e| e.name() == name)
-        };
+        let kept_estimator = |name: &str| self.keeps_estimator(sweep, name);
         let kept_bed = |bed: &str| any(&self.testbeds, bed.split('/').next().unwrap_or(bed));
         let baseline = match claim {
             ClaimSpec::Speedup { baseline: None, .. } => sweep.baseline.as_deref(),
@@ -249,6 +255,13 @@ mod tests {
         // Only the box: the plane's claims leave.
         let narrowed = Selection::new(None, Some("gradient-box")).filter_sweep(sweep.clone());
         assert_eq!(texts(&narrowed), ["gradient-box/albedo-0.5"]);
+
+        // A baseline that names no estimator of the sweep stays, for validation to refuse.
+        let mut typo = sweep.clone();
+        typo.baseline = Some("is9_cv9".into());
+        let narrowed = Selection::new(Some("is0_cv0"), None).filter_sweep(typo);
+        assert_eq!(narrowed.baseline.as_deref(), Some("is9_cv9"));
+        assert!(narrowed.validate().is_err());
 
         // Nothing named: the sweep as it was.
         assert_eq!(Selection::new(None, None).filter_sweep(sweep.clone()), sweep);
