@@ -125,9 +125,8 @@ impl Selection {
     /// ([`Selection::claims_left_out`] says which), and a baseline left out is no longer the
     /// sweep's, so a named experiment runs on any part of it.
     pub fn filter_sweep(&self, mut sweep: Sweep) -> Sweep {
-        let keep: Vec<bool> = sweep.claims.iter().map(|c| self.keeps_claim(&sweep, c)).collect();
-        let mut kept = keep.iter();
-        sweep.claims.retain(|_| *kept.next().unwrap_or(&true));
+        let claims = std::mem::take(&mut sweep.claims);
+        sweep.claims = claims.into_iter().filter(|c| self.keeps_claim(&sweep, c)).collect();
         // Only a baseline the selection leaves out goes; one that names no estimator of the sweep
         // stays, for validation to refuse.
         if sweep.baseline.as_deref().is_some_and(|b| !self.keeps_estimator(&sweep, b)) {
@@ -165,7 +164,7 @@ impl Selection {
     /// sweep's, included) is in the selection.
     fn keeps_claim(&self, sweep: &Sweep, claim: &ClaimSpec) -> bool {
         let kept_estimator = |name: &str| self.keeps_estimator(sweep, name);
-        let kept_bed = |bed: &str| any(&self.testbeds, bed.split('/').next().unwrap_or(bed));
+        let kept_bed = |bed: &str| any(&self.testbeds, bed.split_once('/').map_or(bed, |(id, _)| id));
         let baseline = match claim {
             ClaimSpec::Speedup { baseline: None, .. } => sweep.baseline.as_deref(),
             _ => None,
